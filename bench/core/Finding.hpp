@@ -1,0 +1,38 @@
+// A finding: something the firmware did that a bench engineer must look at
+// (a crash, a reset, later a timing violation). Reported with cycle, PC and the
+// nearest ELF symbol so it can be found in the listing.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/Time.hpp"
+
+namespace avrbench {
+
+enum class FindingKind {
+    SimavrCrash,       // simavr stopped the core (e.g. write outside RAM)
+    InvalidOpcode,     // an opcode the AVR core does not decode
+    PcOutsideProgram,  // PC left the loaded program (erased flash or past flashend)
+    StackOverflow,     // SP went below the end of .data/.bss/.noinit
+    BadInterrupt,      // an enabled interrupt without a handler reached __bad_interrupt
+    WatchdogReset,     // the watchdog timed out in system-reset mode
+    JumpToReset,       // execution reached the reset vector without a hardware reset
+};
+
+const char* to_string(FindingKind kind);
+
+struct Finding {
+    FindingKind kind;
+    std::string mcu;      // which MCU of the board
+    Cycle cycle = 0;      // that MCU's cycle counter when it was detected
+    std::uint32_t clock_hz = 0;
+    std::uint32_t pc_bytes = 0;
+    std::string symbol;   // nearest ELF symbol to the PC, "func+0x12"
+    std::string detail;   // one line of explanation
+
+    // "mcu: stack-overflow at cycle 1234 (77.125 us), PC 0x01a4 recurse+0x6: SP 0x0213 below __bss_end 0x0300"
+    std::string describe() const;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,315 @@
+#include "core/Mcu.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+extern "C" {
+#include <avr_ioport.h>
+#include <sim_avr.h>
+#include <sim_cycle_timers.h>
+#include <sim_elf.h>
+#include <sim_io.h>
+}
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+
+struct WatchdogResetHook {
+    // avr_reset() zeroes the I/O space and then calls every module's reset;
+    // the watchdog module sets MCUSR.WDRF in its own reset when the reset was
+    // its doing. Wrapping that hook is how we tell a watchdog reset apart.
+    static void watchdog_reset(avr_io_t* io) {
+        avr_t* avr = io->avr;
+        auto* mcu = static_cast<Mcu*>(static_cast<SimavrLogSink*>(avr->custom.data));
+        mcu->original_watchdog_reset_(io);
+        if (avr_regbit_get(avr, avr->reset_flags.wdrf)) mcu->watchdog_reset_seen_ = true;
+    }
+};
+
+namespace {
+
+// When the SLEEP instruction itself reaches the target, simavr fires this
+// timer and then computes the sleep from the next one; re-arming one cycle
+// ahead keeps that jump short. run_until() cancels it on the way out.
+avr_cycle_count_t horizon_timer(avr_t* avr, avr_cycle_count_t, void*) { return avr->cycle + 1; }
+
+bool is_out_to(const avr_t* avr, std::uint32_t pc_bytes, unsigned io_address) {
+    const unsigned opcode = avr->flash[pc_bytes] | (avr->flash[pc_bytes + 1] << 8);
+    // OUT A,Rr: 1011 1AAr rrrr AAAA (AVR Instruction Set Manual).
+    if ((opcode & 0xF800) != 0xB800) return false;
+    return (((opcode >> 5) & 0x30) | (opcode & 0x0F)) == io_address;
+}
+
+// avr-gcc's prologues and epilogues set SP with `out SPH`, `out SREG`,
+// `out SPL`; between the SPH and SPL writes SP reads as new-high/old-low,
+// which can dip below its true value. The check runs again after the SPL write.
+bool sp_half_written(const avr_t* avr, std::uint32_t pc_before) {
+    constexpr unsigned kSph = 0x3E, kSreg = 0x3F;
+    if (is_out_to(avr, pc_before, kSph)) return true;
+    return pc_before >= 2 && is_out_to(avr, pc_before, kSreg) && is_out_to(avr, pc_before - 2, kSph);
+}
+
+std::string trim_line(const char* text) {
+    std::string s;
+    for (const char* p = text; *p != '\0'; ++p) {
+        if (*p == '\x1b') {  // drop simavr's ANSI colour sequences
+            while (*p != '\0' && *p != 'm') ++p;
+            if (*p == '\0') break;
+            continue;
+        }
+        if (*p == '\n' || *p == '\r') continue;
+        s.push_back(*p);
+    }
+    return s;
+}
+
+}  // namespace
+
+Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options)), elf_(elf) {
+    install_simavr_log_router();
+    mcu_type_ = !options_.mcu_type.empty() ? options_.mcu_type : elf_.embedded_mcu();
+    frequency_hz_ = options_.frequency_hz != 0 ? options_.frequency_hz : elf_.embedded_frequency_hz();
+    if (mcu_type_.empty()) {
+        throw BadInput(elf_.path() + ": no MCU type: the ELF has no .mmcu section; give one with --mcu (e.g. --mcu atmega328p)");
+    }
+    if (frequency_hz_ == 0) {
+        throw BadInput(elf_.path() + ": no clock frequency: the ELF has no .mmcu section; give one with --freq (e.g. --freq 16MHz)");
+    }
+    avr_ = avr_make_mcu_by_name(mcu_type_.c_str());
+    if (avr_ == nullptr) throw BadInput("unknown MCU '" + mcu_type_ + "' (simavr has no core by that name)");
+    avr_init(avr_);
+    route_simavr_log(avr_, this);
+    avr_->log = LOG_ERROR;
+
+    // A shallow copy: simavr only reads the firmware, and clearing tracecount
+    // keeps simavr from opening its own VCD file for firmware that asks for one
+    // (AVR_MMCU_TAG_VCD_TRACE); the bench's recorder is the one trace.
+    elf_firmware_t firmware = elf_.simavr_firmware();
+    firmware.tracecount = 0;
+    if (firmware.flashbase + firmware.flashsize > avr_->flashend + 1) {
+        // avr_loadcode() would abort() the whole process.
+        const std::string message = elf_.path() + ": program of " + std::to_string(firmware.flashsize) +
+                                    " bytes does not fit the " + std::to_string(avr_->flashend + 1) +
+                                    "-byte flash of " + mcu_type_ + " (wrong --mcu?)";
+        route_simavr_log(avr_, nullptr);
+        avr_terminate(avr_);
+        std::free(avr_);
+        avr_ = nullptr;
+        throw BadInput(message);
+    }
+    avr_load_firmware(avr_, &firmware);
+    avr_->frequency = frequency_hz_;
+
+    fixes_ = std::make_unique<SimavrFixes>(avr_);
+    scheduler_ = std::make_unique<Scheduler>(avr_);
+
+    for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
+        if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
+            original_watchdog_reset_ = io->reset;
+            io->reset = &WatchdogResetHook::watchdog_reset;
+        }
+    }
+
+    code_end_bytes_ = avr_->codeend;
+    if (auto bad = elf_.symbol_address("__bad_interrupt")) bad_interrupt_pc_ = *bad;
+    if (elf_.ram_end_of_static_data() > 0) {
+        // A push writes at SP and then decrements it, so SP = __bss_end - 1
+        // is still clear of .bss; one lower and the last push overwrote it.
+        stack_floor_ = static_cast<std::uint16_t>(elf_.ram_end_of_static_data() - 1);
+    }
+}
+
+Mcu::~Mcu() {
+    uarts_.clear();
+    pins_.clear();
+    scheduler_.reset();
+    if (avr_ != nullptr) {
+        avr_cycle_timer_cancel(avr_, &horizon_timer, this);
+        route_simavr_log(avr_, nullptr);
+        avr_terminate(avr_);
+        std::free(avr_);
+    }
+}
+
+Cycle Mcu::cycle() const { return avr_->cycle; }
+std::uint32_t Mcu::pc_bytes() const { return avr_->pc; }
+std::uint16_t Mcu::stack_pointer() const {
+    return static_cast<std::uint16_t>(avr_->data[R_SPL] | (avr_->data[R_SPH] << 8));
+}
+bool Mcu::sleeping() const { return avr_->state == cpu_Sleeping; }
+
+Cycle Mcu::cycles_from_seconds(double seconds) const {
+    return static_cast<Cycle>(std::llround(seconds * static_cast<double>(frequency_hz_)));
+}
+
+bool Mcu::step() {
+    if (halted_) return false;
+    const std::uint32_t pc_before = avr_->pc;
+    const int state = avr_run(avr_);
+    ++steps_;
+    check_after_step(state, pc_before);
+    return !halted_;
+}
+
+StopReason Mcu::run_until(Cycle target_cycle) {
+    stop_requested_ = false;
+    if (halted_) return StopReason::Halted;
+    avr_t* const avr = avr_;
+    // A cycle timer at the target: a core that sleeps (now, or when the SLEEP
+    // instruction executes inside avr_run) jumps to its next cycle timer, and
+    // without this one that could lie far past the target.
+    if (avr->cycle < target_cycle) avr_cycle_timer_register(avr, target_cycle - avr->cycle, &horizon_timer, this);
+    while (avr->cycle < target_cycle) {
+        const std::uint32_t pc_before = avr->pc;
+        const int state = avr_run(avr);
+        ++steps_;
+        const std::uint32_t pc = avr->pc;
+        const std::uint16_t sp = static_cast<std::uint16_t>(avr->data[R_SPL] | (avr->data[R_SPH] << 8));
+        if (__builtin_expect((state != cpu_Running && state != cpu_Sleeping) || pc >= code_end_bytes_ ||
+                                 pc == bad_interrupt_pc_ || pc == 0 || sp < stack_floor_,
+                             0)) {
+            check_after_step(state, pc_before);
+        }
+        if (__builtin_expect(stop_requested_ || halted_, 0)) break;
+    }
+    avr_cycle_timer_cancel(avr, &horizon_timer, this);
+    if (halted_) return StopReason::Halted;
+    if (stop_requested_) {
+        stop_requested_ = false;
+        return StopReason::Requested;
+    }
+    return StopReason::ReachedTarget;
+}
+
+bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
+    char detail[160];
+    if (state == cpu_Crashed) {
+        add_finding(FindingKind::SimavrCrash, avr_->pc,
+                    last_error_log_.empty() ? "simavr stopped the core" : last_error_log_, true);
+        return false;
+    }
+    if (state == cpu_Done || state == cpu_Stopped) {
+        halted_ = true;
+        halt_reason_ = state == cpu_Done ? "SLEEP with interrupts disabled: nothing can wake the core"
+                                         : "simavr stopped the core";
+        return false;
+    }
+    if (halted_) return false;  // a finding raised from inside the step (invalid opcode)
+    const std::uint32_t pc = avr_->pc;
+    if (pc == 0) {
+        ++resets_;
+        // avr_reset() drops every cycle timer: put the scheduler's back.
+        scheduler_->rearm();
+        if (watchdog_reset_seen_) {
+            watchdog_reset_seen_ = false;
+            add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
+        } else {
+            std::snprintf(detail, sizeof detail, "execution jumped to the reset vector from %s",
+                          elf_.describe_flash_address(pc_before).c_str());
+            add_finding(FindingKind::JumpToReset, pc_before, detail, false);
+        }
+        return true;
+    }
+    if (pc == bad_interrupt_pc_) {
+        const unsigned vector_bytes = avr_->vector_size != 0 ? avr_->vector_size : 4;
+        std::snprintf(detail, sizeof detail,
+                      "interrupt vector %u (at 0x%04x) has no handler; avr-libc would reset the MCU",
+                      pc_before / vector_bytes, pc_before);
+        add_finding(FindingKind::BadInterrupt, pc, detail, true);
+        return false;
+    }
+    if (pc >= code_end_bytes_) {
+        std::snprintf(detail, sizeof detail, "PC 0x%04x is past the end of the program (0x%04x), came from %s",
+                      pc, code_end_bytes_, elf_.describe_flash_address(pc_before).c_str());
+        add_finding(FindingKind::PcOutsideProgram, pc, detail, true);
+        return false;
+    }
+    const unsigned sp = avr_->data[R_SPL] | (avr_->data[R_SPH] << 8);
+    if (sp < stack_floor_ && !sp_half_written(avr_, pc_before)) {
+        std::snprintf(detail, sizeof detail, "SP 0x%04x is below the end of .data/.bss (0x%04x): the stack overwrote static data",
+                      sp, elf_.ram_end_of_static_data());
+        add_finding(FindingKind::StackOverflow, pc_before, detail, true);
+        return false;
+    }
+    return true;
+}
+
+void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt) {
+    Finding f;
+    f.kind = kind;
+    f.mcu = options_.name;
+    f.cycle = avr_->cycle;
+    f.clock_hz = frequency_hz_;
+    f.pc_bytes = pc_bytes;
+    f.symbol = elf_.describe_flash_address(pc_bytes);
+    f.detail = std::move(detail);
+    findings_.push_back(std::move(f));
+    if (halt) {
+        halted_ = true;
+        halt_reason_ = findings_.back().describe();
+        stop_requested_ = true;
+    }
+}
+
+void Mcu::on_simavr_error(const char* message) {
+    // avr_sadly_crashed() logs its own name after the message that explains
+    // the crash; keep the explanation.
+    if (std::strstr(message, "avr_sadly_crashed") == nullptr) last_error_log_ = trim_line(message);
+    if (std::strstr(message, "Invalid Opcode") != nullptr && !halted_) {
+        // _avr_invalid_opcode() logs before the PC moves: avr->pc is the opcode.
+        const std::uint32_t pc = avr_->pc;
+        const unsigned opcode = avr_->flash[pc] | (avr_->flash[pc + 1] << 8);
+        char detail[64];
+        std::snprintf(detail, sizeof detail, "opcode 0x%04x is not an AVR instruction", opcode);
+        add_finding(FindingKind::InvalidOpcode, pc, detail, true);
+    }
+}
+
+Pin& Mcu::pin(std::string_view name) {
+    auto it = pins_.find(name);
+    if (it != pins_.end()) return *it->second;
+    std::string_view s = name;
+    if (s.size() == 3 && (s[0] == 'P' || s[0] == 'p')) s.remove_prefix(1);
+    const bool well_formed = s.size() == 2 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] >= '0' && s[1] <= '7';
+    if (!well_formed) throw BadInput("bad pin name '" + std::string(name) + "' (expected e.g. PB5)");
+    const char port = static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
+    const int bit = s[1] - '0';
+    avr_irq_t* irq = avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(port), bit);
+    if (irq == nullptr) throw BadInput(mcu_type_ + " has no port " + std::string(1, port) + " (pin '" + std::string(name) + "')");
+    std::string canonical = std::string("P") + port + static_cast<char>('0' + bit);
+    auto& slot = pins_[canonical];
+    if (!slot) slot = std::make_unique<Pin>(avr_, canonical, irq);
+    return *slot;
+}
+
+Uart& Mcu::uart(int index) {
+    auto& slot = uarts_[index];
+    if (!slot) {
+        try {
+            slot = std::make_unique<Uart>(avr_, *scheduler_, index);
+        } catch (...) {
+            uarts_.erase(index);
+            throw;
+        }
+    }
+    return *slot;
+}
+
+std::uint16_t Mcu::ram_address_of(const std::string& symbol) const {
+    auto address = elf_.symbol_address(symbol);
+    if (!address || *address < 0x800000) throw BadInput(elf_.path() + ": no RAM symbol '" + symbol + "'");
+    return static_cast<std::uint16_t>(*address - 0x800000);
+}
+
+std::uint8_t Mcu::read_ram_u8(const std::string& symbol) const { return avr_->data[ram_address_of(symbol)]; }
+
+std::uint16_t Mcu::read_ram_u16(const std::string& symbol) const {
+    const std::uint16_t a = ram_address_of(symbol);
+    return static_cast<std::uint16_t>(avr_->data[a] | (avr_->data[a + 1] << 8));
+}
+
+}  // namespace avrbench

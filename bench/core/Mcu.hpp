@@ -1,0 +1,122 @@
+// One simavr MCU (RAII): firmware loaded, virtual time, named pins, UARTs, a
+// scheduler, and the crash oracles checked after every instruction.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/ElfImage.hpp"
+#include "core/Finding.hpp"
+#include "core/Pin.hpp"
+#include "core/Scheduler.hpp"
+#include "core/SimavrFixes.hpp"
+#include "core/SimavrLog.hpp"
+#include "core/Uart.hpp"
+#include "core/Time.hpp"
+
+struct avr_t;
+struct avr_io_t;
+
+namespace avrbench {
+
+struct McuOptions {
+    std::string name = "mcu";        // the MCU's name on the board, used in scopes and findings
+    std::string mcu_type;            // overrides the ELF's .mmcu section, e.g. "atmega328p"
+    std::uint32_t frequency_hz = 0;  // overrides the ELF's .mmcu section
+};
+
+enum class StopReason {
+    ReachedTarget,   // the requested cycle was reached
+    Requested,       // a callback called request_stop()
+    Halted,          // the MCU can run no further (finding, crash, sleep with interrupts off)
+};
+
+class Mcu final : private SimavrLogSink {
+public:
+    // Throws BadInput (one line) when the MCU type or clock is unknown or
+    // missing (an ELF without .mmcu section and no override).
+    Mcu(const ElfImage& elf, McuOptions options = {});
+    ~Mcu();
+    Mcu(const Mcu&) = delete;
+    Mcu& operator=(const Mcu&) = delete;
+
+    const std::string& name() const { return options_.name; }
+    const std::string& mcu_type() const { return mcu_type_; }
+    std::uint32_t frequency_hz() const { return frequency_hz_; }
+    const ElfImage& elf() const { return elf_; }
+    avr_t* avr() const { return avr_; }
+
+    Cycle cycle() const;
+    std::uint32_t pc_bytes() const;
+    std::uint16_t stack_pointer() const;
+    double seconds() const { return static_cast<double>(cycle()) / frequency_hz_; }
+    Cycle cycles_from_seconds(double seconds) const;
+
+    bool sleeping() const;
+    // The core stopped: a finding halted it, simavr crashed it, or it slept with
+    // interrupts disabled (nothing can wake it).
+    bool halted() const { return halted_; }
+    const std::string& halt_reason() const { return halt_reason_; }
+
+    // Runs until the cycle counter reaches `target_cycle`, the MCU halts, or a
+    // callback asks to stop. A sleeping core jumps straight to its next event.
+    StopReason run_until(Cycle target_cycle);
+    StopReason run_for(Cycle cycles) { return run_until(cycle() + cycles); }
+    // Executes one instruction (or one sleep fast-forward). Returns false once halted.
+    bool step();
+    void request_stop() { stop_requested_ = true; }
+
+    // "PB5" (also "B5"). Throws BadInput for a port the MCU does not have.
+    Pin& pin(std::string_view name);
+    // USART n. Throws BadInput when the MCU has no such USART.
+    Uart& uart(int index = 0);
+    Scheduler& scheduler() { return *scheduler_; }
+
+    const std::vector<Finding>& findings() const { return findings_; }
+    // Number of avr_run() steps taken: instructions plus sleep fast-forwards.
+    std::uint64_t steps() const { return steps_; }
+    // How many times the core went through a reset after power-on.
+    unsigned resets() const { return resets_; }
+
+    // Value of a RAM variable by its ELF symbol (for tests and reports).
+    std::uint8_t read_ram_u8(const std::string& symbol) const;
+    std::uint16_t read_ram_u16(const std::string& symbol) const;
+
+private:
+    friend struct WatchdogResetHook;
+    bool check_after_step(int state, std::uint32_t pc_before);
+    void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);
+    void on_simavr_error(const char* message) override;
+    std::uint16_t ram_address_of(const std::string& symbol) const;
+
+    McuOptions options_;
+    ElfImage elf_;
+    std::string mcu_type_;
+    std::uint32_t frequency_hz_ = 0;
+    avr_t* avr_ = nullptr;
+    std::unique_ptr<SimavrFixes> fixes_;
+    std::unique_ptr<Scheduler> scheduler_;
+    std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
+    std::map<int, std::unique_ptr<Uart>> uarts_;
+    std::vector<Finding> findings_;
+
+    // Oracle thresholds, precomputed so the hot loop only compares.
+    std::uint32_t code_end_bytes_ = 0;        // first flash byte past .text
+    std::uint32_t bad_interrupt_pc_ = ~0u;    // __bad_interrupt, or never
+    std::uint16_t stack_floor_ = 0;           // SP below this has overwritten .bss
+
+    std::uint64_t steps_ = 0;
+    unsigned resets_ = 0;
+    bool stop_requested_ = false;
+    bool halted_ = false;
+    std::string halt_reason_;
+    std::string last_error_log_;
+    void (*original_watchdog_reset_)(::avr_io_t*) = nullptr;
+    bool watchdog_reset_seen_ = false;
+};
+
+}  // namespace avrbench

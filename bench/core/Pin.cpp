@@ -1,0 +1,41 @@
+#include "core/Pin.hpp"
+
+extern "C" {
+#include <sim_avr.h>
+#include <sim_irq.h>
+}
+
+namespace avrbench {
+
+Pin::Pin(avr_t* avr, std::string name, avr_irq_t* irq) : avr_(avr), name_(std::move(name)), irq_(irq) {}
+
+Pin::~Pin() {
+    if (notify_registered_) avr_irq_unregister_notify(irq_, &Pin::notify, this);
+}
+
+bool Pin::level() const { return (irq_->value & 0xff) != 0; }
+
+void Pin::drive(bool level) { avr_raise_irq(irq_, level ? 1 : 0); }
+
+void Pin::on_change(Listener fn) {
+    listeners_.push_back(std::move(fn));
+    if (!notify_registered_) {
+        notified_level_ = level();
+        avr_irq_register_notify(irq_, &Pin::notify, this);
+        notify_registered_ = true;
+    }
+}
+
+// simavr raises a port's pin IRQs on every PORT write, changed or not, and a
+// timer's compare output raises the pin twice for one edge (once with
+// AVR_IOPORT_OUTPUT = 0x100 or'ed in, once nested from the port write), so an
+// edge is a change from the level the listeners last heard.
+void Pin::notify(avr_irq_t*, std::uint32_t value, void* param) {
+    auto* self = static_cast<Pin*>(param);
+    const bool level = (value & 0xff) != 0;
+    if (level == self->notified_level_) return;
+    self->notified_level_ = level;
+    for (auto& fn : self->listeners_) fn(self->avr_->cycle, level);
+}
+
+}  // namespace avrbench

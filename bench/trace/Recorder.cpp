@@ -1,0 +1,87 @@
+#include "trace/Recorder.hpp"
+
+#include <cctype>
+#include <sstream>
+
+extern "C" {
+#include <sim_avr.h>
+#include <avr_ioport.h>
+#include <sim_io.h>
+#include <sim_irq.h>
+}
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+
+struct Recorder::PinSink {
+    avr_t* avr;
+    avr_irq_t* irq;
+    Timeline* timeline;
+    SignalId id;
+    bool level;
+
+    // simavr raises pin IRQs on every PORT write, changed or not, and a timer's
+    // compare output raises the pin twice for one edge (once with
+    // AVR_IOPORT_OUTPUT = 0x100 or'ed in, once nested from the port write), so
+    // an edge is a change from the level this sink last recorded.
+    static void notify(avr_irq_t*, std::uint32_t value, void* param) {
+        auto* sink = static_cast<PinSink*>(param);
+        const bool level = (value & 0xff) != 0;
+        if (level == sink->level) return;
+        sink->level = level;
+        sink->timeline->record(sink->id, sink->avr->cycle, level ? 1 : 0);
+    }
+};
+
+Recorder::Recorder(Timeline& timeline) : timeline_(timeline) {}
+
+Recorder::~Recorder() {
+    for (auto& sink : pin_sinks_) avr_irq_unregister_notify(sink->irq, &PinSink::notify, sink.get());
+}
+
+SignalId Recorder::trace_pin(Mcu& mcu, Pin& pin) {
+    const SignalId id = timeline_.add_signal({mcu.name(), pin.name(), SignalKind::Wire, 1, mcu.frequency_hz()});
+    const bool level = pin.level();
+    timeline_.record(id, mcu.cycle(), level ? 1 : 0);
+    pin_sinks_.push_back(std::make_unique<PinSink>(PinSink{mcu.avr(), pin.irq(), &timeline_, id, level}));
+    avr_irq_register_notify(pin.irq(), &PinSink::notify, pin_sinks_.back().get());
+    return id;
+}
+
+SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
+    const SignalId id = timeline_.add_signal(
+        {mcu.name(), "uart" + std::to_string(uart.index()) + "_tx", SignalKind::Bus, 8, mcu.frequency_hz()});
+    Timeline* timeline = &timeline_;
+    uart.on_transmit([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
+    return id;
+}
+
+std::vector<SignalId> Recorder::trace_pins(Mcu& mcu, const std::string& spec) {
+    std::vector<std::string> names;
+    std::stringstream ss(spec);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back()))) item.pop_back();
+        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front()))) item.erase(0, 1);
+        if (item.empty()) continue;
+        std::string upper;
+        for (char c : item) upper.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+        if (upper == "ALL") {
+            for (char port = 'A'; port <= 'L'; ++port) {
+                if (avr_io_getirq(mcu.avr(), AVR_IOCTL_IOPORT_GETIRQ(port), 0) == nullptr) continue;
+                for (int bit = 0; bit < 8; ++bit) names.push_back(std::string("P") + port + char('0' + bit));
+            }
+        } else if (upper.size() == 5 && upper.rfind("PORT", 0) == 0) {
+            for (int bit = 0; bit < 8; ++bit) names.push_back(std::string("P") + upper[4] + char('0' + bit));
+        } else {
+            names.push_back(upper);
+        }
+    }
+    if (names.empty()) throw BadInput("--trace: no pins in '" + spec + "'");
+    std::vector<SignalId> ids;
+    for (const auto& name : names) ids.push_back(trace_pin(mcu, mcu.pin(name)));
+    return ids;
+}
+
+}  // namespace avrbench

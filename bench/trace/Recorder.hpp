@@ -1,0 +1,38 @@
+// Connects MCU signals to a Timeline: pins (every edge with its cycle) and
+// UART transmit bytes. Pin edges arrive through a plain simavr IRQ callback
+// that appends to the timeline, the cheapest hook simavr offers.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/Mcu.hpp"
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+
+class Recorder {
+public:
+    explicit Recorder(Timeline& timeline);
+    ~Recorder();
+    Recorder(const Recorder&) = delete;
+    Recorder& operator=(const Recorder&) = delete;
+
+    // Adds "<mcu name>.<pin name>" as a wire, starting with its current level.
+    SignalId trace_pin(Mcu& mcu, Pin& pin);
+    // Adds "<mcu name>.uart<n>_tx" as an 8-bit bus: one event per byte, at the
+    // cycle of the UDR write.
+    SignalId trace_uart_tx(Mcu& mcu, Uart& uart);
+
+    // Pins named in `spec`: "PB5,PD2", "PORTB" (its 8 pins) or "all" (every
+    // pin of every port the MCU has). Throws BadInput on an unknown name.
+    std::vector<SignalId> trace_pins(Mcu& mcu, const std::string& spec);
+
+private:
+    struct PinSink;
+    Timeline& timeline_;
+    std::vector<std::unique_ptr<PinSink>> pin_sinks_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,84 @@
+// The timeline recorder: every traced signal change with the cycle it happened on.
+//
+// Recording is on the simulation's hot path (a pin IRQ fires for every PORT write),
+// so record() is an inline append to one flat vector; everything else (sorting
+// across clock domains, formatting) happens when a writer reads the timeline.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/Time.hpp"
+
+namespace avrbench {
+
+enum class SignalKind : std::uint8_t {
+    Wire,  // 1-bit digital signal
+    Bus,   // `width` bits, e.g. a UART byte or an 8-bit port
+    Real,  // analog value (volts, degC, ...) stored as double
+};
+
+struct SignalInfo {
+    std::string scope;  // one scope per MCU and per part, e.g. "mcu" or "x_driver"
+    std::string name;   // e.g. "PB5", "uart0_tx"
+    SignalKind kind = SignalKind::Wire;
+    unsigned width = 1;                 // bits; 1 for Wire, ignored for Real
+    std::uint32_t clock_hz = 16000000;  // clock domain whose cycles stamp this signal's events
+};
+
+using SignalId = std::uint32_t;
+
+struct TimelineEvent {
+    Cycle cycle;
+    SignalId signal;
+    union {
+        std::uint64_t bits;
+        double real;
+    } value;
+};
+
+class Timeline {
+public:
+    // Registers a signal; ids are dense and in registration order, which is also
+    // the order writers list signals in. Throws std::invalid_argument (one line
+    // naming the signal) for an empty scope or name, whitespace in either (VCD
+    // separates tokens by whitespace), a Wire wider than 1 bit, a Bus width
+    // outside 1..64, a zero clock, or a scope+name registered before.
+    SignalId add_signal(SignalInfo info);
+
+    // Record blindly: writers drop events that repeat a signal's value. For a
+    // Wire any nonzero `bits` is 1; for a Bus bits above `width` are ignored.
+    void record(SignalId id, Cycle cycle, std::uint64_t bits) {
+        TimelineEvent e{cycle, id, {}};
+        e.value.bits = bits;
+        events_.push_back(e);
+    }
+    void record_real(SignalId id, Cycle cycle, double value) {
+        TimelineEvent e{cycle, id, {}};
+        e.value.real = value;
+        events_.push_back(e);
+    }
+
+    const std::vector<SignalInfo>& signals() const { return signals_; }
+    // Events in the order they were recorded. Within one clock domain this is
+    // cycle order; across domains (several MCUs) order may differ by up to one
+    // instruction, so writers that need global order sort by time.
+    const std::vector<TimelineEvent>& events() const { return events_; }
+
+    // Returns the signal with that scope and name, or -1.
+    long find(const std::string& scope, const std::string& name) const;
+
+    // Avoids reallocation on the hot path when the caller knows the run's size.
+    void reserve_events(std::size_t count) { events_.reserve(count); }
+
+private:
+    std::vector<SignalInfo> signals_;
+    std::vector<TimelineEvent> events_;
+    std::map<std::pair<std::string, std::string>, SignalId> index_;  // (scope, name) -> id
+};
+
+}  // namespace avrbench

@@ -1,0 +1,378 @@
+#include "trace/VcdWriter.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "trace/ScopeGroups.hpp"
+#include "trace/VcdTimescale.hpp"
+
+#ifndef AVRBENCH_VERSION
+#define AVRBENCH_VERSION "dev"
+#endif
+
+namespace avrbench {
+
+namespace {
+
+// Text is formatted into one string and handed to fwrite in large blocks: per-
+// character stream output would make a 10-million-event dump take minutes.
+constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
+
+class Output {
+public:
+    Output(std::string& buffer, std::FILE* file, const std::string& path)
+        : buffer_(buffer), file_(file), path_(path) {}
+
+    void text(std::string_view s) { buffer_.append(s); }
+    void character(char c) { buffer_.push_back(c); }
+    void number(std::uint64_t value) {
+        char digits[24];
+        const auto end = std::to_chars(digits, digits + sizeof digits, value).ptr;
+        buffer_.append(digits, end);
+    }
+    void real(double value) {
+        char digits[40];
+        // Shortest text that parses back to the same double.
+        const auto end = std::to_chars(digits, digits + sizeof digits, value).ptr;
+        buffer_.append(digits, end);
+    }
+    void binary(std::uint64_t value, unsigned width) {
+        const std::size_t at = buffer_.size();
+        buffer_.resize(at + width);
+        char* out = buffer_.data() + at;
+        for (unsigned bit = width; bit-- > 0;) *out++ = static_cast<char>('0' + ((value >> bit) & 1U));
+    }
+    void maybe_flush() {
+        if (file_ != nullptr && buffer_.size() >= kFlushBytes) flush();
+    }
+    void flush() {
+        if (file_ == nullptr || buffer_.empty()) return;
+        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+            throw std::runtime_error("cannot write VCD file '" + path_ + "': " + std::strerror(errno));
+        buffer_.clear();
+    }
+
+private:
+    std::string& buffer_;
+    std::FILE* file_;
+    const std::string& path_;
+};
+
+// Per-signal writer state: how to format it, what was last written, and the
+// value staged for the timestamp being assembled.
+struct SignalState {
+    std::string code;  // VCD identifier
+    SignalKind kind = SignalKind::Wire;
+    unsigned width = 1;
+    std::uint64_t mask = 1;
+    std::uint32_t clock_hz = 0;
+    std::uint64_t units_per_cycle = 0;  // 0: not a whole number, convert with rounding
+    bool known = false;                 // false until a value was written (shown as x)
+    std::uint64_t written = 0;          // last written value (a double's bits for Real)
+    std::uint64_t staged = 0;
+    std::uint64_t staged_group = std::numeric_limits<std::uint64_t>::max();
+};
+
+class VcdEmitter {
+public:
+    VcdEmitter(const Timeline& timeline, const VcdOptions& options, Output& out)
+        : timeline_(timeline), options_(options), out_(out), timescale_(choose_timescale(timeline, options)) {
+        const auto& infos = timeline.signals();
+        signals_.resize(infos.size());
+        for (std::size_t id = 0; id < infos.size(); ++id) {
+            SignalState& s = signals_[id];
+            const SignalInfo& info = infos[id];
+            s.code = vcd_identifier(static_cast<std::uint32_t>(id));
+            s.kind = info.kind;
+            s.width = info.kind == SignalKind::Bus ? info.width : 1;
+            s.mask = s.width >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.width) - 1;
+            s.clock_hz = info.clock_hz;
+            s.units_per_cycle = timescale_.units_per_cycle(info.clock_hz);
+        }
+    }
+
+    VcdResult run() {
+        write_header();
+        const auto& events = timeline_.events();
+        bool sorted = true;
+        std::uint64_t previous = 0;
+        for (std::size_t i = 0; i < events.size() && sorted; ++i) {
+            const std::uint64_t t = time_of(events[i], i);
+            sorted = t >= previous;
+            previous = t;
+        }
+        if (sorted) {
+            // The common case (one MCU, or domains recorded in order): no copy, no sort.
+            write_changes(events.size(), [&](std::size_t i) { return Keyed{time_of(events[i], i), i}; });
+        } else {
+            // Sorting (time, record index) pairs is the stable sort by time.
+            std::vector<Keyed> keys(events.size());
+            for (std::size_t i = 0; i < events.size(); ++i) keys[i] = Keyed{time_of(events[i], i), i};
+            std::sort(keys.begin(), keys.end(), [](const Keyed& a, const Keyed& b) {
+                return a.time != b.time ? a.time < b.time : a.index < b.index;
+            });
+            write_changes(keys.size(), [&](std::size_t i) { return keys[i]; });
+        }
+        if (options_.end_cycle) {
+            const std::uint64_t end_time = timescale_.units_at(*options_.end_cycle, options_.end_clock_hz);
+            if (end_time > result_.end_time) {
+                out_.character('#');
+                out_.number(end_time);
+                out_.character('\n');
+                result_.end_time = end_time;
+            }
+        }
+        out_.flush();
+        result_.timescale = timescale_.text();
+        result_.exact = timescale_.exact();
+        return result_;
+    }
+
+private:
+    struct Keyed {
+        std::uint64_t time;
+        std::size_t index;
+    };
+
+    static VcdTimescale choose_timescale(const Timeline& timeline, const VcdOptions& options) {
+        std::vector<std::uint32_t> clocks;
+        for (const SignalInfo& info : timeline.signals()) clocks.push_back(info.clock_hz);
+        if (options.end_cycle) clocks.push_back(options.end_clock_hz);
+        return VcdTimescale::for_clocks(clocks);
+    }
+
+    std::uint64_t time_of(const TimelineEvent& e, std::size_t index) const {
+        if (e.signal >= signals_.size())
+            throw std::out_of_range("timeline event " + std::to_string(index) + " refers to signal id " +
+                                    std::to_string(e.signal) + ", but only " + std::to_string(signals_.size()) +
+                                    " signals are registered");
+        const SignalState& s = signals_[e.signal];
+        std::uint64_t units = 0;
+        if (s.units_per_cycle != 0 && !__builtin_mul_overflow(e.cycle, s.units_per_cycle, &units)) return units;
+        return timescale_.units_at(e.cycle, s.clock_hz);  // rounds, or throws on overflow
+    }
+
+    std::uint64_t normalized(const SignalState& s, const TimelineEvent& e) const {
+        switch (s.kind) {
+        case SignalKind::Wire: return e.value.bits != 0 ? 1 : 0;
+        case SignalKind::Bus: return e.value.bits & s.mask;
+        case SignalKind::Real: return std::bit_cast<std::uint64_t>(e.value.real);
+        }
+        return 0;
+    }
+
+    void write_header() {
+        out_.text("$version avrbench " AVRBENCH_VERSION " $end\n");
+        // No $date: the dump must not depend on when it was written.
+        out_.text("$comment cycle times:");
+        std::vector<std::uint32_t> clocks;
+        for (const SignalState& s : signals_) clocks.push_back(s.clock_hz);
+        if (options_.end_cycle) clocks.push_back(options_.end_clock_hz);
+        std::sort(clocks.begin(), clocks.end());
+        clocks.erase(std::unique(clocks.begin(), clocks.end()), clocks.end());
+        for (const std::uint32_t clock_hz : clocks) {
+            out_.text(" ");
+            out_.number(clock_hz);
+            const std::uint64_t per_cycle = timescale_.units_per_cycle(clock_hz);
+            out_.text(" Hz: ");
+            if (per_cycle != 0) {
+                out_.number(per_cycle);
+                out_.text(" x ");
+                out_.text(timescale_.text());
+                out_.text(" per cycle, exact;");
+            } else {
+                out_.text("rounded to the nearest ");
+                out_.text(timescale_.text());
+                out_.text(";");
+            }
+        }
+        out_.text(" $end\n");
+        out_.text("$timescale ");
+        out_.text(timescale_.text());
+        out_.text(" $end\n");
+
+        const auto& infos = timeline_.signals();
+        for (const ScopeGroup& group : group_by_scope(timeline_)) {
+            out_.text("$scope module ");
+            out_.text(group.scope);
+            out_.text(" $end\n");
+            for (const SignalId id : group.signals) {
+                const SignalState& s = signals_[id];
+                out_.text(s.kind == SignalKind::Real ? "$var real 64 " : "$var wire ");
+                if (s.kind != SignalKind::Real) {
+                    out_.number(s.width);
+                    out_.character(' ');
+                }
+                out_.text(s.code);
+                out_.character(' ');
+                out_.text(infos[id].name);
+                out_.text(" $end\n");
+            }
+            out_.text("$upscope $end\n");
+        }
+        out_.text("$enddefinitions $end\n");
+    }
+
+    void write_value(const SignalState& s, std::uint64_t value) {
+        if (s.kind == SignalKind::Real) {
+            out_.character('r');
+            out_.real(std::bit_cast<double>(value));
+            out_.character(' ');
+        } else if (s.width == 1) {
+            out_.character(value != 0 ? '1' : '0');
+        } else {
+            out_.character('b');
+            out_.binary(value, s.width);
+            out_.character(' ');
+        }
+        out_.text(s.code);
+        out_.character('\n');
+    }
+
+    void write_unknown(const SignalState& s) {
+        if (s.kind == SignalKind::Real)
+            out_.text("r0 ");
+        else
+            out_.text(s.width == 1 ? "x" : "bx ");
+        out_.text(s.code);
+        out_.character('\n');
+    }
+
+    void stage(const TimelineEvent& e) {
+        SignalState& s = signals_[e.signal];
+        if (s.staged_group != group_) {
+            s.staged_group = group_;
+            touched_.push_back(e.signal);
+        }
+        s.staged = normalized(s, e);  // a later event at the same time overrides
+    }
+
+    // Writes the staged values of one timestamp that differ from what was written.
+    void commit(std::uint64_t time) {
+        bool stamped = false;
+        for (const SignalId id : touched_) {
+            SignalState& s = signals_[id];
+            if (s.known && s.staged == s.written) continue;
+            if (!stamped) {
+                out_.character('#');
+                out_.number(time);
+                out_.character('\n');
+                stamped = true;
+                result_.end_time = time;
+            }
+            write_value(s, s.staged);
+            s.written = s.staged;
+            s.known = true;
+            ++result_.value_changes;
+        }
+        touched_.clear();
+        ++group_;
+        out_.maybe_flush();
+    }
+
+    template <class KeyAt>
+    void write_changes(std::size_t count, KeyAt key_at) {
+        const auto& events = timeline_.events();
+        std::size_t i = 0;
+        // Time-0 events give the initial values in $dumpvars.
+        for (; i < count; ++i) {
+            const Keyed k = key_at(i);
+            if (k.time != 0) break;
+            stage(events[k.index]);
+        }
+        out_.text("#0\n$dumpvars\n");
+        for (SignalState& s : signals_) {
+            if (s.staged_group == group_) {
+                write_value(s, s.staged);
+                s.written = s.staged;
+            } else {
+                write_unknown(s);
+                s.written = 0;  // r0 for a real; unused for x
+            }
+            s.known = s.kind == SignalKind::Real || s.staged_group == group_;
+        }
+        out_.text("$end\n");
+        touched_.clear();
+        ++group_;
+
+        if (i == count) return;
+        std::uint64_t current = key_at(i).time;
+        for (; i < count; ++i) {
+            const Keyed k = key_at(i);
+            if (k.time != current) {
+                commit(current);
+                current = k.time;
+            }
+            stage(events[k.index]);
+        }
+        commit(current);
+    }
+
+    const Timeline& timeline_;
+    const VcdOptions& options_;
+    Output& out_;
+    VcdTimescale timescale_;
+    std::vector<SignalState> signals_;
+    std::vector<SignalId> touched_;
+    std::uint64_t group_ = 0;  // counts timestamps; marks which signals are staged
+    VcdResult result_;
+};
+
+}  // namespace
+
+std::string vcd_identifier(std::uint32_t index) {
+    // Bijective numeration (no "zero digit" problem): every code is distinct and
+    // as short as possible. A code made of 4+ digits could spell a keyword such
+    // as "$end"; that takes over 839,000 signals, far beyond any bench.
+    std::string code;
+    std::uint64_t n = index;
+    for (;;) {
+        code.push_back(static_cast<char>('!' + n % 94));
+        n /= 94;
+        if (n == 0) break;
+        --n;
+    }
+    return code;
+}
+
+std::string format_vcd(const Timeline& timeline, const VcdOptions& options, VcdResult* result) {
+    std::string text;
+    const std::string no_path;
+    Output out(text, nullptr, no_path);
+    const VcdResult written = VcdEmitter(timeline, options, out).run();
+    if (result != nullptr) *result = written;
+    return text;
+}
+
+VcdResult write_vcd(const Timeline& timeline, const std::string& path, const VcdOptions& options) {
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    if (file == nullptr) throw std::runtime_error("cannot write VCD file '" + path + "': " + std::strerror(errno));
+    std::string buffer;
+    buffer.reserve(kFlushBytes + 4096);
+    Output out(buffer, file, path);
+    VcdResult result;
+    try {
+        result = VcdEmitter(timeline, options, out).run();
+    } catch (...) {
+        // A truncated dump would look like a run that stopped early: leave none.
+        std::fclose(file);
+        std::remove(path.c_str());
+        throw;
+    }
+    if (std::fclose(file) != 0) {
+        const int error = errno;
+        std::remove(path.c_str());
+        throw std::runtime_error("cannot write VCD file '" + path + "': " + std::strerror(error));
+    }
+    return result;
+}
+
+}  // namespace avrbench

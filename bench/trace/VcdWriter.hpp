@@ -1,0 +1,59 @@
+// Writes a Timeline as a Value Change Dump (IEEE 1364-2005 §18) for gtkwave and
+// other waveform viewers.
+//
+// What the output promises:
+// - Byte-identical for identical timelines: no $date, no wall clock, no paths.
+// - Timestamps are exact cycle times when every clock has an exact VCD unit
+//   (see VcdTimescale); VcdResult::exact says whether they are.
+// - Events of all clock domains are merged in time order; events at the same
+//   time keep the order they were recorded in.
+// - At one timestamp the LAST recorded value of a signal wins (VCD describes the
+//   value a signal has at a time; a zero-width glitch could not be seen anyway),
+//   and an event that leaves a signal's value unchanged is dropped, so recorders
+//   may record blindly.
+// - $dumpvars at #0 gives each signal's value at time 0: its last event at
+//   time 0, else x for wires and buses and r0 for reals (VCD has no unknown
+//   real; record a value at cycle 0 when 0 would mislead).
+// - Wires and 1-bit buses are written as scalars (`1!`), wider buses as full-width
+//   binary (`b00100000 "`), reals in the shortest form that reads back to the
+//   same double (`r25.5 #`, std::to_chars; also `rinf`, `rnan`).
+// - Signals are listed one $scope module per distinct SignalInfo::scope, scopes
+//   in order of first appearance, signals in registration order.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+
+struct VcdOptions {
+    // When set, the dump ends with #<time of end_cycle> so viewers show the whole
+    // run, not just up to the last change. Ignored when earlier than the last change.
+    std::optional<Cycle> end_cycle;
+    std::uint32_t end_clock_hz = 16000000;  // clock domain of end_cycle
+};
+
+struct VcdResult {
+    std::string timescale;            // e.g. "100ps"
+    bool exact = true;                // false: a clock has no exact VCD unit; times rounded to 1fs
+    std::uint64_t value_changes = 0;  // changes written after #0 (after dedupe)
+    std::uint64_t end_time = 0;       // last timestamp written, in timescale units
+};
+
+// Throws std::runtime_error naming `path` when it cannot be written,
+// std::out_of_range for an event whose signal id was never registered, and
+// std::overflow_error when a time does not fit 64 bits.
+VcdResult write_vcd(const Timeline& timeline, const std::string& path, const VcdOptions& options = {});
+
+// The same dump as a string (tests, small traces).
+std::string format_vcd(const Timeline& timeline, const VcdOptions& options = {}, VcdResult* result = nullptr);
+
+// The VCD identifier code of the signal with id `index`: bijective base 94 over
+// the printable characters '!'..'~', least significant digit first, so ids
+// 0..93 get one character and the next 94^2 = 8836 get two.
+std::string vcd_identifier(std::uint32_t index);
+
+}  // namespace avrbench

@@ -1,0 +1,150 @@
+// `avrbench run`: the summary, the VCD it writes, and one clear line with exit
+// code 2 for every kind of bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <ostream>
+
+#include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
+#include "trace/VcdReader.hpp"
+
+namespace avrbench {
+namespace {
+
+using test::quoted;
+
+const std::string kCli = AVRBENCH_CLI;
+
+std::size_t line_count(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST(CliRun, BlinkWritesAVcdThatReadsBackWithTheTimerPeriod) {
+    const auto dir = test::scratch_dir("cli-blink");
+    const auto vcd = (dir / "blink.vcd").string();
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("blink_timer1")) +
+                                         " --for 10ms --trace PB5,PB1 --vcd " + quoted(vcd), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    // 10 ms at 16 MHz = 160000 cycles; the run stops at the first
+    // instruction boundary at or after it (instructions take up to 5 cycles).
+    EXPECT_NE(r.out.find("simulated  0.0100"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" (16000"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("findings   0"), std::string::npos) << r.out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "blink.gtkw"));
+
+    const VcdDump parsed = read_vcd(vcd);
+    const VcdVariable* oc1a = parsed.find("mcu.PB1");
+    ASSERT_NE(oc1a, nullptr);
+    // 1 ms between OC1A toggles (Timer1 CTC, (249+1)*64 cycles at 16 MHz).
+    ASSERT_GT(parsed.timescale_fs, 0u);
+    const std::uint64_t one_ms = 1'000'000'000'000ULL / parsed.timescale_fs;
+    std::vector<std::uint64_t> toggles;
+    for (std::size_t i = 1; i < oc1a->changes.size(); ++i) toggles.push_back(oc1a->changes[i].time);
+    ASSERT_GE(toggles.size(), 9u);
+    for (std::size_t i = 1; i < toggles.size(); ++i) EXPECT_EQ(toggles[i] - toggles[i - 1], one_ms);
+}
+
+TEST(CliRun, TwoRunsGiveByteIdenticalVcds) {
+    const auto dir = test::scratch_dir("cli-determinism");
+    for (const char* name : {"a.vcd", "b.vcd"}) {
+        const auto r = test::run_command(kCli + " run " + quoted(test::firmware("uart_echo")) +
+                                             " --for 5ms --uart-in " + quoted(test::source_path("tests/cli/echo_input.txt")) +
+                                             " --vcd " + quoted((dir / name).string()), dir);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    const std::string a = test::slurp(dir / "a.vcd");
+    ASSERT_GT(a.size(), 200u);
+    EXPECT_EQ(a, test::slurp(dir / "b.vcd"));
+}
+
+TEST(CliRun, UartInAndOut) {
+    const auto dir = test::scratch_dir("cli-uart");
+    const auto out = dir / "out.txt";
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("uart_echo")) + " --for 10ms --uart-in " +
+                                         quoted(test::source_path("tests/cli/echo_input.txt")) + " --uart-out " +
+                                         quoted(out.string()), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(test::slurp(out), "avrbench uart_echo\r\n" + test::slurp(test::source_path("tests/cli/echo_input.txt")));
+}
+
+TEST(CliRun, UntilSleepStopsAtTheFirstSleep) {
+    const auto dir = test::scratch_dir("cli-sleep");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("sleep_idle")) + " --until-sleep", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("firmware executed SLEEP"), std::string::npos) << r.out;
+}
+
+TEST(CliRun, FirmwareThatNeverSleepsTimesOutWithCode3) {
+    const auto dir = test::scratch_dir("cli-nosleep");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("busy_poll")) + " --until-sleep --for 5ms", dir);
+    EXPECT_EQ(r.exit_code, 3);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("did not execute SLEEP within 5ms"), std::string::npos) << r.err;
+}
+
+TEST(CliRun, CrashIsAFindingWithExitCode1) {
+    const auto dir = test::scratch_dir("cli-crash");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("crash_bad_opcode")), dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.out.find("invalid-opcode"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("bad_opcode_here"), std::string::npos) << r.out;
+}
+
+struct BadInputCase {
+    const char* name;
+    std::string args;
+    std::string expected_fragment;
+};
+
+// Keeps ctest's test names short: gtest would otherwise print the raw bytes.
+void PrintTo(const BadInputCase& c, std::ostream* os) { *os << c.name; }
+
+class CliBadInput : public ::testing::TestWithParam<BadInputCase> {};
+
+TEST_P(CliBadInput, OneLineAndExitCode2) {
+    const auto dir = test::scratch_dir(std::string("cli-bad-") + GetParam().name);
+    const auto r = test::run_command(kCli + " " + GetParam().args, dir);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(GetParam().expected_fragment), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllErrors, CliBadInput,
+    ::testing::Values(
+        BadInputCase{"missing_file", "run /nonexistent/fw.elf", "/nonexistent/fw.elf: no such file"},
+        BadInputCase{"not_elf", "run " + test::source_path("tests/cli/echo_input.txt"), "echo_input.txt: not an ELF file"},
+        BadInputCase{"not_avr", "run " + std::string(AVRBENCH_CLI), "not an AVR ELF"},
+        BadInputCase{"unknown_mcu", "run " + test::firmware("blink_timer1") + " --mcu atmega9999",
+                     "unknown MCU 'atmega9999'"},
+        BadInputCase{"no_mmcu", "run " + test::firmware("blink_timer1_nommcu"), "give one with --mcu"},
+        BadInputCase{"bad_duration", "run " + test::firmware("blink_timer1") + " --for 2parsecs", "--for"},
+        BadInputCase{"bad_freq", "run " + test::firmware("blink_timer1") + " --freq fast", "--freq"},
+        BadInputCase{"missing_uart_in", "run " + test::firmware("uart_echo") + " --uart-in /nonexistent/in.txt",
+                     "/nonexistent/in.txt"},
+        BadInputCase{"unknown_pin", "run " + test::firmware("blink_timer1") + " --trace PZ3", "PZ3"},
+        BadInputCase{"unknown_option", "run " + test::firmware("blink_timer1") + " --frobnicate", "usage error"},
+        BadInputCase{"no_subcommand", "", "usage error"}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+TEST(CliRun, FirmwareForABiggerMcuCrashesCleanly) {
+    // The Mega 2560 start-up code sets SP to 0x21FF; on an ATtiny85 (RAMEND
+    // 0x25F) the first push writes outside RAM. simavr reports it; the bench
+    // turns it into a finding instead of letting the write hit host memory.
+    const auto dir = test::scratch_dir("cli-wrong-mcu");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("blink_timer1_m2560")) + " --mcu attiny85", dir);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_NE(r.out.find("simavr-crash"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("out of ram"), std::string::npos) << r.out;
+}
+
+TEST(CliRun, ElfWithoutMmcuRunsWithMcuAndFreq) {
+    const auto dir = test::scratch_dir("cli-nommcu");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("blink_timer1_nommcu")) +
+                                         " --mcu atmega328p --freq 16MHz --for 2ms", dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("atmega328p at 16 MHz"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace avrbench

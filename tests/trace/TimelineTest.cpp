@@ -1,0 +1,57 @@
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+namespace {
+
+TEST(Timeline, AddSignalReturnsDenseIdsAndFindLooksThemUp) {
+    Timeline timeline;
+    EXPECT_EQ(timeline.add_signal({"mcu", "PB5", SignalKind::Wire, 1, 16000000}), 0u);
+    EXPECT_EQ(timeline.add_signal({"mcu", "portb", SignalKind::Bus, 8, 16000000}), 1u);
+    EXPECT_EQ(timeline.add_signal({"heater", "PB5", SignalKind::Real, 1, 16000000}), 2u);
+    EXPECT_EQ(timeline.find("mcu", "portb"), 1);
+    EXPECT_EQ(timeline.find("heater", "PB5"), 2);  // same name, other scope
+    EXPECT_EQ(timeline.find("mcu", "PB6"), -1);
+    EXPECT_EQ(timeline.find("nope", "PB5"), -1);
+    EXPECT_EQ(timeline.signals().size(), 3u);
+}
+
+TEST(Timeline, RejectsSignalsAViewerCouldNotShow) {
+    Timeline timeline;
+    timeline.add_signal({"mcu", "PB5", SignalKind::Wire, 1, 16000000});
+    EXPECT_THROW(timeline.add_signal({"mcu", "PB5", SignalKind::Wire, 1, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"", "a", SignalKind::Wire, 1, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "", SignalKind::Wire, 1, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "a b", SignalKind::Wire, 1, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"m\tcu", "a", SignalKind::Wire, 1, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "w", SignalKind::Wire, 8, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "b0", SignalKind::Bus, 0, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "b65", SignalKind::Bus, 65, 16000000}), std::invalid_argument);
+    EXPECT_THROW(timeline.add_signal({"mcu", "clk0", SignalKind::Wire, 1, 0}), std::invalid_argument);
+    EXPECT_EQ(timeline.signals().size(), 1u);  // nothing half-registered
+    try {
+        timeline.add_signal({"mcu", "PB5", SignalKind::Wire, 1, 16000000});
+        FAIL() << "duplicate accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("mcu.PB5"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Timeline, RecordKeepsRecordOrderAndValues) {
+    Timeline timeline;
+    const SignalId pin = timeline.add_signal({"mcu", "PB5", SignalKind::Wire, 1, 16000000});
+    const SignalId temp = timeline.add_signal({"heater", "temp_degC", SignalKind::Real, 64, 16000000});
+    timeline.record(pin, 10, 1);
+    timeline.record_real(temp, 5, 21.5);
+    ASSERT_EQ(timeline.events().size(), 2u);
+    EXPECT_EQ(timeline.events()[0].cycle, 10u);
+    EXPECT_EQ(timeline.events()[0].value.bits, 1u);
+    EXPECT_EQ(timeline.events()[1].cycle, 5u);
+    EXPECT_EQ(timeline.events()[1].value.real, 21.5);
+}
+
+}  // namespace
+}  // namespace avrbench
