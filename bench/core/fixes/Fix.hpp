@@ -1,0 +1,76 @@
+// Building blocks for the corrections in SimavrFixes: one file per fix in
+// this folder, each an `install_...(avr_t*)` returning the state it needs to
+// keep alive (or nullptr), registered in SimavrFixes.cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+extern "C" {
+#include <sim_avr.h>
+}
+
+namespace avrbench {
+
+// State a fix keeps for the lifetime of its core.
+class Fix {
+public:
+    virtual ~Fix() = default;
+};
+
+// Chains a bench handler in front of (or after) the write handler simavr
+// installed on one I/O register. The handler receives `this`; call
+// `write_original()` to let simavr do its part.
+class IoWriteHook {
+public:
+    using Handler = void (*)(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+
+    IoWriteHook(avr_t* avr, avr_io_addr_t data_address, Handler handler, void* context);
+    ~IoWriteHook();
+    IoWriteHook(const IoWriteHook&) = delete;
+    IoWriteHook& operator=(const IoWriteHook&) = delete;
+
+    void write_original(avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+    void* context() const { return context_; }
+
+private:
+    static void trampoline(avr_t* avr, avr_io_addr_t addr, std::uint8_t value, void* param);
+
+    avr_t* avr_;
+    avr_io_addr_t address_;
+    Handler handler_;
+    void* context_;
+    avr_io_write_t original_;
+    void* original_param_;
+};
+
+// Same for reads.
+class IoReadHook {
+public:
+    using Handler = std::uint8_t (*)(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr);
+
+    IoReadHook(avr_t* avr, avr_io_addr_t data_address, Handler handler, void* context);
+    ~IoReadHook();
+    IoReadHook(const IoReadHook&) = delete;
+    IoReadHook& operator=(const IoReadHook&) = delete;
+
+    std::uint8_t read_original(avr_t* avr, avr_io_addr_t addr);
+    void* context() const { return context_; }
+
+private:
+    static std::uint8_t trampoline(avr_t* avr, avr_io_addr_t addr, void* param);
+
+    avr_t* avr_;
+    avr_io_addr_t address_;
+    Handler handler_;
+    void* context_;
+    avr_io_read_t original_;
+    void* original_param_;
+};
+
+// The simavr I/O module of a kind ("uart", "timer", "port", "adc",
+// "watchdog", ...) and optional name character, or nullptr. The returned
+// pointer is the module's avr_io_t, the first member of its specific struct.
+avr_io_t* find_io_module(avr_t* avr, const char* kind, char name = 0);
+
+}  // namespace avrbench
