@@ -1,6 +1,7 @@
 // A finding: something the firmware did that a bench engineer must look at
-// (a crash, a reset, later a timing violation). Reported with cycle, PC and the
-// nearest ELF symbol so it can be found in the listing.
+// (a crash, a reset, a driver timing violation, an axis crash). Reported with
+// the cycle, and for the MCU's own findings the PC and nearest ELF symbol so
+// it can be found in the listing.
 #pragma once
 
 #include <cstdint>
@@ -18,15 +19,25 @@ enum class FindingKind {
     BadInterrupt,      // an enabled interrupt without a handler reached __bad_interrupt
     WatchdogReset,     // the watchdog timed out in system-reset mode
     JumpToReset,       // execution reached the reset vector without a hardware reset
+
+    // Found by parts watching the firmware's pins (parts/).
+    StepHighTooShort,    // STEP active shorter than the driver's minimum
+    StepLowTooShort,     // STEP inactive shorter than the driver's minimum
+    DirSetupViolation,   // DIR changed too shortly before an active STEP edge
+    DirHoldViolation,    // DIR changed too shortly after an active STEP edge
+    StepRateTooHigh,     // STEP period shorter than the driver's maximum rate allows
+    AxisOutOfTravel,     // an axis was driven past either end of its travel (a crash)
+    HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
 };
 
 const char* to_string(FindingKind kind);
 
 struct Finding {
     FindingKind kind;
-    std::string mcu;      // which MCU of the board
+    std::string source;   // which MCU or part of the board reported it
     Cycle cycle = 0;      // that MCU's cycle counter when it was detected
     std::uint32_t clock_hz = 0;
+    bool has_pc = true;   // false for part findings: no PC is meaningful there
     std::uint32_t pc_bytes = 0;
     std::string symbol;   // nearest ELF symbol to the PC, "func+0x12"
     std::string detail;   // one line of explanation

@@ -15,6 +15,8 @@ extern "C" {
 }
 
 #include "core/Errors.hpp"
+#include "core/McuPins.hpp"
+#include "core/fixes/Fix.hpp"
 
 namespace avrbench {
 
@@ -241,7 +243,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
 void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt) {
     Finding f;
     f.kind = kind;
-    f.mcu = options_.name;
+    f.source = options_.name;
     f.cycle = avr_->cycle;
     f.clock_hz = frequency_hz_;
     f.pc_bytes = pc_bytes;
@@ -278,11 +280,17 @@ Pin& Mcu::pin(std::string_view name) {
     if (!well_formed) throw BadInput("bad pin name '" + std::string(name) + "' (expected e.g. PB5)");
     const char port = static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
     const int bit = s[1] - '0';
+    if (!mcu_has_pin(mcu_type_, port, bit)) {
+        throw BadInput(mcu_type_ + " has no pin P" + std::string(1, port) + std::string(1, static_cast<char>('0' + bit)));
+    }
     avr_irq_t* irq = avr_io_getirq(avr_, AVR_IOCTL_IOPORT_GETIRQ(port), bit);
     if (irq == nullptr) throw BadInput(mcu_type_ + " has no port " + std::string(1, port) + " (pin '" + std::string(name) + "')");
     std::string canonical = std::string("P") + port + static_cast<char>('0' + bit);
     auto& slot = pins_[canonical];
-    if (!slot) slot = std::make_unique<Pin>(avr_, canonical, irq);
+    if (!slot) {
+        auto* ioport = reinterpret_cast<avr_ioport_t*>(find_io_module(avr_, "port", port));
+        slot = std::make_unique<Pin>(avr_, canonical, irq, ioport, bit);
+    }
     return *slot;
 }
 

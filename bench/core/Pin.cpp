@@ -1,13 +1,15 @@
 #include "core/Pin.hpp"
 
 extern "C" {
+#include <avr_ioport.h>
 #include <sim_avr.h>
 #include <sim_irq.h>
 }
 
 namespace avrbench {
 
-Pin::Pin(avr_t* avr, std::string name, avr_irq_t* irq) : avr_(avr), name_(std::move(name)), irq_(irq) {}
+Pin::Pin(avr_t* avr, std::string name, avr_irq_t* irq, avr_ioport_t* port, int bit)
+    : avr_(avr), name_(std::move(name)), irq_(irq), port_(port), mask_(static_cast<std::uint8_t>(1u << bit)) {}
 
 Pin::~Pin() {
     if (notify_registered_) avr_irq_unregister_notify(irq_, &Pin::notify, this);
@@ -15,7 +17,26 @@ Pin::~Pin() {
 
 bool Pin::level() const { return (irq_->value & 0xff) != 0; }
 
-void Pin::drive(bool level) { avr_raise_irq(irq_, level ? 1 : 0); }
+void Pin::drive(bool level) {
+    port_->external.pull_mask = static_cast<std::uint8_t>(port_->external.pull_mask | mask_);
+    port_->external.pull_value = static_cast<std::uint8_t>(level ? (port_->external.pull_value | mask_)
+                                                                  : (port_->external.pull_value & ~mask_));
+    avr_raise_irq(irq_, level ? 1 : 0);
+}
+
+void Pin::release() {
+    port_->external.pull_mask = static_cast<std::uint8_t>(port_->external.pull_mask & ~mask_);
+    port_->external.pull_value = static_cast<std::uint8_t>(port_->external.pull_value & ~mask_);
+    if (!is_output()) avr_raise_irq(irq_, internal_pull_up() ? 1 : 0);
+}
+
+bool Pin::driven() const { return (port_->external.pull_mask & mask_) != 0; }
+
+bool Pin::internal_pull_up() const {
+    return !is_output() && (avr_->data[port_->r_port] & mask_) != 0;
+}
+
+bool Pin::is_output() const { return (avr_->data[port_->r_ddr] & mask_) != 0; }
 
 void Pin::on_change(Listener fn) {
     listeners_.push_back(std::move(fn));

@@ -1,6 +1,7 @@
 // One MCU pin (`PB5`) as a signal: watch its level, drive it from outside.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 
 struct avr_t;
 struct avr_irq_t;
+struct avr_ioport_t;
 
 namespace avrbench {
 
@@ -16,7 +18,7 @@ class Pin {
 public:
     using Listener = std::function<void(Cycle cycle, bool level)>;
 
-    Pin(avr_t* avr, std::string name, avr_irq_t* irq);
+    Pin(avr_t* avr, std::string name, avr_irq_t* irq, avr_ioport_t* port, int bit);
     Pin(const Pin&) = delete;
     Pin& operator=(const Pin&) = delete;
     ~Pin();
@@ -26,8 +28,18 @@ public:
     // output, the external drive or pull-up when it is an input.
     bool level() const;
     // Drives the pin from outside (a switch, another MCU); sets the PIN bit
-    // and raises pin-change interrupts as the hardware would.
+    // and raises pin-change interrupts as the hardware would. The level is
+    // held as simavr's "external" state of the pin, so later PORT writes (which
+    // make simavr re-raise every input's pull-up level) do not override it.
     void drive(bool level);
+    // Stops driving: the pin reads its internal pull-up (PORTxn = 1 while an
+    // input) or, floating, 0.
+    void release();
+    bool driven() const;
+    // The firmware has the pin as an input with PORTxn = 1.
+    bool internal_pull_up() const;
+    // The firmware has the pin as an output (DDxn = 1).
+    bool is_output() const;
     void on_change(Listener fn);
 
     // The simavr IRQ of the pin, for hot-path observers (the trace recorder)
@@ -41,6 +53,8 @@ private:
     avr_t* avr_;
     std::string name_;
     avr_irq_t* irq_;
+    avr_ioport_t* port_;
+    std::uint8_t mask_;
     std::vector<Listener> listeners_;
     bool notify_registered_ = false;
     bool notified_level_ = false;

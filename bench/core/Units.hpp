@@ -1,5 +1,6 @@
 // Quantities with units as users write them: "2s", "250us", "16MHz",
-// "1.9us", "80". One parser so the CLI, board files and scenarios agree.
+// "1.9us", "200mm", "4.7kohm". One parser so the CLI, board files and
+// scenarios agree. Values are returned in SI units.
 #pragma once
 
 #include <cstdint>
@@ -8,12 +9,38 @@
 
 namespace avrbench {
 
-// Seconds from "2s", "250ms", "100us", "500ns", "1.5min". A bare number is an
-// error (ambiguous). Throws BadInput naming `what` on a bad value or unit.
+enum class Dimension {
+    Dimensionless,  // a bare number: counts, ratios, or a unit carried by the name (steps_per_mm)
+    Time,           // s
+    Length,         // m
+    Frequency,      // Hz
+    Angle,          // rad
+    Voltage,        // V
+    Current,        // A
+    Resistance,     // ohm
+    Power,          // W
+    Temperature,    // degC (offset scale kept as users write it: 25degC -> 25)
+    ThermalResistance,  // K/W
+    HeatCapacity,       // J/K
+    Torque,             // N*m
+    Inductance,         // H
+    Inertia,            // kg*m^2
+    Speed,              // m/s
+    Acceleration,       // m/s^2
+};
+
+const char* to_string(Dimension dimension);
+
+// Parses "<number><unit>" (a space between is allowed) into SI units of
+// `dimension`. A bare number is accepted only for Dimensionless. Throws
+// BadInput naming `what` on a bad number, a unit of another dimension, or an
+// unknown unit; the message lists the units the dimension accepts.
+double parse_quantity(std::string_view text, Dimension dimension, std::string_view what);
+
+// Seconds from "2s", "250ms", "100us", "500ns", "1.5min".
 double parse_seconds(std::string_view text, std::string_view what);
 
-// Hertz from "16MHz", "20 MHz", "32768Hz", "16e6" or "16000000" (a bare
-// number is Hz). Throws BadInput naming `what`.
+// Hertz from "16MHz", "20 MHz", "32768Hz", or a bare number of Hz.
 std::uint32_t parse_frequency_hz(std::string_view text, std::string_view what);
 
 }  // namespace avrbench

@@ -1,5 +1,10 @@
 #include "trace/GtkwWriter.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -38,6 +43,17 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
     text += "[dumpfile] \"" + dump_path + "\"\n";
     if (!save_file_name.empty()) text += "[savefile] \"" + save_file_name + "\"\n";
     text += "[timestart] 0\n";
+    if (options.fit_end_time > 0 && options.fit_width_pixels > 0) {
+        // "100ps" -> 100: gtkwave counts time in the unit (ps), not in steps of 100 ps.
+        const double multiplier = std::max(1.0, std::atof(options.fit_timescale.c_str()));
+        constexpr double kPixelsPerUnitAtZoom0 = 192.0;
+        const double units_per_pixel =
+            static_cast<double>(options.fit_end_time) * multiplier / options.fit_width_pixels;
+        const double zoom = -std::log2(units_per_pixel * kPixelsPerUnitAtZoom0);
+        char line[64];
+        std::snprintf(line, sizeof line, "*%.6f 0\n", zoom);
+        text += line;
+    }
 
     const auto& infos = timeline.signals();
     const std::vector<ScopeGroup> groups = group_by_scope(timeline);

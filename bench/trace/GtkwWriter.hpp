@@ -13,6 +13,7 @@
 // The content is deterministic: no date, sizes or paths besides the dump's.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "trace/Timeline.hpp"
@@ -22,6 +23,15 @@ namespace avrbench {
 struct GtkwOptions {
     unsigned analog_extra_rows = 3;  // height of each real's plot beyond its own row
     bool groups_closed = false;      // start with groups collapsed (@c00200)
+    // When non-zero: open zoomed so the dump's 0..fit_end_time (in units of
+    // the VCD's `fit_timescale`, e.g. VcdResult::end_time and ::timescale)
+    // fills about fit_width_pixels of the default window's wave pane.
+    // gtkwave 3.3.118 reads the "*<zoom>" line as: time per pixel =
+    // 2^-zoom / 192 in the timescale's unit (ps for "100ps"); measured on
+    // screenshots at zoom 0, -10, -20 and -32 with 100 ps and 1 fs dumps.
+    std::uint64_t fit_end_time = 0;
+    std::string fit_timescale = "1ps";
+    unsigned fit_width_pixels = 550;
 };
 
 // `dump_path` is written as given into [dumpfile]. gtkwave opens it relative to

@@ -11,6 +11,7 @@ extern "C" {
 }
 
 #include "core/Errors.hpp"
+#include "core/McuPins.hpp"
 
 namespace avrbench {
 
@@ -57,6 +58,35 @@ SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
     return id;
 }
 
+std::vector<SignalId> Recorder::trace_part(Part& part) {
+    std::vector<SignalId> ids;
+    for (const auto& s : part.signals()) {
+        ids.push_back(timeline_.add_signal({part.name(), s.name, s.real ? SignalKind::Real : SignalKind::Wire, 1,
+                                            part.clock().frequency_hz()}));
+    }
+    if (ids.empty()) return ids;
+    Timeline* timeline = &timeline_;
+    std::vector<bool> real;
+    for (const auto& s : part.signals()) real.push_back(s.real);
+    // The values at the moment tracing starts, so the trace has no unknowns.
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        const double v = part.signal_value(i);
+        if (real[i]) {
+            timeline_.record_real(ids[i], part.clock().cycle(), v);
+        } else {
+            timeline_.record(ids[i], part.clock().cycle(), v != 0 ? 1 : 0);
+        }
+    }
+    part.watch_signals([timeline, ids, real](std::size_t signal, Cycle cycle, double value) {
+        if (real[signal]) {
+            timeline->record_real(ids[signal], cycle, value);
+        } else {
+            timeline->record(ids[signal], cycle, value != 0 ? 1 : 0);
+        }
+    });
+    return ids;
+}
+
 std::vector<SignalId> Recorder::trace_pins(Mcu& mcu, const std::string& spec) {
     std::vector<std::string> names;
     std::stringstream ss(spec);
@@ -70,10 +100,14 @@ std::vector<SignalId> Recorder::trace_pins(Mcu& mcu, const std::string& spec) {
         if (upper == "ALL") {
             for (char port = 'A'; port <= 'L'; ++port) {
                 if (avr_io_getirq(mcu.avr(), AVR_IOCTL_IOPORT_GETIRQ(port), 0) == nullptr) continue;
-                for (int bit = 0; bit < 8; ++bit) names.push_back(std::string("P") + port + char('0' + bit));
+                for (int bit = 0; bit < 8; ++bit) {
+                if (mcu_has_pin(mcu.mcu_type(), port, bit)) names.push_back(std::string("P") + port + char('0' + bit));
+                }
             }
         } else if (upper.size() == 5 && upper.rfind("PORT", 0) == 0) {
-            for (int bit = 0; bit < 8; ++bit) names.push_back(std::string("P") + upper[4] + char('0' + bit));
+            for (int bit = 0; bit < 8; ++bit) {
+                if (mcu_has_pin(mcu.mcu_type(), upper[4], bit)) names.push_back(std::string("P") + upper[4] + char('0' + bit));
+            }
         } else {
             names.push_back(upper);
         }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/Mcu.hpp"
+#include "parts/Part.hpp"
 #include "trace/Timeline.hpp"
 
 namespace avrbench {
@@ -24,6 +25,10 @@ public:
     // Adds "<mcu name>.uart<n>_tx" as an 8-bit bus: one event per byte, at the
     // cycle of the UDR write.
     SignalId trace_uart_tx(Mcu& mcu, Uart& uart);
+
+    // Every signal the part publishes (positions, levels, temperatures), in a
+    // scope named after the part, stamped with the part's clock.
+    std::vector<SignalId> trace_part(Part& part);
 
     // Pins named in `spec`: "PB5,PD2", "PORTB" (its 8 pins) or "all" (every
     // pin of every port the MCU has). Throws BadInput on an unknown name.

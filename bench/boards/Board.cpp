@@ -1,0 +1,241 @@
+#include "boards/Board.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "boards/PartRegistry.hpp"
+
+namespace avrbench {
+namespace {
+
+std::string known_types() {
+    std::string out;
+    for (const auto& [name, type] : part_types()) out += (out.empty() ? "" : ", ") + name;
+    return out;
+}
+
+const RawParam* find_param(const PartDecl& decl, const std::string& name) {
+    for (const auto& p : decl.params) {
+        if (p.name == name) return &p;
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+Board::Board(BoardSpec spec, const std::map<std::string, std::string>& firmware) : spec_(std::move(spec)) {
+    build_mcus(firmware);
+    build_parts();
+    build_nets();
+    for (auto& m : mcus_) lockstep_.add(*m);
+}
+
+Board::~Board() = default;
+
+std::unique_ptr<Board> Board::from_file(const std::string& path, const std::map<std::string, std::string>& firmware) {
+    return std::make_unique<Board>(load_board_file(path), firmware);
+}
+
+void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
+    for (const auto& [name, elf] : firmware) {
+        if (spec_.find_mcu(name) == nullptr) throw BadInput(spec_.path + ": the board has no MCU '" + name + "'");
+    }
+    for (const auto& decl : spec_.mcus) {
+        auto it = firmware.find(decl.name);
+        const std::string elf_path = it != firmware.end() ? it->second : decl.firmware;
+        if (elf_path.empty()) {
+            throw BadInput(decl.location + ": MCU '" + decl.name + "' has no firmware (give an ELF)");
+        }
+        const ElfImage elf = ElfImage::load(elf_path);
+        if (!elf.embedded_mcu().empty() && elf.embedded_mcu() != decl.type) {
+            throw BadInput(elf_path + ": built for " + elf.embedded_mcu() + ", but " + decl.location + " declares MCU '" +
+                           decl.name + "' as " + decl.type);
+        }
+        McuOptions options;
+        options.name = decl.name;
+        options.mcu_type = decl.type;
+        options.frequency_hz = decl.clock_hz;
+        mcus_.push_back(std::make_unique<Mcu>(elf, options));
+    }
+}
+
+void Board::build_parts() {
+    // Each part is clocked by the MCU its nets lead to, else by the part it
+    // refers to, else by the board's first MCU.
+    std::map<std::string, Mcu*> clock_of;
+    for (const auto& net : spec_.nets) {
+        Mcu* net_mcu = nullptr;
+        for (const auto& e : net.endpoints) {
+            if (spec_.find_mcu(e.owner) != nullptr) net_mcu = &mcu(e.owner);
+        }
+        if (net_mcu == nullptr) continue;
+        for (const auto& e : net.endpoints) {
+            if (spec_.find_part(e.owner) != nullptr && clock_of.count(e.owner) == 0) clock_of[e.owner] = net_mcu;
+        }
+    }
+
+    std::map<std::string, Part*> built;
+    std::set<std::string> pending;
+    for (const auto& d : spec_.parts) pending.insert(d.name);
+    while (!pending.empty()) {
+        bool progress = false;
+        for (const auto& decl : spec_.parts) {
+            if (pending.count(decl.name) == 0) continue;
+            auto type_it = part_types().find(decl.type);
+            if (type_it == part_types().end()) {
+                throw BadInput(decl.location + ": part '" + decl.name + "': unknown part type '" + decl.type +
+                               "' (known: " + known_types() + ")");
+            }
+            const PartType& type = type_it->second;
+            // References must name declared parts of the right type; wait
+            // until those are built.
+            bool ready = true;
+            Mcu* referenced_clock = nullptr;
+            for (const auto& [param, allowed] : type.references) {
+                const RawParam* raw = find_param(decl, param);
+                if (raw == nullptr) continue;  // resolve_params reports the missing required one
+                const PartDecl* target = spec_.find_part(raw->value);
+                if (target == nullptr) {
+                    throw BadInput(raw->location + ": part '" + decl.name + "': " + param + " '" + raw->value +
+                                   "' is not a part of this board");
+                }
+                bool type_ok = false;
+                for (const auto& a : allowed) type_ok = type_ok || a == target->type;
+                if (!type_ok) {
+                    throw BadInput(raw->location + ": part '" + decl.name + "': " + param + " '" + raw->value +
+                                   "' is a " + target->type + ", expected " + allowed.front());
+                }
+                auto b = built.find(raw->value);
+                if (b == built.end()) {
+                    ready = false;
+                } else if (referenced_clock == nullptr) {
+                    referenced_clock = &b->second->clock();
+                }
+            }
+            if (!ready) continue;
+
+            std::map<std::string, std::string> preset = type.implied;
+            if (!type.presets.empty()) {
+                const RawParam* raw = find_param(decl, "preset");
+                std::string preset_name = raw != nullptr ? raw->value : "";
+                if (preset_name.empty()) {
+                    for (const auto& spec : type.params) {
+                        if (spec.name == "preset") preset_name = spec.default_value;
+                    }
+                }
+                auto p = type.presets.find(preset_name);
+                if (p != type.presets.end()) {
+                    for (const auto& [k, v] : p->second) preset[k] = v;
+                }
+            }
+            const ParamValues values = resolve_params(type.params, preset, decl.params, decl.name, decl.location);
+            Mcu* clock = clock_of.count(decl.name) ? clock_of[decl.name]
+                         : referenced_clock != nullptr ? referenced_clock
+                                                       : mcus_.front().get();
+            auto lookup = [&built](const std::string& n) -> Part& { return *built.at(n); };
+            try {
+                parts_.push_back(type.build(decl.name, *clock, values, lookup));
+            } catch (const BadInput& e) {
+                throw BadInput(decl.location + ": " + e.what());
+            }
+            built[decl.name] = parts_.back().get();
+            pending.erase(decl.name);
+            progress = true;
+        }
+        if (!progress) {
+            const PartDecl* stuck = spec_.find_part(*pending.begin());
+            throw BadInput(stuck->location + ": part '" + stuck->name + "' is part of a circular reference");
+        }
+    }
+}
+
+void Board::build_nets() {
+    for (const auto& decl : spec_.nets) {
+        auto net = std::make_unique<Net>(decl.name);
+        std::vector<std::string> drivers;
+        for (const auto& e : decl.endpoints) {
+            if (spec_.find_mcu(e.owner) != nullptr) {
+                Mcu& m = mcu(e.owner);
+                Pin* pin = nullptr;
+                try {
+                    pin = &m.pin(e.pin);
+                } catch (const BadInput& err) {
+                    throw BadInput(e.location + ": " + err.what());
+                }
+                mcu_terminals_.push_back(std::make_unique<McuPinTerminal>(m, *pin));
+                net->connect(*mcu_terminals_.back());
+                continue;
+            }
+            Part& p = part(e.owner);
+            PartPin* pin = p.find_pin(e.pin);
+            if (pin == nullptr) {
+                std::string list;
+                for (std::size_t i = 0; i < p.pin_count(); ++i) list += (list.empty() ? "" : ", ") + p.pin(i).name();
+                throw BadInput(e.location + ": part '" + p.name() + "' (" + std::string(p.type()) + ") has no pin '" +
+                               e.pin + "' (pins: " + list + ")");
+            }
+            if (pin->role() == TerminalRole::Output) drivers.push_back(e.text());
+            net->connect(*pin);
+        }
+        if (drivers.size() > 1) {
+            throw BadInput(decl.location + ": net '" + decl.name + "' is driven by two outputs: " + drivers[0] + " and " +
+                           drivers[1]);
+        }
+        nets_.push_back(std::move(net));
+    }
+    for (auto& p : parts_) p->start();
+    for (auto& n : nets_) n->settle();
+}
+
+Mcu& Board::mcu(const std::string& name) {
+    if (name.empty()) return *mcus_.front();
+    for (auto& m : mcus_) {
+        if (m->name() == name) return *m;
+    }
+    throw BadInput("the board has no MCU '" + name + "'");
+}
+
+std::vector<Mcu*> Board::mcus() const {
+    std::vector<Mcu*> out;
+    for (const auto& m : mcus_) out.push_back(m.get());
+    return out;
+}
+
+Part& Board::part(const std::string& name) {
+    for (auto& p : parts_) {
+        if (p->name() == name) return *p;
+    }
+    throw BadInput("the board has no part '" + name + "'");
+}
+
+std::vector<Part*> Board::parts() const {
+    std::vector<Part*> out;
+    for (const auto& p : parts_) out.push_back(p.get());
+    return out;
+}
+
+Pin& Board::pin(const std::string& endpoint_or_label) {
+    std::string text = endpoint_or_label;
+    for (const auto& l : spec_.labels) {
+        if (l.name == text) text = l.endpoint.text();
+    }
+    const auto dot = text.find('.');
+    if (dot == std::string::npos) throw BadInput("'" + endpoint_or_label + "' is not mcu.PIN or a label");
+    return mcu(text.substr(0, dot)).pin(text.substr(dot + 1));
+}
+
+StopReason Board::run_until_seconds(double seconds) {
+    const auto end_ps = static_cast<std::uint64_t>(std::llround(seconds * 1e12));
+    return lockstep_.run_until_ps(end_ps);
+}
+
+double Board::now_seconds() const { return static_cast<double>(lockstep_.now_ps()) * 1e-12; }
+
+std::vector<Finding> Board::findings() const {
+    std::vector<Finding> out;
+    for (const auto& m : mcus_) out.insert(out.end(), m->findings().begin(), m->findings().end());
+    for (const auto& p : parts_) out.insert(out.end(), p->findings().begin(), p->findings().end());
+    return out;
+}
+
+}  // namespace avrbench

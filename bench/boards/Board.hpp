@@ -1,0 +1,77 @@
+// A board built from a board file: its MCUs with their firmware, its parts and
+// its nets, advanced together in simulated time.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "boards/BoardFile.hpp"
+#include "core/Errors.hpp"
+#include "core/Lockstep.hpp"
+#include "core/Mcu.hpp"
+#include "parts/Part.hpp"
+#include "wiring/Net.hpp"
+
+namespace avrbench {
+
+class Board {
+public:
+    // `firmware` maps MCU name to ELF path; an MCU missing there uses the
+    // board file's `firmware:`. Throws BadInput (one line, file:line where it
+    // applies) for unknown part types, parameters, part pins, nets with two
+    // drivers, circular part references, a firmware built for another MCU.
+    Board(BoardSpec spec, const std::map<std::string, std::string>& firmware);
+    static std::unique_ptr<Board> from_file(const std::string& path, const std::map<std::string, std::string>& firmware);
+    ~Board();
+    Board(const Board&) = delete;
+    Board& operator=(const Board&) = delete;
+
+    const BoardSpec& spec() const { return spec_; }
+
+    // The MCU by name; "" is the board's first (for single-MCU boards).
+    Mcu& mcu(const std::string& name = "");
+    std::vector<Mcu*> mcus() const;
+    Part& part(const std::string& name);
+    template <class T>
+    T& part_as(const std::string& name) {
+        auto* p = dynamic_cast<T*>(&part(name));
+        if (p == nullptr) throw BadInput("part '" + name + "' is not of the requested type");
+        return *p;
+    }
+    std::vector<Part*> parts() const;
+    template <class T>
+    std::vector<T*> parts_of_type() const {
+        std::vector<T*> out;
+        for (const auto& p : parts_) {
+            if (auto* t = dynamic_cast<T*>(p.get())) out.push_back(t);
+        }
+        return out;
+    }
+    // "uno.PD2", or a label name from the board file.
+    Pin& pin(const std::string& endpoint_or_label);
+
+    Lockstep& lockstep() { return lockstep_; }
+    // Advances every MCU to `seconds` of simulated time.
+    StopReason run_until_seconds(double seconds);
+    StopReason run_for_seconds(double seconds) { return run_until_seconds(now_seconds() + seconds); }
+    double now_seconds() const;
+
+    // Every finding of every MCU and part, in the order they happened per source.
+    std::vector<Finding> findings() const;
+
+private:
+    void build_mcus(const std::map<std::string, std::string>& firmware);
+    void build_parts();
+    void build_nets();
+
+    BoardSpec spec_;
+    std::vector<std::unique_ptr<Mcu>> mcus_;  // first member: destroyed last
+    std::vector<std::unique_ptr<Part>> parts_;
+    std::vector<std::unique_ptr<Terminal>> mcu_terminals_;
+    std::vector<std::unique_ptr<Net>> nets_;
+    Lockstep lockstep_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,248 @@
+#include "boards/BoardFile.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/Errors.hpp"
+#include "core/McuPins.hpp"
+#include "core/Units.hpp"
+
+namespace avrbench {
+namespace {
+
+std::string where(const std::string& path, const YAML::Node& node) {
+    const auto mark = node.Mark();
+    return path + ":" + std::to_string(mark.line >= 0 ? mark.line + 1 : 0);
+}
+
+std::string scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
+    if (!node.IsScalar()) throw BadInput(where(path, node) + ": " + what + " must be a single value");
+    return node.Scalar();
+}
+
+bool valid_name(const std::string& name) {
+    if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+    for (char c : name) {
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+    }
+    return true;
+}
+
+Endpoint parse_endpoint(const YAML::Node& node, const std::string& path) {
+    const std::string text = scalar(node, path, "a net endpoint");
+    const auto dot = text.find('.');
+    if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() || text.find('.', dot + 1) != std::string::npos) {
+        throw BadInput(where(path, node) + ": '" + text + "' is not an endpoint (expected mcu.PIN or part.pin)");
+    }
+    return Endpoint{text.substr(0, dot), text.substr(dot + 1), where(path, node)};
+}
+
+void check_name(const std::string& name, const std::string& location, const char* what, std::set<std::string>& seen) {
+    if (!valid_name(name)) throw BadInput(location + ": '" + name + "' is not a valid " + what + " name");
+    if (!seen.insert(name).second) throw BadInput(location + ": duplicate name '" + name + "'");
+}
+
+// Checks an MCU endpoint's pin against the MCU's pin-out.
+void check_mcu_pin(const Endpoint& e, const McuDecl& mcu) {
+    const std::string& pin = e.pin;
+    const bool shape = pin.size() == 3 && pin[0] == 'P' && std::isupper(static_cast<unsigned char>(pin[1])) &&
+                       std::isdigit(static_cast<unsigned char>(pin[2]));
+    const bool too_high = pin.size() >= 3 && pin[0] == 'P' && std::isdigit(static_cast<unsigned char>(pin[2])) &&
+                          pin.size() > 3;
+    if (too_high || (shape && !mcu_has_pin(mcu.type, pin[1], pin[2] - '0'))) {
+        throw BadInput(e.location + ": unknown pin '" + pin + "': " + mcu.type + " has no such pin");
+    }
+    if (!shape) throw BadInput(e.location + ": '" + pin + "' is not an MCU pin name (expected e.g. PD2)");
+}
+
+}  // namespace
+
+const McuDecl* BoardSpec::find_mcu(const std::string& n) const {
+    for (const auto& m : mcus) {
+        if (m.name == n) return &m;
+    }
+    return nullptr;
+}
+
+const PartDecl* BoardSpec::find_part(const std::string& n) const {
+    for (const auto& p : parts) {
+        if (p.name == n) return &p;
+    }
+    return nullptr;
+}
+
+const SerialDecl* BoardSpec::find_serial(const std::string& n) const {
+    for (const auto& s : serial) {
+        if (s.name == n) return &s;
+    }
+    return nullptr;
+}
+
+BoardSpec load_board_file(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": no such board file");
+    std::ifstream in(path);
+    if (!in) throw BadInput(path + ": cannot read");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_board_text(ss.str(), path);
+}
+
+BoardSpec parse_board_text(const std::string& text, const std::string& path) {
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw BadInput(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    }
+    if (!root.IsMap()) throw BadInput(path + ":1: a board file is a map with mcus, parts, nets");
+
+    BoardSpec spec;
+    spec.path = path;
+    static const std::set<std::string> kSections = {"board", "description", "mcus", "parts", "nets", "serial", "labels"};
+    for (const auto& kv : root) {
+        const std::string key = kv.first.Scalar();
+        if (kSections.count(key) == 0) {
+            throw BadInput(where(path, kv.first) + ": unknown section '" + key +
+                           "' (expected board, description, mcus, parts, nets, serial, labels)");
+        }
+    }
+    if (root["board"]) spec.name = scalar(root["board"], path, "board");
+    if (root["description"]) spec.description = scalar(root["description"], path, "description");
+
+    std::set<std::string> names;
+    const YAML::Node mcus = root["mcus"];
+    if (!mcus || !mcus.IsMap() || mcus.size() == 0) throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
+    for (const auto& kv : mcus) {
+        McuDecl m;
+        m.name = kv.first.Scalar();
+        m.location = where(path, kv.first);
+        check_name(m.name, m.location, "MCU", names);
+        if (!kv.second.IsMap()) throw BadInput(m.location + ": MCU '" + m.name + "' must be a map with type and clock");
+        for (const auto& field : kv.second) {
+            const std::string key = field.first.Scalar();
+            const std::string loc = where(path, field.first);
+            if (key == "type") m.type = scalar(field.second, path, "type");
+            else if (key == "clock") m.clock_hz = parse_frequency_hz(scalar(field.second, path, "clock"), loc + ": MCU '" + m.name + "': clock");
+            else if (key == "firmware") m.firmware = scalar(field.second, path, "firmware");
+            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware)");
+        }
+        if (m.type.empty()) throw BadInput(m.location + ": MCU '" + m.name + "': missing 'type' (e.g. atmega328p)");
+        if (m.clock_hz == 0) throw BadInput(m.location + ": MCU '" + m.name + "': missing 'clock' (e.g. 16MHz)");
+        if (!m.firmware.empty() && std::filesystem::path(m.firmware).is_relative()) {
+            m.firmware = (std::filesystem::path(path).parent_path() / m.firmware).string();
+        }
+        spec.mcus.push_back(std::move(m));
+    }
+
+    if (const YAML::Node parts = root["parts"]) {
+        if (!parts.IsMap()) throw BadInput(where(path, parts) + ": 'parts' must be a map of part name to its settings");
+        for (const auto& kv : parts) {
+            PartDecl p;
+            p.name = kv.first.Scalar();
+            p.location = where(path, kv.first);
+            check_name(p.name, p.location, "part", names);
+            if (!kv.second.IsMap()) throw BadInput(p.location + ": part '" + p.name + "' must be a map with a type");
+            for (const auto& field : kv.second) {
+                const std::string key = field.first.Scalar();
+                if (key == "type") {
+                    p.type = scalar(field.second, path, "type");
+                } else {
+                    p.params.push_back({key, scalar(field.second, path, "parameter " + key), where(path, field.first)});
+                }
+            }
+            if (p.type.empty()) throw BadInput(p.location + ": part '" + p.name + "': missing 'type'");
+            spec.parts.push_back(std::move(p));
+        }
+    }
+
+    if (const YAML::Node nets = root["nets"]) {
+        if (!nets.IsMap()) throw BadInput(where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
+        std::set<std::string> net_names;
+        std::set<std::string> used_endpoints;
+        for (const auto& kv : nets) {
+            NetDecl n;
+            n.name = kv.first.Scalar();
+            n.location = where(path, kv.first);
+            check_name(n.name, n.location, "net", net_names);
+            if (!kv.second.IsSequence() || kv.second.size() < 2) {
+                throw BadInput(n.location + ": net '" + n.name + "' must list at least two endpoints, e.g. [uno.PD2, x_driver.step]");
+            }
+            for (const auto& e : kv.second) {
+                Endpoint ep = parse_endpoint(e, path);
+                if (!used_endpoints.insert(ep.text()).second) {
+                    throw BadInput(ep.location + ": '" + ep.text() + "' is already on another net");
+                }
+                n.endpoints.push_back(std::move(ep));
+            }
+            spec.nets.push_back(std::move(n));
+        }
+    }
+
+    if (const YAML::Node serial = root["serial"]) {
+        if (!serial.IsMap()) throw BadInput(where(path, serial) + ": 'serial' must be a map of port name to its settings");
+        for (const auto& kv : serial) {
+            SerialDecl s;
+            s.name = kv.first.Scalar();
+            s.location = where(path, kv.first);
+            check_name(s.name, s.location, "serial port", names);
+            for (const auto& field : kv.second) {
+                const std::string key = field.first.Scalar();
+                const std::string loc = where(path, field.first);
+                const std::string value = scalar(field.second, path, key);
+                if (key == "mcu") {
+                    s.mcu = value;
+                } else if (key == "usart") {
+                    s.usart = static_cast<int>(parse_quantity(value, Dimension::Dimensionless, loc + ": usart"));
+                } else if (key == "flow") {
+                    if (value != "send_and_wait" && value != "character_counting") {
+                        throw BadInput(loc + ": flow '" + value + "' is not send_and_wait or character_counting");
+                    }
+                    s.flow = value;
+                } else if (key == "rx_buffer") {
+                    s.rx_buffer_bytes = static_cast<unsigned>(parse_quantity(value, Dimension::Dimensionless, loc + ": rx_buffer"));
+                } else {
+                    throw BadInput(loc + ": serial '" + s.name + "': unknown key '" + key + "' (expected mcu, usart, flow, rx_buffer)");
+                }
+            }
+            spec.serial.push_back(std::move(s));
+        }
+    }
+
+    if (const YAML::Node labels = root["labels"]) {
+        if (!labels.IsMap()) throw BadInput(where(path, labels) + ": 'labels' must be a map of name to endpoint");
+        std::set<std::string> label_names;
+        for (const auto& kv : labels) {
+            LabelDecl l;
+            l.name = kv.first.Scalar();
+            l.location = where(path, kv.first);
+            check_name(l.name, l.location, "label", label_names);
+            l.endpoint = parse_endpoint(kv.second, path);
+            spec.labels.push_back(std::move(l));
+        }
+    }
+
+    // Cross-references that need only the file itself.
+    auto check_endpoint = [&](const Endpoint& e) {
+        if (const McuDecl* m = spec.find_mcu(e.owner)) {
+            check_mcu_pin(e, *m);
+        } else if (spec.find_part(e.owner) == nullptr) {
+            throw BadInput(e.location + ": '" + e.owner + "' is neither an MCU nor a part of this board");
+        }
+    };
+    for (const auto& n : spec.nets) {
+        for (const auto& e : n.endpoints) check_endpoint(e);
+    }
+    for (const auto& l : spec.labels) check_endpoint(l.endpoint);
+    for (const auto& s : spec.serial) {
+        if (spec.find_mcu(s.mcu) == nullptr) throw BadInput(s.location + ": serial '" + s.name + "': unknown MCU '" + s.mcu + "'");
+    }
+    return spec;
+}
+
+}  // namespace avrbench

@@ -1,0 +1,92 @@
+// Board files: the machine configuration. YAML (yaml-cpp) with MCUs and their
+// clocks, parts with parameters, nets joining MCU pins and part pins, serial
+// ports for UART hosts, and labels naming pins for later wiring. Structural
+// errors are reported as one line "file:line: ..." (BadInput).
+//
+//   board: arduino-uno-cnc-shield-v3
+//   mcus:
+//     uno: {type: atmega328p, clock: 16MHz}
+//   parts:
+//     x_driver: {type: step_dir_driver, preset: a4988, microsteps: 16}
+//     x: {type: linear_axis, driver: x_driver, steps_per_mm: 250, travel: 200mm}
+//   nets:
+//     x_step: [uno.PD2, x_driver.step]
+//   serial:
+//     host: {mcu: uno, usart: 0, flow: character_counting, rx_buffer: 128}
+//   labels:
+//     probe: uno.PC5
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "parts/Params.hpp"
+
+namespace avrbench {
+
+struct Endpoint {
+    std::string owner;  // MCU or part name
+    std::string pin;    // "PD2" or "step"
+    std::string location;
+    std::string text() const { return owner + "." + pin; }
+};
+
+struct McuDecl {
+    std::string name;
+    std::string type;
+    std::uint32_t clock_hz = 0;
+    std::string firmware;  // optional default ELF, resolved relative to the board file
+    std::string location;
+};
+
+struct PartDecl {
+    std::string name;
+    std::string type;
+    std::vector<RawParam> params;
+    std::string location;
+};
+
+struct NetDecl {
+    std::string name;
+    std::vector<Endpoint> endpoints;
+    std::string location;
+};
+
+struct SerialDecl {
+    std::string name;
+    std::string mcu;
+    int usart = 0;
+    std::string flow = "send_and_wait";  // or character_counting
+    unsigned rx_buffer_bytes = 128;
+    std::string location;
+};
+
+struct LabelDecl {
+    std::string name;
+    Endpoint endpoint;
+    std::string location;
+};
+
+struct BoardSpec {
+    std::string path;
+    std::string name;
+    std::string description;
+    std::vector<McuDecl> mcus;
+    std::vector<PartDecl> parts;
+    std::vector<NetDecl> nets;
+    std::vector<SerialDecl> serial;
+    std::vector<LabelDecl> labels;
+
+    const McuDecl* find_mcu(const std::string& name) const;
+    const PartDecl* find_part(const std::string& name) const;
+    const SerialDecl* find_serial(const std::string& name) const;
+};
+
+// Reads and checks the file's structure (sections, names, endpoint syntax,
+// MCU types and pins, duplicate names). Part types, parameters and part pins
+// are checked when the board is built (Board), with the same file:line style.
+BoardSpec load_board_file(const std::string& path);
+BoardSpec parse_board_text(const std::string& text, const std::string& path);
+
+}  // namespace avrbench

@@ -1,0 +1,34 @@
+// The part types a board file may name: for each, its parameters, presets,
+// the other parts it refers to, and how to build it.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+struct PartType {
+    std::string name;
+    std::vector<ParamSpec> params;
+    // Preset tables selected by the "preset" parameter, if the type has one.
+    std::map<std::string, std::map<std::string, std::string>> presets;
+    // Fixed values this type name implies (linear_axis -> kind: linear).
+    std::map<std::string, std::string> implied;
+    // Parameters that name other parts, with the part type they must have.
+    std::map<std::string, std::vector<std::string>> references;
+    using Lookup = std::function<Part&(const std::string& name)>;
+    std::function<std::unique_ptr<Part>(const std::string& name, Mcu& clock, const ParamValues& params,
+                                        const Lookup& lookup)>
+        build;
+};
+
+// Every part type the bench ships, by name.
+const std::map<std::string, PartType>& part_types();
+
+}  // namespace avrbench

@@ -1,0 +1,86 @@
+#include "parts/Axis.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+
+std::vector<ParamSpec> Axis::param_specs() {
+    using PT = ParamType;
+    return {
+        {"driver", PT::Text, Dimension::Dimensionless, true, "", {}, "", "the step_dir_driver part that moves it"},
+        {"kind", PT::Choice, Dimension::Dimensionless, false, "linear", {"linear", "rotary"}, "", ""},
+        {"steps_per_mm", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
+         "STEP pulses per mm at the driver's configured microsteps (linear)"},
+        {"steps_per_rev", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
+         "STEP pulses per revolution at the driver's configured microsteps (rotary)"},
+        {"travel", PT::Quantity, Dimension::Length, false, "", {}, "", "length of travel (linear), from 0"},
+        {"start_position", PT::Quantity, Dimension::Length, false, "0mm", {}, "assumed: the carriage starts at 0",
+         "carriage position at power-on"},
+    };
+}
+
+Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver& driver)
+    : Part(std::move(name), clock), driver_(driver), rotary_(params.text("kind") == "rotary") {
+    const double microsteps = driver.configured_microsteps();
+    if (rotary_) {
+        if (!params.has("steps_per_rev")) throw BadInput("part '" + this->name() + "': a rotary axis needs steps_per_rev");
+        const double steps_per_rev = params.quantity("steps_per_rev");
+        // One 1/256 full step is (256 / microsteps)^-1 of a configured step.
+        radians_per_256_ = 2.0 * 3.14159265358979323846 / steps_per_rev * microsteps / 256.0;
+        metres_per_256_ = 0;
+    } else {
+        if (!params.has("steps_per_mm")) throw BadInput("part '" + this->name() + "': a linear axis needs steps_per_mm");
+        if (!params.has("travel")) throw BadInput("part '" + this->name() + "': a linear axis needs travel");
+        const double steps_per_m = params.quantity("steps_per_mm") * 1e3;
+        metres_per_256_ = microsteps / 256.0 / steps_per_m;
+        radians_per_256_ = 0;
+        travel_m_ = params.quantity("travel");
+        travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
+        const double start_m = params.quantity("start_position");
+        if (start_m < 0 || start_m > travel_m_) {
+            throw BadInput("part '" + this->name() + "': start_position outside 0..travel");
+        }
+        carriage_256_ = std::llround(start_m / metres_per_256_);
+    }
+    sig_position_ = add_signal(rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? 0.0 : position_mm());
+    driver_.on_step([this](int delta) { on_step(delta); });
+}
+
+double Axis::position_steps() const {
+    return static_cast<double>(driver_.position_256()) * driver_.configured_microsteps() / 256.0;
+}
+
+double Axis::position_deg() const { return angle_rad_ * 180.0 / 3.14159265358979323846; }
+
+void Axis::on_step(int delta_256) {
+    if (rotary_) {
+        angle_rad_ += delta_256 * radians_per_256_;
+        publish(sig_position_, position_deg());
+        for (auto& fn : move_listeners_) fn(angle_rad_);
+        return;
+    }
+    const std::int64_t wanted = carriage_256_ + delta_256;
+    if (wanted < 0 || wanted > travel_256_) {
+        if (!in_crash_) {
+            in_crash_ = true;
+            ++crashes_;
+            char detail[160];
+            std::snprintf(detail, sizeof detail, "carriage driven past the %s end of travel (%.4f mm of 0..%.3f mm)",
+                          wanted < 0 ? "lower" : "upper", static_cast<double>(wanted) * metres_per_256_ * 1e3,
+                          travel_m_ * 1e3);
+            report(FindingKind::AxisOutOfTravel, detail);
+        }
+        carriage_256_ = wanted < 0 ? 0 : travel_256_;  // the carriage stays at the end it hit
+    } else {
+        in_crash_ = false;
+        carriage_256_ = wanted;
+    }
+    publish(sig_position_, position_mm());
+    const double position_m = static_cast<double>(carriage_256_) * metres_per_256_;
+    for (auto& fn : move_listeners_) fn(position_m);
+}
+
+}  // namespace avrbench

@@ -1,0 +1,55 @@
+// A stepper driver on a linear axis (steps/mm, travel) or a rotary axis
+// (steps/rev). Tracks the commanded steps and the carriage position; driving
+// the carriage into either end of travel is a finding (a crash), and the
+// carriage stays at the end it hit, as a real one would.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+#include "parts/StepDirDriver.hpp"
+
+namespace avrbench {
+
+class Axis final : public Part {
+public:
+    static std::vector<ParamSpec> param_specs();
+
+    Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver& driver);
+    std::string_view type() const override { return rotary_ ? "rotary_axis" : "linear_axis"; }
+
+    bool rotary() const { return rotary_; }
+    StepDirDriver& driver() const { return driver_; }
+    // Net steps at the driver's configured resolution (signed).
+    double position_steps() const;
+    // Linear: carriage position in mm (0 .. travel). Rotary: degrees.
+    double position_mm() const { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
+    double position_deg() const;
+    double travel_mm() const { return travel_m_ * 1e3; }
+    std::uint64_t steps() const { return driver_.steps_taken(); }
+    unsigned crashes() const { return crashes_; }
+
+    void on_move(std::function<void(double position_m)> fn) { move_listeners_.push_back(std::move(fn)); }
+
+private:
+    void on_step(int delta_256);
+
+    StepDirDriver& driver_;
+    bool rotary_;
+    double metres_per_256_;  // carriage travel per 1/256 full step (linear)
+    double radians_per_256_;  // per 1/256 full step (rotary)
+    double travel_m_ = 0;
+    // Carriage position in 1/256 full steps from the lower end: an integer,
+    // so millions of steps do not accumulate rounding.
+    std::int64_t carriage_256_ = 0;
+    std::int64_t travel_256_ = 0;
+    double angle_rad_ = 0;
+    bool in_crash_ = false;
+    unsigned crashes_ = 0;
+    std::size_t sig_position_;
+    std::vector<std::function<void(double)>> move_listeners_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,123 @@
+#include "parts/LimitSwitch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+
+std::vector<ParamSpec> LimitSwitch::param_specs() {
+    using PT = ParamType;
+    return {
+        {"axis", PT::Text, Dimension::Dimensionless, true, "", {}, "", "the axis whose carriage trips it"},
+        {"side", PT::Choice, Dimension::Dimensionless, false, "min", {"min", "max"}, "",
+         "min: trips at or below position; max: at or above"},
+        {"position", PT::Quantity, Dimension::Length, false, "", {}, "",
+         "trip position (default: 0 for min, the travel for max)"},
+        {"hysteresis", PT::Quantity, Dimension::Length, false, "0.05mm", {},
+         "assumed: a typical microswitch's differential travel", "travel past the trip point before it releases"},
+        {"contact", PT::Choice, Dimension::Dimensionless, false, "NO", {"NO", "NC"}, "", "normally open or closed"},
+        {"switched_to", PT::Choice, Dimension::Dimensionless, false, "gnd", {"gnd", "vcc"}, "",
+         "what the closed contact connects the signal to"},
+        {"pull", PT::Choice, Dimension::Dimensionless, false, "internal_up",
+         {"internal_up", "external_up", "external_down", "none"}, "",
+         "what sets the level while the contact is open"},
+        {"bounce", PT::Quantity, Dimension::Time, false, "0s", {}, "assumed: no bounce unless asked",
+         "duration of contact bounce after each transition"},
+        {"bounce_edges", PT::Integer, Dimension::Dimensionless, false, "4", {}, "assumed",
+         "extra make/break pairs during a bounce, at most"},
+        {"seed", PT::Integer, Dimension::Dimensionless, false, "1", {}, "", "seed for the bounce timing"},
+    };
+}
+
+LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params, Axis& axis)
+    : Part(std::move(name), clock),
+      axis_(axis),
+      min_side_(params.text("side") == "min"),
+      hysteresis_m_(params.quantity("hysteresis")),
+      normally_open_(params.text("contact") == "NO"),
+      closed_level_(params.text("switched_to") == "vcc"),
+      pull_(params.text("pull")),
+      bounce_s_(params.quantity("bounce")),
+      bounce_edges_(static_cast<unsigned>(params.integer("bounce_edges"))),
+      rng_(static_cast<std::uint64_t>(params.integer("seed"))) {
+    if (axis.rotary()) throw BadInput("part '" + this->name() + "': limit switches go on linear axes");
+    trip_m_ = params.has("position") ? params.quantity("position") : (min_side_ ? 0.0 : axis.travel_mm() * 1e-3);
+    out_pin_ = add_pin("out", TerminalRole::Output);
+    sig_closed_ = add_signal("closed", false);
+    axis_.on_move([this](double position_m) { on_axis_move(position_m); });
+}
+
+bool LimitSwitch::contact_closed() const { return normally_open_ ? triggered_ : !triggered_; }
+
+void LimitSwitch::start() {
+    on_axis_move(axis_.position_mm() * 1e-3);
+    apply_contact(contact_closed());
+}
+
+void LimitSwitch::on_axis_move(double position_m) {
+    // Half a micrometre of slack so a carriage stopped exactly on the trip
+    // point trips despite rounding in the mm <-> step conversion.
+    constexpr double kEpsilon_m = 0.5e-6;
+    bool now = triggered_;
+    if (min_side_) {
+        if (!triggered_ && position_m <= trip_m_ + kEpsilon_m) now = true;
+        if (triggered_ && position_m > trip_m_ + hysteresis_m_ + kEpsilon_m) now = false;
+    } else {
+        if (!triggered_ && position_m >= trip_m_ - kEpsilon_m) now = true;
+        if (triggered_ && position_m < trip_m_ - hysteresis_m_ - kEpsilon_m) now = false;
+    }
+    if (now == triggered_) return;
+    triggered_ = now;
+    if (now) ++trips_;
+    set_contact(contact_closed());
+}
+
+void LimitSwitch::set_contact(bool closed) {
+    const std::uint64_t generation = ++bounce_generation_;
+    if (bounce_s_ <= 0 || bounce_edges_ == 0) {
+        apply_contact(closed);
+        return;
+    }
+    // Bounce: the contact chatters between the old and new state at times
+    // drawn from the seeded generator within the bounce window, then settles.
+    // Raw engine output keeps the sequence identical on every platform
+    // (std:: distributions are implementation-defined).
+    const Cycle window = static_cast<Cycle>(std::llround(bounce_s_ * clock().frequency_hz()));
+    const unsigned pairs = 1 + static_cast<unsigned>(rng_() % bounce_edges_);
+    std::vector<Cycle> offsets;
+    for (unsigned i = 0; i < 2 * pairs; ++i) offsets.push_back(window > 1 ? rng_() % window : 0);
+    std::sort(offsets.begin(), offsets.end());
+    apply_contact(closed);
+    const Cycle start = clock().cycle();
+    bool state = closed;
+    for (Cycle offset : offsets) {
+        state = !state;
+        const bool level = state;
+        clock().scheduler().at(start + offset, [this, generation, level](Cycle) {
+            if (generation == bounce_generation_) apply_contact(level);
+        });
+    }
+    clock().scheduler().at(start + window, [this, generation, closed](Cycle) {
+        if (generation == bounce_generation_) apply_contact(closed);
+    });
+}
+
+void LimitSwitch::apply_contact(bool closed) {
+    if (applied_once_ && closed != applied_closed_) ++contact_transitions_;
+    applied_once_ = true;
+    applied_closed_ = closed;
+    publish(sig_closed_, closed ? 1 : 0);
+    if (closed) {
+        drive_output(out_pin_, closed_level_);
+    } else if (pull_ == "internal_up" || pull_ == "none") {
+        // The MCU pin decides: its pull-up if the firmware enabled it, else floating (reads 0).
+        release_output(out_pin_);
+    } else {
+        drive_output(out_pin_, pull_ == "external_up");
+    }
+}
+
+}  // namespace avrbench

@@ -1,0 +1,56 @@
+// A limit (end-stop) switch on an axis: trips at a position with hysteresis;
+// NO or NC contact switched to GND or VCC; the level of the open contact comes
+// from a pull-up (the MCU's internal one, as the firmware sets it, or an
+// external resistor) or pull-down; optional contact bounce, deterministic from
+// a seed.
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include "parts/Axis.hpp"
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+class LimitSwitch final : public Part {
+public:
+    static std::vector<ParamSpec> param_specs();
+
+    LimitSwitch(std::string name, Mcu& clock, const ParamValues& params, Axis& axis);
+    std::string_view type() const override { return "limit_switch"; }
+
+    bool triggered() const { return triggered_; }
+    bool contact_closed() const;
+    unsigned trips() const { return trips_; }
+    // Make/break transitions of the contact, bounce included.
+    unsigned contact_transitions() const { return contact_transitions_; }
+
+    void start() override;
+
+private:
+    void on_axis_move(double position_m);
+    void set_contact(bool closed);
+    void apply_contact(bool closed);
+
+    Axis& axis_;
+    std::size_t out_pin_;
+    bool min_side_;
+    double trip_m_, hysteresis_m_;
+    bool normally_open_;
+    bool closed_level_;        // the output level with the contact closed
+    std::string pull_;         // internal_up | external_up | external_down | none
+    double bounce_s_;
+    unsigned bounce_edges_;
+    std::mt19937_64 rng_;
+    bool triggered_ = false;
+    unsigned trips_ = 0;
+    unsigned contact_transitions_ = 0;
+    bool applied_closed_ = false;
+    bool applied_once_ = false;
+    std::uint64_t bounce_generation_ = 0;
+    std::size_t sig_closed_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,61 @@
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+std::string PartPin::label() const { return part_.name() + "." + name_; }
+
+void PartPin::receive(bool level) {
+    if (level == level_) return;
+    level_ = level;
+    part_.on_input(index_, level);
+}
+
+void PartPin::set_level(bool level) {
+    if (level == level_ && !released_) return;
+    level_ = level;
+    released_ = false;
+    drive(level);
+}
+
+void PartPin::set_released() {
+    if (released_) return;
+    released_ = true;
+    release_net();
+}
+
+PartPin* Part::find_pin(std::string_view name) {
+    for (auto& p : pins_) {
+        if (p->name() == name) return p.get();
+    }
+    return nullptr;
+}
+
+std::size_t Part::add_pin(std::string name, TerminalRole role) {
+    pins_.push_back(std::make_unique<PartPin>(*this, pins_.size(), std::move(name), role));
+    return pins_.size() - 1;
+}
+
+std::size_t Part::add_signal(std::string name, bool real, double initial) {
+    signal_infos_.push_back({std::move(name), real});
+    signal_values_.push_back(initial);
+    return signal_infos_.size() - 1;
+}
+
+void Part::publish(std::size_t signal, double value) {
+    signal_values_[signal] = value;
+    const Cycle now = clock_->cycle();
+    for (auto& fn : signal_listeners_) fn(signal, now, value);
+}
+
+void Part::report(FindingKind kind, std::string detail) {
+    Finding f;
+    f.kind = kind;
+    f.source = name_;
+    f.cycle = clock_->cycle();
+    f.clock_hz = clock_->frequency_hz();
+    f.has_pc = false;
+    f.detail = std::move(detail);
+    findings_.push_back(std::move(f));
+}
+
+}  // namespace avrbench

@@ -1,0 +1,110 @@
+// A model of one real component: its pins, parameters (with units and
+// sources), state, and how it evolves between pin events. A part knows nothing
+// of its neighbours; the board's nets connect its pins.
+//
+// Time: a part is clocked by one MCU of the board (the one its nets lead to):
+// clock().cycle() is "now", clock().scheduler() schedules its own events.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Finding.hpp"
+#include "core/Mcu.hpp"
+#include "wiring/Net.hpp"
+
+namespace avrbench {
+
+class Part;
+
+// One pin of a part.
+class PartPin final : public Terminal {
+public:
+    PartPin(Part& part, std::size_t index, std::string name, TerminalRole role)
+        : part_(part), index_(index), name_(std::move(name)), role_(role) {}
+    std::string label() const override;
+    TerminalRole role() const override { return role_; }
+    void receive(bool level) override;
+    bool initial_level() const override { return level_; }
+    bool initially_released() const override { return released_; }
+
+    const std::string& name() const { return name_; }
+    bool level() const { return level_; }
+    bool connected() const { return net() != nullptr; }
+    void set_level(bool level);  // an output driving its net
+    void set_released();         // an output letting go of its net
+
+private:
+    Part& part_;
+    std::size_t index_;
+    std::string name_;
+    TerminalRole role_;
+    bool level_ = false;
+    bool released_ = false;
+};
+
+// A value a part exposes for tracing (a position, a temperature, a level).
+struct PartSignalInfo {
+    std::string name;
+    bool real = false;  // a real number, else a 0/1 wire
+};
+
+class Part {
+public:
+    Part(std::string name, Mcu& clock) : name_(std::move(name)), clock_(&clock) {}
+    virtual ~Part() = default;
+    Part(const Part&) = delete;
+    Part& operator=(const Part&) = delete;
+
+    const std::string& name() const { return name_; }
+    virtual std::string_view type() const = 0;
+    Mcu& clock() const { return *clock_; }
+
+    std::size_t pin_count() const { return pins_.size(); }
+    PartPin& pin(std::size_t index) { return *pins_[index]; }
+    PartPin* find_pin(std::string_view name);
+
+    // After all nets are connected: drive initial outputs, arm timers.
+    virtual void start() {}
+
+    const std::vector<Finding>& findings() const { return findings_; }
+
+    // Signals for the trace recorder, and a subscription to their changes.
+    const std::vector<PartSignalInfo>& signals() const { return signal_infos_; }
+    double signal_value(std::size_t signal) const { return signal_values_[signal]; }
+    using SignalListener = std::function<void(std::size_t signal, Cycle cycle, double value)>;
+    void watch_signals(SignalListener fn) { signal_listeners_.push_back(std::move(fn)); }
+
+protected:
+    std::size_t add_pin(std::string name, TerminalRole role);
+    std::size_t add_signal(std::string name, bool real, double initial = 0);
+    void publish(std::size_t signal, double value);
+
+    // A net drove one of this part's input pins.
+    virtual void on_input(std::size_t pin, bool level) {
+        (void)pin;
+        (void)level;
+    }
+    void drive_output(std::size_t pin, bool level) { pins_[pin]->set_level(level); }
+    void release_output(std::size_t pin) { pins_[pin]->set_released(); }
+    bool input_level(std::size_t pin) const { return pins_[pin]->level(); }
+    bool connected(std::size_t pin) const { return pins_[pin]->connected(); }
+
+    void report(FindingKind kind, std::string detail);
+
+private:
+    friend class PartPin;
+    std::string name_;
+    Mcu* clock_;
+    std::vector<std::unique_ptr<PartPin>> pins_;
+    std::vector<Finding> findings_;
+    std::vector<PartSignalInfo> signal_infos_;
+    std::vector<double> signal_values_;
+    std::vector<SignalListener> signal_listeners_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,70 @@
+// A step/dir stepper driver (A4988, DRV8825, TMC2208 in legacy step/dir mode,
+// or generic). Watches STEP, DIR, ENABLE and the microstep pins, counts steps
+// into a position, and reports every violation of the datasheet timing as a
+// finding with its cycle.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+class StepDirDriver final : public Part {
+public:
+    static std::vector<ParamSpec> param_specs();
+    // Datasheet timing per preset (name -> parameter -> value with unit).
+    static const std::map<std::string, std::map<std::string, std::string>>& presets();
+
+    StepDirDriver(std::string name, Mcu& clock, const ParamValues& params);
+    std::string_view type() const override { return "step_dir_driver"; }
+
+    // Position in 1/256 full steps (the common denominator of every microstep
+    // resolution the presets support), signed; + is DIR at its "forward" level.
+    std::int64_t position_256() const { return position_256_; }
+    std::uint64_t steps_taken() const { return steps_taken_; }        // active edges while enabled
+    std::uint64_t steps_ignored() const { return steps_ignored_; }    // active edges while disabled
+    double peak_step_rate_hz() const { return peak_step_rate_hz_; }   // from the shortest STEP period
+    unsigned microsteps() const { return current_microsteps_; }       // resolution at the last step
+    unsigned configured_microsteps() const { return configured_microsteps_; }
+    bool enabled() const;
+
+    // Called after every step that moved the position (the axis listens).
+    void on_step(std::function<void(int delta_256)> fn) { step_listeners_.push_back(std::move(fn)); }
+
+private:
+    void on_input(std::size_t pin, bool level) override;
+    void on_step_edge(bool active);
+    void on_dir_change();
+    unsigned microsteps_from_pins() const;
+    Cycle cycles(double seconds) const;
+
+    std::size_t step_pin_, dir_pin_, enable_pin_;
+    std::vector<std::size_t> ms_pins_;
+    std::string preset_;
+
+    bool step_active_level_;         // true: rising edge steps
+    bool enable_active_level_;       // level of ENABLE that enables the outputs
+    bool forward_dir_level_;         // DIR level counted as + (the "positive" direction)
+    Cycle step_high_min_cycles_, step_low_min_cycles_, dir_setup_cycles_, dir_hold_cycles_;
+    Cycle min_step_period_cycles_;
+    double max_step_rate_hz_;
+    unsigned configured_microsteps_;  // when the MS pins are not wired (jumpers)
+    unsigned current_microsteps_;
+
+    std::int64_t position_256_ = 0;
+    std::uint64_t steps_taken_ = 0, steps_ignored_ = 0;
+    double peak_step_rate_hz_ = 0;
+    bool have_active_edge_ = false, have_inactive_edge_ = false, have_dir_change_ = false;
+    Cycle last_active_edge_ = 0, last_inactive_edge_ = 0, last_dir_change_ = 0;
+    std::size_t sig_step_, sig_dir_, sig_position_;
+    std::vector<std::function<void(int)>> step_listeners_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,125 @@
+// Every malformed board file gives one line naming file:line and the problem.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "boards/Board.hpp"
+#include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
+
+namespace avrbench {
+namespace {
+
+// A valid board, line by line, so each case below can break one line.
+const char* const kGood[] = {
+    "mcus:",                                                                              // 1
+    "  uno: {type: atmega328p, clock: 16MHz}",                                            // 2
+    "parts:",                                                                             // 3
+    "  x_driver: {type: step_dir_driver, preset: a4988}",                                 // 4
+    "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200mm}",        // 5
+    "  x_min: {type: limit_switch, axis: x, position: 0mm}",                              // 6
+    "nets:",                                                                              // 7
+    "  x_step: [uno.PD2, x_driver.step]",                                                 // 8
+    "  x_limit: [uno.PB1, x_min.out]",                                                    // 9
+};
+
+std::string board_with(int line, const std::string& replacement) {
+    std::string out;
+    for (int i = 0; i < static_cast<int>(std::size(kGood)); ++i) {
+        out += (i + 1 == line ? replacement : std::string(kGood[i])) + "\n";
+    }
+    return out;
+}
+
+std::string error_of(const std::string& text) {
+    try {
+        Board board(parse_board_text(text, "bad.yaml"), {{"uno", test::firmware("step_pattern")}});
+    } catch (const BadInput& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+TEST(BoardFileErrors, TheGoodBoardBuilds) { EXPECT_EQ(error_of(board_with(0, "")), "(no error)"); }
+
+struct Case {
+    const char* name;
+    int line;
+    std::string replacement;
+    std::string expected;  // the whole message
+};
+
+class BoardFileError : public ::testing::TestWithParam<Case> {};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+TEST_P(BoardFileError, NamesFileLineAndProblem) {
+    const Case& c = GetParam();
+    std::string expected = c.expected;
+    if (auto at = expected.find("{elf}"); at != std::string::npos) expected.replace(at, 5, test::firmware("step_pattern"));
+    EXPECT_EQ(error_of(board_with(c.line, c.replacement)), expected);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BoardFileError,
+    ::testing::Values(
+        Case{"unknown_part_type", 4, "  x_driver: {type: step_dir_drvr}",
+             "bad.yaml:4: part 'x_driver': unknown part type 'step_dir_drvr' (known: limit_switch, linear_axis, "
+             "rotary_axis, step_dir_driver)"},
+        Case{"unknown_pin", 8, "  x_step: [uno.PD9, x_driver.step]",
+             "bad.yaml:8: unknown pin 'PD9': atmega328p has no such pin"},
+        Case{"pin_the_part_lacks", 8, "  x_step: [uno.PC7, x_driver.step]",
+             "bad.yaml:8: unknown pin 'PC7': atmega328p has no such pin"},
+        Case{"unknown_owner", 9, "  x_limit: [uno.PB1, y_min.out]",
+             "bad.yaml:9: 'y_min' is neither an MCU nor a part of this board"},
+        Case{"missing_required", 5, "  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm}",
+             "bad.yaml:5: part 'x': missing required parameter 'driver' (the step_dir_driver part that moves it)"},
+        Case{"unknown_unit", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200furlongs}",
+             "bad.yaml:5: part 'x': travel: unknown unit 'furlongs' in '200furlongs' (expected m, mm, um, cm)"},
+        Case{"wrong_unit", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_high_min: 2mm}",
+             "bad.yaml:4: part 'x_driver': step_high_min: '2mm' is a length, expected a time (s, ms, us, ns, min, h)"},
+        Case{"missing_unit", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200}",
+             "bad.yaml:5: part 'x': travel: '200' needs a unit (m, mm, um, cm)"},
+        Case{"unknown_parameter", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_hi_min: 2us}",
+             "bad.yaml:4: part 'x_driver': unknown parameter 'step_hi_min' (known: preset, step_edge, step_high_min, "
+             "step_low_min, dir_setup, dir_hold, max_step_rate, enable_active, microsteps, forward_dir)"},
+        Case{"bad_preset", 4, "  x_driver: {type: step_dir_driver, preset: a4989}",
+             "bad.yaml:4: part 'x_driver': preset: 'a4989' is not one of a4988, drv8825, tmc2208, generic"},
+        Case{"unknown_part_pin", 8, "  x_step: [uno.PD2, x_driver.stp]",
+             "bad.yaml:8: part 'x_driver' (step_dir_driver) has no pin 'stp' (pins: step, dir, enable, ms1, ms2, ms3)"},
+        Case{"wrong_reference_type", 6, "  x_min: {type: limit_switch, axis: x_driver, position: 0mm}",
+             "bad.yaml:6: part 'x_min': axis 'x_driver' is a step_dir_driver, expected linear_axis"},
+        // yaml-cpp reports the line where it noticed the missing ']': the next one.
+        Case{"yaml_syntax", 8, "  x_step: [uno.PD2, x_driver.step",
+             "bad.yaml:9: YAML syntax error: end of sequence flow not found"},
+        Case{"bad_clock", 2, "  uno: {type: atmega328p, clock: 16MHZ}",
+             "bad.yaml:2: MCU 'uno': clock: unknown unit 'MHZ' in '16MHZ' (expected Hz, kHz, MHz, rpm)"},
+        Case{"unknown_section", 7, "netz:",
+             "bad.yaml:7: unknown section 'netz' (expected board, description, mcus, parts, nets, serial, labels)"},
+        Case{"mcu_mismatch", 2, "  uno: {type: atmega2560, clock: 16MHz}",
+             "{elf}: built for atmega328p, but bad.yaml:2 declares MCU 'uno' as atmega2560"}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+TEST(BoardFileErrors, TwoOutputsOnOneNet) {
+    std::string text = board_with(0, "");
+    text += "  y_limit: [uno.PB2, x_min.out]\n";  // x_min.out is already on x_limit
+    EXPECT_EQ(error_of(text), "bad.yaml:10: 'x_min.out' is already on another net");
+    // Two distinct switch outputs on one net.
+    std::string two = board_with(9, "  x_limit: [uno.PB1, x_min.out, x_max.out]");
+    two.insert(two.find("nets:"), "  x_max: {type: limit_switch, axis: x, side: max}\n");
+    EXPECT_EQ(error_of(two), "bad.yaml:10: net 'x_limit' is driven by two outputs: x_min.out and x_max.out");
+}
+
+TEST(BoardFileErrors, CliSaysItInOneLineWithExitCode2) {
+    const auto dir = test::scratch_dir("board-cli");
+    const auto path = dir / "bad.yaml";
+    std::ofstream(path) << board_with(8, "  x_step: [uno.PD9, x_driver.step]");
+    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " run --board " + path.string() + " " +
+                                         test::firmware("step_pattern"), dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, "avrbench: error: " + path.string() + ":8: unknown pin 'PD9': atmega328p has no such pin\n");
+    EXPECT_EQ(r.out, "");
+}
+
+}  // namespace
+}  // namespace avrbench

@@ -1,0 +1,136 @@
+// The A4988 model on the UNO + CNC shield board, driven by step_pattern: a
+// firmware that emits a fixed STEP/DIR/ENABLE sequence with deliberate faults
+// (firmware/boards/step_pattern/main.c documents each phase and its numbers).
+#include <gtest/gtest.h>
+
+#include "boards/Board.hpp"
+#include "parts/Axis.hpp"
+#include "parts/StepDirDriver.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+std::unique_ptr<Board> uno_with(const std::string& firmware) {
+    return Board::from_file(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"),
+                            {{"uno", test::firmware(firmware)}});
+}
+
+std::vector<Finding> of_kind(const std::vector<Finding>& all, FindingKind kind) {
+    std::vector<Finding> out;
+    for (const auto& f : all) {
+        if (f.kind == kind) out.push_back(f);
+    }
+    return out;
+}
+
+struct PatternRun {
+    std::unique_ptr<Board> board = uno_with("step_pattern");
+    std::vector<std::pair<Cycle, bool>> step_edges;  // from the MCU pin itself, independent of the driver model
+    PatternRun() {
+        Mcu& uno = board->mcu("uno");
+        uno.pin("PD2").on_change([this, &uno](Cycle c, bool level) {
+            (void)uno;
+            step_edges.emplace_back(c, level);
+        });
+        board->run_for_seconds(0.05);  // the whole pattern takes < 1 ms
+        EXPECT_EQ(uno.read_ram_u8("phase"), 8) << "the pattern did not finish";
+    }
+    StepDirDriver& driver() { return board->part_as<StepDirDriver>("x_driver"); }
+};
+
+TEST(StepDirDriver, CountsStepsAndIgnoresThemWhileDisabled) {
+    PatternRun run;
+    // step_pattern header: 155 active edges while enabled, 30 while disabled.
+    EXPECT_EQ(run.driver().steps_taken(), 155u);
+    EXPECT_EQ(run.driver().steps_ignored(), 30u);
+    std::size_t rising = 0;
+    for (const auto& [c, level] : run.step_edges) rising += level ? 1 : 0;
+    EXPECT_EQ(rising, 185u);  // the pin saw every pulse: 155 + 30
+    // Net motion +49 steps at 1/16 microstepping (board: microsteps 16).
+    auto& x = run.board->part_as<Axis>("x");
+    EXPECT_DOUBLE_EQ(x.position_steps(), 49.0);
+    // 250 steps/mm (grbl default): +49 steps from the 100 mm start = 100.196 mm.
+    EXPECT_NEAR(x.position_mm(), 100.0 + 49.0 / 250.0, 1e-9);
+}
+
+TEST(StepDirDriver, ReportsTheShortPulseAtItsFallingEdge) {
+    PatternRun run;
+    const auto shorts = of_kind(run.board->findings(), FindingKind::StepHighTooShort);
+    ASSERT_EQ(shorts.size(), 1u);
+    // The pin trace has the pulse: find the one high interval shorter than
+    // 16 cycles (1 us at 16 MHz); the finding carries its falling edge.
+    Cycle falling = 0, width = 0;
+    for (std::size_t i = 1; i < run.step_edges.size(); ++i) {
+        if (!run.step_edges[i].second && run.step_edges[i - 1].second &&
+            run.step_edges[i].first - run.step_edges[i - 1].first < 16) {
+            falling = run.step_edges[i].first;
+            width = run.step_edges[i].first - run.step_edges[i - 1].first;
+        }
+    }
+    ASSERT_NE(falling, 0u);
+    EXPECT_EQ(width, 8u);  // 6 delay cycles + the 2-cycle CBI (step_pattern phase 2)
+    EXPECT_EQ(shorts[0].cycle, falling);
+    EXPECT_EQ(shorts[0].source, "x_driver");
+}
+
+TEST(StepDirDriver, ReportsDirSetupAndHoldViolations) {
+    PatternRun run;
+    const auto setup = of_kind(run.board->findings(), FindingKind::DirSetupViolation);
+    const auto hold = of_kind(run.board->findings(), FindingKind::DirHoldViolation);
+    ASSERT_EQ(setup.size(), 1u);
+    ASSERT_EQ(hold.size(), 1u);
+    // Both happen 2 cycles (one SBI/CBI) from the STEP edge; the A4988 needs
+    // 200 ns = 3.2 cycles, so 4 cycles.
+    EXPECT_NE(setup[0].detail.find("2 cycles before"), std::string::npos) << setup[0].detail;
+    EXPECT_NE(hold[0].detail.find("2 cycles after"), std::string::npos) << hold[0].detail;
+}
+
+TEST(StepDirDriver, ReportsShortLowTimeAndExcessRate) {
+    PatternRun run;
+    const auto low = of_kind(run.board->findings(), FindingKind::StepLowTooShort);
+    const auto rate = of_kind(run.board->findings(), FindingKind::StepRateTooHigh);
+    ASSERT_EQ(low.size(), 1u);
+    // Phase 7: 2 delay cycles + the 2-cycle SBI = 4 cycles low.
+    EXPECT_NE(low[0].detail.find("inactive for 4 cycles"), std::string::npos) << low[0].detail;
+    // Phase 7's period is 32 + 4 = 36 cycles: 16e6 / 36 = 444 444 steps/s,
+    // within the A4988's 500 kHz (1 / (1 us + 1 us)); no other period is shorter.
+    EXPECT_EQ(rate.size(), 0u);
+    EXPECT_NEAR(run.driver().peak_step_rate_hz(), 16e6 / 36.0, 1.0);
+}
+
+TEST(StepDirDriver, Drv8825PresetCatchesTheRateTheA4988Allows) {
+    // The same pins with a DRV8825: 250 kHz maximum and 1.9 us (30.4 -> 31
+    // cycles) minimum high and low (TI SLVSA73 §7.6).
+    const std::string board_text = R"(
+mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+parts:
+  x_driver: {type: step_dir_driver, preset: drv8825, microsteps: 32}
+nets:
+  x_step: [uno.PD2, x_driver.step]
+  x_dir: [uno.PD5, x_driver.dir]
+  enable: [uno.PB0, x_driver.enable]
+)";
+    Board board(parse_board_text(board_text, "drv8825-test.yaml"), {{"uno", test::firmware("step_pattern")}});
+    board.run_for_seconds(0.05);
+    const auto findings = board.findings();
+    const auto rate = of_kind(findings, FindingKind::StepRateTooHigh);
+    ASSERT_EQ(rate.size(), 1u);
+    EXPECT_NE(rate[0].detail.find("STEP period 36 cycles"), std::string::npos) << rate[0].detail;
+    // Phase 2's 8-cycle pulse and phase 7's 4-cycle low time violate 31 cycles too.
+    EXPECT_EQ(of_kind(findings, FindingKind::StepHighTooShort).size(), 1u);
+    EXPECT_EQ(of_kind(findings, FindingKind::StepLowTooShort).size(), 1u);
+    // 650 ns setup/hold = 10.4 -> 11 cycles: the 2-cycle DIR changes violate both.
+    EXPECT_EQ(of_kind(findings, FindingKind::DirSetupViolation).size(), 1u);
+    EXPECT_EQ(of_kind(findings, FindingKind::DirHoldViolation).size(), 1u);
+}
+
+TEST(StepDirDriver, NoFindingsForGoodSteps) {
+    PatternRun run;
+    // Exactly the four faults the pattern contains, nothing for the 180 good pulses.
+    EXPECT_EQ(run.board->findings().size(), 4u);
+}
+
+}  // namespace
+}  // namespace avrbench
