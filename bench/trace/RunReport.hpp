@@ -1,0 +1,74 @@
+// Everything an HTML report shows about one run, gathered by whoever ran it
+// (the CLI, a scenario) from the board, the host and the comparison. Plain
+// data: the report writer (HtmlReport) depends on nothing else.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/Finding.hpp"
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+
+// Which timeline signals mean what, so the report can plot them.
+struct AxisSeries {
+    std::string name;          // "x"
+    SignalId position;         // real signal: position in mm (linear) or degrees (rotary)
+    bool rotary = false;
+};
+
+struct TemperatureSeries {
+    std::string name;                  // "hotend"
+    SignalId temperature_degC;         // real
+    std::optional<SignalId> duty;      // real 0..1 (heater duty), if known
+    std::optional<double> target_degC;
+};
+
+struct ServoSeries {
+    std::string name;
+    SignalId angle_deg;  // real
+};
+
+struct TranscriptLine {
+    Cycle cycle = 0;
+    std::uint32_t clock_hz = 16000000;
+    bool from_host = true;  // host -> firmware, else firmware -> host
+    std::string text;
+};
+
+// A failed (or passed) comparison against a golden timeline, in terms the
+// report can draw: the golden's events next to the actual ones, and where the
+// first divergence is.
+struct ComparisonView {
+    bool passed = true;
+    Timeline golden;                   // same signal names as the actual timeline where they match
+    std::string first_divergence_signal;  // "uno.PD2"; empty if none
+    Cycle first_divergence_cycle = 0;
+    std::uint32_t first_divergence_clock_hz = 16000000;
+    std::string summary;               // one paragraph, plain text
+    struct ChannelRow {
+        std::string signal;
+        std::string verdict;   // "ok", "timing", "missing", "extra", ...
+        std::string detail;
+    };
+    std::vector<ChannelRow> channels;
+};
+
+struct RunReport {
+    std::string title;               // "stepdir_test on arduino-uno-cnc-shield-v3"
+    std::vector<std::string> facts;  // "firmware: build/firmware/x.elf (sha256 ...)", "simulated: 1.2 s", ...
+    const Timeline* timeline = nullptr;
+    Cycle end_cycle = 0;
+    std::uint32_t end_clock_hz = 16000000;
+    std::vector<AxisSeries> axes;             // 2 or 3 linear axes give the XY(Z) toolpath
+    std::vector<TemperatureSeries> temperatures;
+    std::vector<ServoSeries> servos;
+    std::vector<TranscriptLine> transcript;
+    std::vector<Finding> findings;
+    std::optional<ComparisonView> comparison;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,235 @@
+#include "trace/TimelineText.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+namespace {
+
+const char* kind_name(SignalKind k) {
+    switch (k) {
+        case SignalKind::Wire: return "wire";
+        case SignalKind::Bus: return "bus";
+        case SignalKind::Real: return "real";
+    }
+    return "wire";
+}
+
+std::string format_value(const SignalInfo& info, const TimelineEvent& e) {
+    if (info.kind == SignalKind::Real) {
+        char buf[64];
+        auto [end, ec] = std::to_chars(buf, buf + sizeof buf, e.value.real);
+        (void)ec;
+        return std::string(buf, end);
+    }
+    return std::to_string(e.value.bits);
+}
+
+bool same_value(const SignalInfo& info, const TimelineEvent& a, const TimelineEvent& b) {
+    return info.kind == SignalKind::Real ? a.value.real == b.value.real : a.value.bits == b.value.bits;
+}
+
+struct Pair {
+    Cycle delta;
+    std::string value;
+    bool operator==(const Pair& o) const { return delta == o.delta && value == o.value; }
+};
+
+std::string full_name(const SignalInfo& s) { return s.scope + "." + s.name; }
+
+}  // namespace
+
+std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id) {
+    std::vector<TimelineEvent> events;
+    for (const auto& e : timeline.events()) {
+        if (e.signal == id) events.push_back(e);
+    }
+    std::stable_sort(events.begin(), events.end(),
+                     [](const TimelineEvent& a, const TimelineEvent& b) { return a.cycle < b.cycle; });
+    const SignalInfo& info = timeline.signals()[id];
+    std::vector<TimelineEvent> out;
+    for (const auto& e : events) {
+        // At one cycle the last value recorded wins (as in the VCD writer).
+        if (!out.empty() && out.back().cycle == e.cycle) {
+            out.back() = e;
+            if (out.size() >= 2 && same_value(info, out[out.size() - 2], out.back())) out.pop_back();
+            continue;
+        }
+        if (!out.empty() && same_value(info, out.back(), e)) continue;
+        out.push_back(e);
+    }
+    return out;
+}
+
+std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header) {
+    std::string out = "avrbench-timeline 1\n";
+    out += "bench " + header.bench_version + "\n";
+    for (const auto& in : header.inputs) out += "input " + in.role + " " + in.sha256 + " " + in.path + "\n";
+    out += "end " + std::to_string(header.end_cycle) + " " + std::to_string(header.end_clock_hz) + "\n";
+    const auto& signals = timeline.signals();
+    for (const auto& s : signals) {
+        out += "signal " + full_name(s) + " " + kind_name(s.kind) + " " +
+               std::to_string(s.kind == SignalKind::Real ? 64u : s.width) + " " + std::to_string(s.clock_hz) + "\n";
+    }
+    for (SignalId id = 0; id < signals.size(); ++id) {
+        const SignalInfo& info = signals[id];
+        out += "\n@" + full_name(info) + "\n";
+        const auto changes = changes_of(timeline, id);
+        if (changes.empty()) continue;
+        out += std::to_string(changes[0].cycle) + " " + format_value(info, changes[0]) + "\n";
+        std::vector<Pair> pairs;
+        for (std::size_t i = 1; i < changes.size(); ++i) {
+            pairs.push_back({changes[i].cycle - changes[i - 1].cycle, format_value(info, changes[i])});
+        }
+        std::size_t i = 0;
+        while (i < pairs.size()) {
+            // A block of 1 or 2 pairs repeated 3 or more times becomes one line.
+            bool emitted = false;
+            for (std::size_t block = 1; block <= 2 && !emitted; ++block) {
+                std::size_t repeats = 1;
+                while (i + (repeats + 1) * block <= pairs.size()) {
+                    bool same = true;
+                    for (std::size_t k = 0; k < block; ++k) same = same && pairs[i + repeats * block + k] == pairs[i + k];
+                    if (!same) break;
+                    ++repeats;
+                }
+                if (repeats >= 3) {
+                    out += "*" + std::to_string(repeats);
+                    for (std::size_t k = 0; k < block; ++k) {
+                        out += " +" + std::to_string(pairs[i + k].delta) + " " + pairs[i + k].value;
+                    }
+                    out += "\n";
+                    i += repeats * block;
+                    emitted = true;
+                }
+            }
+            if (!emitted) {
+                out += "+" + std::to_string(pairs[i].delta) + " " + pairs[i].value + "\n";
+                ++i;
+            }
+        }
+    }
+    return out;
+}
+
+void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw BadInput(path + ": cannot write");
+    out << format_timeline_text(timeline, header);
+    if (!out) throw BadInput(path + ": write failed");
+}
+
+ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source) {
+    ParsedTimeline parsed;
+    std::istringstream in(text);
+    std::string line;
+    int line_no = 0;
+    auto fail = [&](const std::string& what) { throw BadInput(source + ":" + std::to_string(line_no) + ": " + what); };
+    auto next_line = [&]() -> bool {
+        while (std::getline(in, line)) {
+            ++line_no;
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            return true;
+        }
+        return false;
+    };
+    if (!next_line() || line != "avrbench-timeline 1") fail("not an avrbench timeline (expected 'avrbench-timeline 1')");
+    long current = -1;
+    Cycle last_cycle = 0;
+    auto parse_u64 = [&](const std::string& s) -> std::uint64_t {
+        std::uint64_t v = 0;
+        auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+        if (ec != std::errc() || end != s.data() + s.size()) fail("'" + s + "' is not a whole number");
+        return v;
+    };
+    auto record = [&](Cycle cycle, const std::string& value) {
+        const SignalInfo& info = parsed.timeline.signals()[static_cast<std::size_t>(current)];
+        if (info.kind == SignalKind::Real) {
+            double v = 0;
+            auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+            if (ec != std::errc() || end != value.data() + value.size()) fail("'" + value + "' is not a number");
+            parsed.timeline.record_real(static_cast<SignalId>(current), cycle, v);
+        } else {
+            parsed.timeline.record(static_cast<SignalId>(current), cycle, parse_u64(value));
+        }
+        last_cycle = cycle;
+    };
+    while (next_line()) {
+        if (line.empty()) continue;
+        std::istringstream ls(line);
+        std::string word;
+        ls >> word;
+        if (word == "bench") {
+            ls >> parsed.header.bench_version;
+        } else if (word == "input") {
+            TimelineInput input;
+            ls >> input.role >> input.sha256;
+            std::getline(ls >> std::ws, input.path);
+            parsed.header.inputs.push_back(input);
+        } else if (word == "end") {
+            std::string c, f;
+            ls >> c >> f;
+            parsed.header.end_cycle = parse_u64(c);
+            parsed.header.end_clock_hz = static_cast<std::uint32_t>(parse_u64(f));
+        } else if (word == "signal") {
+            std::string name, kind, width, clock;
+            ls >> name >> kind >> width >> clock;
+            const auto dot = name.find('.');
+            if (dot == std::string::npos) fail("signal '" + name + "' has no scope");
+            SignalInfo info;
+            info.scope = name.substr(0, dot);
+            info.name = name.substr(dot + 1);
+            if (kind == "wire") info.kind = SignalKind::Wire;
+            else if (kind == "bus") info.kind = SignalKind::Bus;
+            else if (kind == "real") info.kind = SignalKind::Real;
+            else fail("unknown signal kind '" + kind + "'");
+            info.width = info.kind == SignalKind::Real ? 1 : static_cast<unsigned>(parse_u64(width));
+            info.clock_hz = static_cast<std::uint32_t>(parse_u64(clock));
+            parsed.timeline.add_signal(info);
+        } else if (word[0] == '@') {
+            const std::string name = word.substr(1);
+            const auto dot = name.find('.');
+            current = dot == std::string::npos ? -1 : parsed.timeline.find(name.substr(0, dot), name.substr(dot + 1));
+            if (current < 0) fail("events for undeclared signal '" + name + "'");
+            last_cycle = 0;
+        } else if (current < 0) {
+            fail("unexpected '" + line + "'");
+        } else if (word[0] == '*') {
+            const std::uint64_t repeats = parse_u64(word.substr(1));
+            std::vector<std::pair<Cycle, std::string>> block;
+            std::string delta, value;
+            while (ls >> delta >> value) {
+                if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs");
+                block.emplace_back(parse_u64(delta.substr(1)), value);
+            }
+            if (block.empty()) fail("empty repeat block");
+            for (std::uint64_t r = 0; r < repeats; ++r) {
+                for (const auto& [d, v] : block) record(last_cycle + d, v);
+            }
+        } else if (word[0] == '+') {
+            std::string value;
+            ls >> value;
+            record(last_cycle + parse_u64(word.substr(1)), value);
+        } else {
+            std::string value;
+            ls >> value;
+            record(parse_u64(word), value);
+        }
+    }
+    return parsed;
+}
+
+ParsedTimeline read_timeline_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(path + ": no such golden timeline");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_timeline_text(ss.str(), path);
+}
+
+}  // namespace avrbench

@@ -1,0 +1,399 @@
+#include "verify/TimelineCompare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "trace/TimelineText.hpp"
+
+namespace avrbench {
+namespace {
+
+std::string full_name(const SignalInfo& s) { return s.scope + "." + s.name; }
+
+std::string value_text(const SignalInfo& info, const TimelineEvent& e) {
+    char buf[64];
+    if (info.kind == SignalKind::Real) {
+        std::snprintf(buf, sizeof buf, "%.6g", e.value.real);
+    } else if (info.kind == SignalKind::Bus && info.width == 8 && e.value.bits >= 32 && e.value.bits < 127) {
+        std::snprintf(buf, sizeof buf, "0x%02llx '%c'", static_cast<unsigned long long>(e.value.bits),
+                      static_cast<char>(e.value.bits));
+    } else {
+        std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(e.value.bits));
+    }
+    return buf;
+}
+
+std::string event_text(const SignalInfo& info, const TimelineEvent& e) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s at cycle %llu (%.6f ms)", value_text(info, e).c_str(),
+                  static_cast<unsigned long long>(e.cycle), static_cast<double>(e.cycle) * 1e3 / info.clock_hz);
+    return buf;
+}
+
+bool equal_value(const SignalInfo& info, const TimelineEvent& a, const TimelineEvent& b) {
+    return info.kind == SignalKind::Real ? a.value.real == b.value.real : a.value.bits == b.value.bits;
+}
+
+void add_context(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
+                 const std::vector<TimelineEvent>& a, std::size_t index, std::size_t around) {
+    const std::size_t from = index > around ? index - around : 0;
+    const std::size_t to = std::min(std::max(g.size(), a.size()), index + around + 1);
+    for (std::size_t i = from; i < to; ++i) {
+        std::string line = (i == index ? "> " : "  ") + std::string("#") + std::to_string(i) + "  golden ";
+        line += i < g.size() ? event_text(info, g[i]) : "(none)";
+        line += "  |  actual ";
+        line += i < a.size() ? event_text(info, a[i]) : "(none)";
+        r.context.push_back(line);
+    }
+}
+
+void diverge_at(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
+                const std::vector<TimelineEvent>& a, std::size_t index, std::size_t around, const std::string& detail) {
+    r.passed = false;
+    r.verdict = "differs";
+    r.diverges = true;
+    r.detail = detail;
+    const bool have_g = index < g.size(), have_a = index < a.size();
+    r.divergence_cycle = have_g && have_a ? std::min(g[index].cycle, a[index].cycle)
+                         : have_g         ? g[index].cycle
+                                          : a[index].cycle;
+    r.expected = have_g ? event_text(info, g[index]) : "(no more changes)";
+    r.actual = have_a ? event_text(info, a[index]) : "(no more changes)";
+    add_context(r, info, g, a, index, around);
+}
+
+std::vector<TimelineEvent> rising(const std::vector<TimelineEvent>& changes) {
+    std::vector<TimelineEvent> out;
+    for (std::size_t i = 0; i < changes.size(); ++i) {
+        if (changes[i].value.bits != 0 && (i > 0 || changes[i].cycle > 0)) out.push_back(changes[i]);
+    }
+    return out;
+}
+
+// Value of a piecewise-constant signal at `cycle`.
+double value_at(const std::vector<TimelineEvent>& changes, const SignalInfo& info, Cycle cycle) {
+    double v = 0;
+    for (const auto& e : changes) {
+        if (e.cycle > cycle) break;
+        v = info.kind == SignalKind::Real ? e.value.real : static_cast<double>(e.value.bits);
+    }
+    return v;
+}
+
+// Fraction of [begin, end) during which a wire is high.
+double duty(const std::vector<TimelineEvent>& changes, Cycle begin, Cycle end) {
+    if (end <= begin) return 0;
+    Cycle high = 0;
+    bool level = false;
+    Cycle t = begin;
+    for (const auto& e : changes) {
+        if (e.cycle <= begin) {
+            level = e.value.bits != 0;
+            continue;
+        }
+        if (e.cycle >= end) break;
+        if (level) high += e.cycle - t;
+        t = e.cycle;
+        level = e.value.bits != 0;
+    }
+    if (level) high += end - t;
+    return static_cast<double>(high) / static_cast<double>(end - begin);
+}
+
+void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule,
+                     const std::vector<TimelineEvent>& g, const std::vector<TimelineEvent>& a,
+                     const CompareOptions& options) {
+    const std::size_t around = options.context_events;
+    char buf[200];
+    switch (rule.kind) {
+        case RuleKind::Ignore:
+            return;
+        case RuleKind::Exact: {
+            for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
+                if (i < g.size() && i < a.size() && g[i].cycle == a[i].cycle && equal_value(info, g[i], a[i])) continue;
+                std::snprintf(buf, sizeof buf, "change #%zu differs (%zu golden vs %zu actual changes)", i, g.size(), a.size());
+                diverge_at(r, info, g, a, i, around, buf);
+                return;
+            }
+            return;
+        }
+        case RuleKind::Timing: {
+            double worst = 0;
+            for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
+                if (i >= g.size() || i >= a.size() || !equal_value(info, g[i], a[i])) {
+                    std::snprintf(buf, sizeof buf, "change #%zu: value sequence differs (%zu golden vs %zu actual changes)",
+                                  i, g.size(), a.size());
+                    diverge_at(r, info, g, a, i, around, buf);
+                    return;
+                }
+                // Either the edge is where it was (absolute tolerance), or the
+                // interval that ends at it is as long as it was (relative
+                // tolerance): a jittered pulse moves its edges but keeps its width.
+                const double shift = std::fabs(static_cast<double>(a[i].cycle) - static_cast<double>(g[i].cycle));
+                const double g_interval = static_cast<double>(i == 0 ? g[0].cycle : g[i].cycle - g[i - 1].cycle);
+                const double a_interval = static_cast<double>(i == 0 ? a[0].cycle : a[i].cycle - a[i - 1].cycle);
+                const double interval_error = std::fabs(a_interval - g_interval);
+                const double interval_allowed = rule.tolerance_cycles + rule.tolerance_rel * g_interval;
+                worst = std::max(worst, shift);
+                if (shift > rule.tolerance_cycles && interval_error > interval_allowed) {
+                    std::snprintf(buf, sizeof buf,
+                                  "change #%zu moved by %.0f cycles (tolerance %.0f); its interval changed by %.0f "
+                                  "(tolerance %.1f)",
+                                  i, shift, rule.tolerance_cycles, interval_error, interval_allowed);
+                    diverge_at(r, info, g, a, i, around, buf);
+                    return;
+                }
+            }
+            std::snprintf(buf, sizeof buf, "largest shift %.0f cycles", worst);
+            r.detail = buf;
+            return;
+        }
+        case RuleKind::Steps: {
+            const auto gs = rising(g), as = rising(a);
+            double worst = 0;
+            for (std::size_t i = 0; i < std::min(gs.size(), as.size()); ++i) {
+                const double shift = std::fabs(static_cast<double>(as[i].cycle) - static_cast<double>(gs[i].cycle));
+                worst = std::max(worst, shift);
+                if (shift > rule.tolerance_cycles) {
+                    std::snprintf(buf, sizeof buf, "step %zu moved by %.0f cycles, tolerance %.0f", i + 1, shift,
+                                  rule.tolerance_cycles);
+                    diverge_at(r, info, gs, as, i, around, buf);
+                    return;
+                }
+            }
+            if (gs.size() != as.size()) {
+                std::snprintf(buf, sizeof buf, "%zu steps expected, %zu taken (%s)", gs.size(), as.size(),
+                              as.size() < gs.size() ? "lost steps" : "extra steps");
+                diverge_at(r, info, gs, as, std::min(gs.size(), as.size()), around, buf);
+                return;
+            }
+            std::snprintf(buf, sizeof buf, "%zu steps, largest shift %.0f cycles", gs.size(), worst);
+            r.detail = buf;
+            return;
+        }
+        case RuleKind::StepRate:
+        case RuleKind::PwmDuty:
+        case RuleKind::Band: {
+            const Cycle g_end = options.golden_end_cycle ? options.golden_end_cycle : (g.empty() ? 0 : g.back().cycle);
+            const Cycle a_end = options.actual_end_cycle ? options.actual_end_cycle : (a.empty() ? 0 : a.back().cycle);
+            const Cycle end = std::min(g_end, a_end);
+            if (rule.kind == RuleKind::Band) {
+                std::vector<Cycle> times;
+                for (const auto& e : g) times.push_back(e.cycle);
+                for (const auto& e : a) times.push_back(e.cycle);
+                std::sort(times.begin(), times.end());
+                double worst = 0;
+                for (Cycle t : times) {
+                    const double d = std::fabs(value_at(a, info, t) - value_at(g, info, t));
+                    worst = std::max(worst, d);
+                    if (d > rule.band) {
+                        std::snprintf(buf, sizeof buf, "at %.6f ms actual %.6g vs golden %.6g (band %.6g)",
+                                      static_cast<double>(t) * 1e3 / info.clock_hz, value_at(a, info, t),
+                                      value_at(g, info, t), rule.band);
+                        r.passed = false;
+                        r.verdict = "differs";
+                        r.diverges = true;
+                        r.divergence_cycle = t;
+                        r.detail = buf;
+                        std::snprintf(buf, sizeof buf, "%.6g", value_at(g, info, t));
+                        r.expected = buf;
+                        std::snprintf(buf, sizeof buf, "%.6g", value_at(a, info, t));
+                        r.actual = buf;
+                        return;
+                    }
+                }
+                std::snprintf(buf, sizeof buf, "largest difference %.6g", worst);
+                r.detail = buf;
+                return;
+            }
+            const Cycle window = std::max<Cycle>(1, static_cast<Cycle>(std::llround(rule.window_s * info.clock_hz)));
+            const auto gs = rising(g), as = rising(a);
+            for (Cycle begin = 0; begin < end; begin += window) {
+                const Cycle stop = std::min(end, begin + window);
+                if (rule.kind == RuleKind::PwmDuty) {
+                    const double dg = duty(g, begin, stop), da = duty(a, begin, stop);
+                    if (std::fabs(dg - da) > rule.band) {
+                        std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.3f ms (band %.4f)", da,
+                                      dg, static_cast<double>(begin) * 1e3 / info.clock_hz, rule.band);
+                        r.passed = false;
+                        r.verdict = "differs";
+                        r.diverges = true;
+                        r.divergence_cycle = begin;
+                        r.detail = buf;
+                        r.expected = std::to_string(dg);
+                        r.actual = std::to_string(da);
+                        return;
+                    }
+                } else {
+                    auto count = [&](const std::vector<TimelineEvent>& edges) {
+                        return static_cast<double>(std::count_if(edges.begin(), edges.end(), [&](const TimelineEvent& e) {
+                            return e.cycle >= begin && e.cycle < stop;
+                        }));
+                    };
+                    const double cg = count(gs), ca = count(as);
+                    if (std::fabs(ca - cg) > rule.tolerance_rel * cg + 1) {
+                        std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.3f ms", ca, cg,
+                                      static_cast<double>(begin) * 1e3 / info.clock_hz);
+                        r.passed = false;
+                        r.verdict = "differs";
+                        r.diverges = true;
+                        r.divergence_cycle = begin;
+                        r.detail = buf;
+                        r.expected = std::to_string(static_cast<long long>(cg));
+                        r.actual = std::to_string(static_cast<long long>(ca));
+                        return;
+                    }
+                }
+            }
+            r.detail = "all windows within tolerance";
+            return;
+        }
+    }
+}
+
+}  // namespace
+
+const char* to_string(RuleKind kind) {
+    switch (kind) {
+        case RuleKind::Exact: return "exact";
+        case RuleKind::Timing: return "timing";
+        case RuleKind::Steps: return "steps";
+        case RuleKind::StepRate: return "step-rate";
+        case RuleKind::PwmDuty: return "pwm-duty";
+        case RuleKind::Band: return "band";
+        case RuleKind::Ignore: return "ignore";
+    }
+    return "?";
+}
+
+bool glob_match(const std::string& pattern, const std::string& text) {
+    std::size_t p = 0, t = 0, star = std::string::npos, mark = 0;
+    while (t < text.size()) {
+        if (p < pattern.size() && (pattern[p] == '?' || pattern[p] == text[t])) {
+            ++p;
+            ++t;
+        } else if (p < pattern.size() && pattern[p] == '*') {
+            star = p++;
+            mark = t;
+        } else if (star != std::string::npos) {
+            p = star + 1;
+            t = ++mark;
+        } else {
+            return false;
+        }
+    }
+    while (p < pattern.size() && pattern[p] == '*') ++p;
+    return p == pattern.size();
+}
+
+const ChannelResult* CompareResult::first_divergence() const {
+    const ChannelResult* first = nullptr;
+    for (const auto& c : channels) {
+        if (c.passed || !c.diverges) continue;
+        if (first == nullptr || c.seconds() < first->seconds()) first = &c;
+    }
+    if (first == nullptr) {
+        for (const auto& c : channels) {
+            if (!c.passed) return &c;
+        }
+    }
+    return first;
+}
+
+CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options) {
+    CompareResult result;
+    std::map<std::string, SignalId> actual_ids;
+    for (SignalId id = 0; id < actual.signals().size(); ++id) actual_ids[full_name(actual.signals()[id])] = id;
+    std::map<std::string, bool> seen;
+    for (SignalId gid = 0; gid < golden.signals().size(); ++gid) {
+        const SignalInfo& info = golden.signals()[gid];
+        ChannelResult r;
+        r.signal = full_name(info);
+        r.clock_hz = info.clock_hz;
+        r.verdict = "ok";
+        seen[r.signal] = true;
+        ChannelRule rule;
+        for (const auto& candidate : options.rules) {
+            if (glob_match(candidate.pattern, r.signal)) {
+                rule = candidate;
+                break;
+            }
+        }
+        r.rule = rule.kind;
+        const auto g = changes_of(golden, gid);
+        r.golden_changes = g.size();
+        auto it = actual_ids.find(r.signal);
+        if (it == actual_ids.end()) {
+            if (rule.kind != RuleKind::Ignore) {
+                r.passed = false;
+                r.verdict = "missing";
+                r.detail = "the run did not record this signal";
+            }
+            result.channels.push_back(r);
+            continue;
+        }
+        const auto a = changes_of(actual, it->second);
+        r.actual_changes = a.size();
+        compare_channel(r, info, rule, g, a, options);
+        result.channels.push_back(r);
+    }
+    for (const auto& [name, id] : actual_ids) {
+        if (seen.count(name)) continue;
+        ChannelRule rule;
+        for (const auto& candidate : options.rules) {
+            if (glob_match(candidate.pattern, name)) {
+                rule = candidate;
+                break;
+            }
+        }
+        if (rule.kind == RuleKind::Ignore) continue;
+        ChannelResult r;
+        r.signal = name;
+        r.rule = rule.kind;
+        r.passed = false;
+        r.verdict = "extra";
+        r.detail = "recorded now but not in the golden timeline";
+        r.actual_changes = changes_of(actual, id).size();
+        result.channels.push_back(r);
+    }
+    for (const auto& c : result.channels) result.passed = result.passed && c.passed;
+    return result;
+}
+
+std::string CompareResult::report() const {
+    std::string out;
+    std::size_t failing = 0;
+    for (const auto& c : channels) failing += c.passed ? 0 : 1;
+    char buf[256];
+    if (passed) {
+        std::snprintf(buf, sizeof buf, "PASS: all %zu channels match the golden timeline\n", channels.size());
+        out += buf;
+    } else {
+        std::snprintf(buf, sizeof buf, "FAIL: %zu of %zu channels differ from the golden timeline\n", failing, channels.size());
+        out += buf;
+        if (const ChannelResult* first = first_divergence()) {
+            std::snprintf(buf, sizeof buf, "first divergence: %s at %.6f ms (cycle %llu): %s\n", first->signal.c_str(),
+                          first->seconds() * 1e3, static_cast<unsigned long long>(first->divergence_cycle),
+                          first->detail.c_str());
+            out += buf;
+            if (!first->expected.empty() || !first->actual.empty()) {
+                out += "  expected " + first->expected + "\n";
+                out += "  actual   " + first->actual + "\n";
+            }
+            for (const auto& line : first->context) out += "  " + line + "\n";
+        }
+    }
+    out += "\n";
+    std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9s %9s  %s\n", "channel", "rule", "verdict", "golden", "actual", "detail");
+    out += buf;
+    for (const auto& c : channels) {
+        std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9zu %9zu  %s\n", c.signal.c_str(), to_string(c.rule),
+                      c.verdict.c_str(), c.golden_changes, c.actual_changes, c.detail.c_str());
+        out += buf;
+    }
+    return out;
+}
+
+}  // namespace avrbench

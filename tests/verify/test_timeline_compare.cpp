@@ -1,0 +1,135 @@
+// Comparators: each rule catches what it must and tolerates what it may; the
+// report names the first divergence with context and summarises every channel.
+#include <gtest/gtest.h>
+
+#include "verify/TimelineCompare.hpp"
+
+namespace avrbench {
+namespace {
+
+constexpr std::uint32_t kHz = 16000000;
+
+Timeline steps(int n, Cycle period, Cycle shift_step = 0, Cycle shift_by = 0, int drop_step = -1) {
+    Timeline t;
+    const SignalId id = t.add_signal({"uno", "PD2", SignalKind::Wire, 1, kHz});
+    t.record(id, 0, 0);
+    for (int i = 0; i < n; ++i) {
+        if (i == drop_step) continue;
+        const Cycle at = 1000 + static_cast<Cycle>(i) * period + (static_cast<Cycle>(i) == shift_step ? shift_by : 0);
+        t.record(id, at, 1);
+        t.record(id, at + 32, 0);
+    }
+    return t;
+}
+
+CompareOptions rule(RuleKind kind, double cycles = 0, double rel = 0) {
+    CompareOptions o;
+    ChannelRule r;
+    r.kind = kind;
+    r.tolerance_cycles = cycles;
+    r.tolerance_rel = rel;
+    o.rules.push_back(r);
+    return o;
+}
+
+TEST(TimelineCompare, IdenticalTimelinesPassEveryRule) {
+    for (RuleKind k : {RuleKind::Exact, RuleKind::Timing, RuleKind::Steps, RuleKind::StepRate, RuleKind::PwmDuty}) {
+        const auto result = compare_timelines(steps(100, 400), steps(100, 400), rule(k));
+        EXPECT_TRUE(result.passed) << to_string(k) << "\n" << result.report();
+    }
+}
+
+TEST(TimelineCompare, ExactNamesTheFirstDivergentEdge) {
+    // Step 40 (0-based) rises 31 cycles late: change #81 (initial 0, then 2 per step).
+    const auto result = compare_timelines(steps(100, 400), steps(100, 400, 40, 31), rule(RuleKind::Exact));
+    ASSERT_FALSE(result.passed);
+    const ChannelResult* first = result.first_divergence();
+    ASSERT_NE(first, nullptr);
+    EXPECT_EQ(first->signal, "uno.PD2");
+    EXPECT_EQ(first->divergence_cycle, 1000u + 40 * 400);  // the golden edge, the earlier of the two
+    EXPECT_EQ(first->expected, "1 at cycle 17000 (1.062500 ms)");
+    EXPECT_EQ(first->actual.rfind("1 at cycle 17031 ", 0), 0u) << first->actual;
+    const std::string report = result.report();
+    EXPECT_NE(report.find("first divergence: uno.PD2 at 1.062500 ms (cycle 17000)"), std::string::npos) << report;
+    EXPECT_NE(report.find("> #81"), std::string::npos) << report;  // context marks the divergent change
+    EXPECT_NE(report.find("uno.PD2"), std::string::npos);
+}
+
+TEST(TimelineCompare, TimingToleranceIsAbsolutePlusRelativeToTheInterval) {
+    // The shifted pulse (rise and fall) comes 31 cycles late: its rise ends a
+    // 368-cycle low interval 31 cycles long, the next rise a 31-cycle short one.
+    const Timeline golden = steps(100, 400), actual = steps(100, 400, 40, 31);
+    EXPECT_FALSE(compare_timelines(golden, actual, rule(RuleKind::Timing, 30)).passed);
+    EXPECT_TRUE(compare_timelines(golden, actual, rule(RuleKind::Timing, 31)).passed);
+    // 10 % of the 368-cycle interval before it = 36.8 cycles allowed.
+    EXPECT_TRUE(compare_timelines(golden, actual, rule(RuleKind::Timing, 0, 0.10)).passed);
+    EXPECT_FALSE(compare_timelines(golden, actual, rule(RuleKind::Timing, 0, 0.08)).passed);  // 29.4 < 31
+}
+
+TEST(TimelineCompare, StepsTolerateJitterButNeverALostStep) {
+    const Timeline golden = steps(100, 400);
+    EXPECT_TRUE(compare_timelines(golden, steps(100, 400, 40, 3), rule(RuleKind::Steps, 5)).passed);
+    const auto lost = compare_timelines(golden, steps(100, 400, 0, 0, 70), rule(RuleKind::Steps, 1000));
+    ASSERT_FALSE(lost.passed);
+    EXPECT_NE(lost.channels[0].detail.find("100 steps expected, 99 taken (lost steps)"), std::string::npos)
+        << lost.channels[0].detail;
+    const auto extra = compare_timelines(golden, steps(101, 400), rule(RuleKind::Steps, 1000));
+    ASSERT_FALSE(extra.passed);
+    EXPECT_NE(extra.channels[0].detail.find("extra steps"), std::string::npos);
+}
+
+TEST(TimelineCompare, PwmDutyPerWindow) {
+    // 25 % vs 30 % duty: period 1000 cycles, high 250 vs 300.
+    auto pwm = [](Cycle high) {
+        Timeline t;
+        const SignalId id = t.add_signal({"mega", "PB4", SignalKind::Wire, 1, kHz});
+        for (Cycle c = 0; c < 160000; c += 1000) {
+            t.record(id, c, 1);
+            t.record(id, c + high, 0);
+        }
+        return t;
+    };
+    CompareOptions o = rule(RuleKind::PwmDuty);
+    o.rules[0].window_s = 0.001;  // 16000 cycles = 16 periods per window
+    o.rules[0].band = 0.04;
+    EXPECT_TRUE(compare_timelines(pwm(250), pwm(270), o).passed);   // |0.25 - 0.27| = 0.02
+    EXPECT_FALSE(compare_timelines(pwm(250), pwm(300), o).passed);  // |0.25 - 0.30| = 0.05
+}
+
+TEST(TimelineCompare, BandOnRealValues) {
+    auto temps = [](double offset) {
+        Timeline t;
+        const SignalId id = t.add_signal({"hotend", "temperature_degC", SignalKind::Real, 1, kHz});
+        for (int i = 0; i < 100; ++i) t.record_real(id, static_cast<Cycle>(i) * 16000, 25.0 + i * 1.75 + offset);
+        return t;
+    };
+    CompareOptions o = rule(RuleKind::Band);
+    o.rules[0].band = 0.5;
+    EXPECT_TRUE(compare_timelines(temps(0), temps(0.4), o).passed);
+    EXPECT_FALSE(compare_timelines(temps(0), temps(0.6), o).passed);
+}
+
+TEST(TimelineCompare, MissingAndExtraChannelsFail) {
+    Timeline golden = steps(10, 400);
+    Timeline actual = steps(10, 400);
+    actual.add_signal({"uno", "PD3", SignalKind::Wire, 1, kHz});
+    const auto extra = compare_timelines(golden, actual, {});
+    EXPECT_FALSE(extra.passed);
+    EXPECT_EQ(extra.channels.back().verdict, "extra");
+    const auto missing = compare_timelines(actual, golden, {});
+    EXPECT_FALSE(missing.passed);
+    EXPECT_EQ(missing.channels.back().verdict, "missing");
+}
+
+TEST(TimelineCompare, RulesMatchByGlobFirstMatchWins) {
+    EXPECT_TRUE(glob_match("uno.PD*", "uno.PD2"));
+    EXPECT_TRUE(glob_match("*.position_mm", "x.position_mm"));
+    EXPECT_FALSE(glob_match("uno.PD?", "uno.PD10"));
+    CompareOptions o;
+    o.rules.push_back({"uno.PD2", RuleKind::Ignore});
+    o.rules.push_back({"*", RuleKind::Exact});
+    EXPECT_TRUE(compare_timelines(steps(100, 400), steps(100, 400, 40, 31), o).passed);
+}
+
+}  // namespace
+}  // namespace avrbench

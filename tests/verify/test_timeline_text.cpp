@@ -1,0 +1,96 @@
+// The golden-timeline text format: exact round trip, compact run-length
+// encoding, readable diffs, strict parsing.
+#include <gtest/gtest.h>
+
+#include "core/Errors.hpp"
+#include "trace/TimelineText.hpp"
+
+namespace avrbench {
+namespace {
+
+// A step train: n pulses, high `high` cycles, period `period`, starting at `start`.
+void add_steps(Timeline& t, SignalId id, Cycle start, int n, Cycle high, Cycle period) {
+    t.record(id, 0, 0);
+    for (int i = 0; i < n; ++i) {
+        t.record(id, start + static_cast<Cycle>(i) * period, 1);
+        t.record(id, start + static_cast<Cycle>(i) * period + high, 0);
+    }
+}
+
+TimelineHeader header() {
+    TimelineHeader h;
+    h.bench_version = "0.1.0";
+    h.inputs = {{"firmware.uno", "ab12", "build/firmware/x.elf"}, {"board", "cd34", "bench/boards/b.yaml"}};
+    h.end_cycle = 1'000'000;
+    h.end_clock_hz = 16'000'000;
+    return h;
+}
+
+TEST(TimelineText, RoundTripIsExact) {
+    Timeline t;
+    const SignalId step = t.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    const SignalId tx = t.add_signal({"uno", "uart0_tx", SignalKind::Bus, 8, 16000000});
+    const SignalId pos = t.add_signal({"x", "position_mm", SignalKind::Real, 1, 20000000});
+    add_steps(t, step, 1696, 1600, 32, 352);
+    t.record(tx, 100, 'o');
+    t.record(tx, 1460, 'k');
+    t.record_real(pos, 0, 100.0);
+    t.record_real(pos, 5, 100.0 + 1.0 / 3.0);  // not representable in short decimal: must survive exactly
+    const std::string text = format_timeline_text(t, header());
+    const ParsedTimeline parsed = parse_timeline_text(text, "golden.txt");
+    EXPECT_EQ(format_timeline_text(parsed.timeline, parsed.header), text);
+    ASSERT_EQ(parsed.header.inputs.size(), 2u);
+    EXPECT_EQ(parsed.header.inputs[1].path, "bench/boards/b.yaml");
+    const auto reals = changes_of(parsed.timeline, 2);
+    ASSERT_EQ(reals.size(), 2u);
+    EXPECT_EQ(reals[1].value.real, 100.0 + 1.0 / 3.0);
+    EXPECT_EQ(parsed.timeline.signals()[2].clock_hz, 20000000u);
+    // 1600 pulses = 3200 changes after the initial 0.
+    EXPECT_EQ(changes_of(parsed.timeline, 0).size(), 3201u);
+}
+
+TEST(TimelineText, PeriodicStepsTakeAFewLines) {
+    Timeline t;
+    const SignalId step = t.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    add_steps(t, step, 1696, 1600, 32, 352);
+    const std::string text = format_timeline_text(t, header());
+    // Initial level, first rising edge, one repeat line for the 1599
+    // (fall after 32, next rise after 320) pairs, and the last fall.
+    EXPECT_NE(text.find("@uno.PD2\n0 0\n+1696 1\n*1599 +32 0 +320 1\n+32 0\n"), std::string::npos) << text;
+}
+
+TEST(TimelineText, OneShiftedStepIsAOneLineChange) {
+    Timeline a, b;
+    const SignalId sa = a.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    const SignalId sb = b.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    add_steps(a, sa, 1000, 100, 32, 400);
+    add_steps(b, sb, 1000, 100, 32, 400);
+    b.record(sb, 1000 + 50 * 400, 0);  // drop step 50's rising edge...
+    b.record(sb, 1000 + 50 * 400 + 3, 1);  // ...and put it 3 cycles later
+    const std::string ta = format_timeline_text(a, header());
+    const std::string tb = format_timeline_text(b, header());
+    EXPECT_NE(ta, tb);
+    // The runs before and after the shifted step stay, so the text differs in a handful of lines.
+    auto lines = [](const std::string& s) { return std::count(s.begin(), s.end(), '\n'); };
+    EXPECT_LE(std::abs(lines(tb) - lines(ta)), 4);
+    EXPECT_LE(lines(tb), 16);  // 8 header lines, and 8 for 100 pulses with one moved
+}
+
+TEST(TimelineText, ParseErrorsNameTheLine) {
+    EXPECT_THROW(parse_timeline_text("hello\n", "g.txt"), BadInput);
+    try {
+        parse_timeline_text("avrbench-timeline 1\nsignal uno.PD2 wire 1 16000000\n@uno.PD3\n0 1\n", "g.txt");
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "g.txt:3: events for undeclared signal 'uno.PD3'");
+    }
+    try {
+        parse_timeline_text("avrbench-timeline 1\nsignal uno.PD2 wire 1 16000000\n@uno.PD2\n0 1\n+x 0\n", "g.txt");
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "g.txt:5: 'x' is not a whole number");
+    }
+}
+
+}  // namespace
+}  // namespace avrbench
