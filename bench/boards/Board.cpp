@@ -74,6 +74,17 @@ void Board::build_parts() {
         }
     }
 
+    // A part with an analog input (adc_pin: mcu.PIN, a thermistor) is clocked
+    // by that MCU: its ADC samples the part.
+    for (const auto& decl : spec_.parts) {
+        const RawParam* raw = find_param(decl, "adc_pin");
+        if (raw == nullptr || clock_of.count(decl.name) != 0) continue;
+        const auto dot = raw->value.find('.');
+        if (dot != std::string::npos && spec_.find_mcu(raw->value.substr(0, dot)) != nullptr) {
+            clock_of[decl.name] = &mcu(raw->value.substr(0, dot));
+        }
+    }
+
     std::map<std::string, Part*> built;
     std::set<std::string> pending;
     for (const auto& d : spec_.parts) pending.insert(d.name);

@@ -1,8 +1,12 @@
 #include "boards/PartRegistry.hpp"
 
 #include "parts/Axis.hpp"
+#include "parts/Fan.hpp"
+#include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
 #include "parts/StepDirDriver.hpp"
+#include "parts/ThermalPlant.hpp"
+#include "parts/Thermistor.hpp"
 
 namespace avrbench {
 namespace {
@@ -43,14 +47,48 @@ PartType limit_switch() {
     return t;
 }
 
+// Thermal parts (docs/THERMAL.md): a plant, and the heaters, thermistors
+// and fans that name it.
+PartType thermal_plant() {
+    PartType t;
+    t.name = "thermal_plant";
+    t.params = ThermalPlant::param_specs();
+    t.presets = ThermalPlant::presets();
+    t.references = {{"filament_driver", {"step_dir_driver"}}};
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup& lookup) {
+        StepDirDriver* driver = nullptr;
+        if (params.has("filament_driver") && !params.text("filament_driver").empty()) {
+            driver = &static_cast<StepDirDriver&>(lookup(params.text("filament_driver")));
+        }
+        return std::make_unique<ThermalPlant>(name, clock, params, driver);
+    };
+    return t;
+}
+
+template <class T>
+PartType on_plant(const std::string& type_name) {
+    PartType t;
+    t.name = type_name;
+    t.params = T::param_specs();
+    if constexpr (requires { T::presets(); }) t.presets = T::presets();
+    t.references = {{"plant", {"thermal_plant"}}};
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup& lookup) {
+        auto& plant = static_cast<ThermalPlant&>(lookup(params.text("plant")));
+        return std::make_unique<T>(name, clock, params, plant);
+    };
+    return t;
+}
+
 }  // namespace
 
 const std::map<std::string, PartType>& part_types() {
     static const std::map<std::string, PartType> types = [] {
         std::map<std::string, PartType> m;
-        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch()}) {
+        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), thermal_plant(),
+                           on_plant<Heater>("heater"), on_plant<Thermistor>("thermistor"), on_plant<Fan>("fan")}) {
             m.emplace(t.name, std::move(t));
         }
+        for (PartType t : motor_part_types()) m.emplace(t.name, std::move(t));
         return m;
     }();
     return types;

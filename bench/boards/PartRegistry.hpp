@@ -31,4 +31,7 @@ struct PartType {
 // Every part type the bench ships, by name.
 const std::map<std::string, PartType>& part_types();
 
+// The motor layer's types (bridges, switches, 74HC595, steppers), in boards/MotorPartTypes.cpp.
+std::vector<PartType> motor_part_types();
+
 }  // namespace avrbench

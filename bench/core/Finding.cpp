@@ -19,6 +19,8 @@ const char* to_string(FindingKind kind) {
         case FindingKind::DirHoldViolation: return "dir-hold-violation";
         case FindingKind::StepRateTooHigh: return "step-rate-too-high";
         case FindingKind::AxisOutOfTravel: return "axis-out-of-travel";
+        case FindingKind::MotorStall: return "motor-stall";
+        case FindingKind::Overheat: return "overheat";
         case FindingKind::HostProtocol: return "host-protocol";
     }
     return "unknown";

@@ -27,6 +27,8 @@ enum class FindingKind {
     DirHoldViolation,    // DIR changed too shortly after an active STEP edge
     StepRateTooHigh,     // STEP period shorter than the driver's maximum rate allows
     AxisOutOfTravel,     // an axis was driven past either end of its travel (a crash)
+    MotorStall,          // a stepper motor's rotor lost synchronism with its excitation (lost steps)
+    Overheat,            // a thermal plant passed its safe maximum temperature
     HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
 };
 

@@ -14,9 +14,11 @@ extern "C" {
 #include <sim_io.h>
 }
 
+#include "core/Adc.hpp"
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
 #include "core/fixes/Fix.hpp"
+#include "core/fixes/Interrupts.hpp"
 
 namespace avrbench {
 
@@ -108,6 +110,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
 
     fixes_ = std::make_unique<SimavrFixes>(avr_);
     scheduler_ = std::make_unique<Scheduler>(avr_);
+    adc_ = std::make_unique<Adc>(avr_, mcu_type_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
@@ -128,7 +131,9 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
 Mcu::~Mcu() {
     uarts_.clear();
     pins_.clear();
+    adc_.reset();
     scheduler_.reset();
+    fixes_.reset();  // the fixes unhook themselves from the core: before it is freed
     if (avr_ != nullptr) {
         avr_cycle_timer_cancel(avr_, &horizon_timer, this);
         route_simavr_log(avr_, nullptr);
@@ -193,6 +198,12 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
         add_finding(FindingKind::SimavrCrash, avr_->pc,
                     last_error_log_.empty() ? "simavr stopped the core" : last_error_log_, true);
         return false;
+    }
+    if (state == cpu_Done && sleep_was_a_nop(avr_)) {
+        // simavr ends the run at a SLEEP with interrupts off before looking at
+        // SE; with SE = 0 the datasheet's SLEEP is a NOP (fixes/InterruptTiming).
+        avr_->state = cpu_Running;
+        return true;
     }
     if (state == cpu_Done || state == cpu_Stopped) {
         halted_ = true;

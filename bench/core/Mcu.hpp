@@ -23,6 +23,8 @@ struct avr_io_t;
 
 namespace avrbench {
 
+class Adc;
+
 struct McuOptions {
     std::string name = "mcu";        // the MCU's name on the board, used in scopes and findings
     std::string mcu_type;            // overrides the ELF's .mmcu section, e.g. "atmega328p"
@@ -75,6 +77,8 @@ public:
     // USART n. Throws BadInput when the MCU has no such USART.
     Uart& uart(int index = 0);
     Scheduler& scheduler() { return *scheduler_; }
+    // The ADC: analog sources per channel, pin -> channel (core/Adc.hpp).
+    Adc& adc() { return *adc_; }
 
     const std::vector<Finding>& findings() const { return findings_; }
     // Number of avr_run() steps taken: instructions plus sleep fast-forwards.
@@ -100,6 +104,7 @@ private:
     avr_t* avr_ = nullptr;
     std::unique_ptr<SimavrFixes> fixes_;
     std::unique_ptr<Scheduler> scheduler_;
+    std::unique_ptr<Adc> adc_;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
     std::vector<Finding> findings_;

@@ -1,5 +1,5 @@
 // One USART of an MCU seen from the outside: the bytes the firmware sends
-// (each with the cycle of its UDR write) and a queue of bytes to send it,
+// (each with the cycle of its start bit: fixes/UartTransmitter) and a queue of bytes to send it,
 // paced by simavr's receive FIFO (XON/XOFF IRQs) and held back until the
 // firmware has enabled its receiver, as a host would wait for the port.
 #pragma once

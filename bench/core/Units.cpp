@@ -35,12 +35,15 @@ constexpr UnitEntry kUnits[] = {
     {"degC", Dimension::Temperature, 1.0},
     {"K/W", Dimension::ThermalResistance, 1.0},
     {"J/K", Dimension::HeatCapacity, 1.0},
+    {"W/K", Dimension::ThermalConductance, 1.0}, {"mW/K", Dimension::ThermalConductance, 1e-3},
     {"N*m", Dimension::Torque, 1.0},       {"mN*m", Dimension::Torque, 1e-3},
     {"H", Dimension::Inductance, 1.0},     {"mH", Dimension::Inductance, 1e-3},
     {"kg*m^2", Dimension::Inertia, 1.0},   {"g*cm^2", Dimension::Inertia, 1e-7},
     {"m/s", Dimension::Speed, 1.0},        {"mm/s", Dimension::Speed, 1e-3},
     {"mm/min", Dimension::Speed, 1e-3 / 60.0},
     {"m/s^2", Dimension::Acceleration, 1.0}, {"mm/s^2", Dimension::Acceleration, 1e-3},
+    {"N*m/A", Dimension::TorqueConstant, 1.0}, {"V*s/rad", Dimension::TorqueConstant, 1.0},
+    {"N*m*s/rad", Dimension::RotaryDamping, 1.0},
 };
 
 std::string accepted_units(Dimension dimension) {
@@ -69,11 +72,14 @@ const char* to_string(Dimension dimension) {
         case Dimension::Temperature: return "a temperature";
         case Dimension::ThermalResistance: return "a thermal resistance";
         case Dimension::HeatCapacity: return "a heat capacity";
+        case Dimension::ThermalConductance: return "a thermal conductance";
         case Dimension::Torque: return "a torque";
         case Dimension::Inductance: return "an inductance";
         case Dimension::Inertia: return "an inertia";
         case Dimension::Speed: return "a speed";
         case Dimension::Acceleration: return "an acceleration";
+        case Dimension::TorqueConstant: return "a torque constant";
+        case Dimension::RotaryDamping: return "a rotary damping";
     }
     return "a quantity";
 }

@@ -22,11 +22,14 @@ enum class Dimension {
     Temperature,    // degC (offset scale kept as users write it: 25degC -> 25)
     ThermalResistance,  // K/W
     HeatCapacity,       // J/K
+    ThermalConductance, // W/K
     Torque,             // N*m
     Inductance,         // H
     Inertia,            // kg*m^2
     Speed,              // m/s
     Acceleration,       // m/s^2
+    TorqueConstant,     // N*m/A (= V*s/rad, the back-EMF constant)
+    RotaryDamping,      // N*m*s/rad (viscous friction)
 };
 
 const char* to_string(Dimension dimension);

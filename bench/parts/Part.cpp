@@ -1,5 +1,9 @@
 #include "parts/Part.hpp"
 
+#include <algorithm>
+
+#include "core/Errors.hpp"
+
 namespace avrbench {
 
 std::string PartPin::label() const { return part_.name() + "." + name_; }
@@ -45,6 +49,24 @@ void Part::publish(std::size_t signal, double value) {
     signal_values_[signal] = value;
     const Cycle now = clock_->cycle();
     for (auto& fn : signal_listeners_) fn(signal, now, value);
+}
+
+void Part::inject_fault(const std::string& fault, Cycle at_cycle) {
+    const auto names = fault_names();
+    if (fault != "none" && std::find(names.begin(), names.end(), fault) == names.end()) {
+        std::string list = "none";
+        for (const auto& n : names) list += ", " + n;
+        throw BadInput("part '" + name_ + "' (" + std::string(type()) + ") has no fault '" + fault + "' (faults: " +
+                       list + ")");
+    }
+    clock_->scheduler().at(at_cycle, [this, fault](Cycle) {
+        fault_ = fault;
+        apply_fault(fault);
+    });
+}
+
+void Part::inject_fault_at_seconds(const std::string& fault, double seconds) {
+    inject_fault(fault, clock_->cycles_from_seconds(seconds));
 }
 
 void Part::report(FindingKind kind, std::string detail) {

@@ -73,6 +73,15 @@ public:
 
     const std::vector<Finding>& findings() const { return findings_; }
 
+    // Faults, by name, for tests and scenario files ("open", "stuck_on", ...;
+    // "none" repairs). inject_fault applies one when this part's clock reaches
+    // `at_cycle` (at the next instruction boundary if that has passed); throws
+    // BadInput for a name the part does not know. A part has one fault at a time.
+    virtual std::vector<std::string> fault_names() const { return {}; }
+    void inject_fault(const std::string& fault, Cycle at_cycle);
+    void inject_fault_at_seconds(const std::string& fault, double seconds);
+    const std::string& fault() const { return fault_; }
+
     // Signals for the trace recorder, and a subscription to their changes.
     const std::vector<PartSignalInfo>& signals() const { return signal_infos_; }
     double signal_value(std::size_t signal) const { return signal_values_[signal]; }
@@ -83,6 +92,9 @@ protected:
     std::size_t add_pin(std::string name, TerminalRole role);
     std::size_t add_signal(std::string name, bool real, double initial = 0);
     void publish(std::size_t signal, double value);
+
+    // Called when an injected fault takes effect ("none": repaired).
+    virtual void apply_fault(const std::string& fault) { (void)fault; }
 
     // A net drove one of this part's input pins.
     virtual void on_input(std::size_t pin, bool level) {
@@ -105,6 +117,7 @@ private:
     std::vector<PartSignalInfo> signal_infos_;
     std::vector<double> signal_values_;
     std::vector<SignalListener> signal_listeners_;
+    std::string fault_ = "none";
 };
 
 }  // namespace avrbench

@@ -74,6 +74,10 @@ std::vector<ParamSpec> StepDirDriver::param_specs() {
         {"microsteps", PT::Integer, Dimension::Dimensionless, false, "16", {}, "assumed: all jumpers fitted",
          "resolution when the microstep pins are not wired (jumpers)"},
         {"forward_dir", PT::Choice, Dimension::Dimensionless, false, "high", {"high", "low"}, "", "DIR level counted as +"},
+        {"current", PT::Quantity, Dimension::Current, false, "0.5A", {}, "assumed: set with the VREF trimmer",
+         "full-scale winding current (a motor part driven by this driver uses it)"},
+        {"motor_supply", PT::Quantity, Dimension::Voltage, false, "12V", {}, "assumed: a 12 V printer/CNC supply",
+         "VMOT, the most the chopper can put across a winding"},
     };
 }
 
@@ -123,6 +127,8 @@ StepDirDriver::StepDirDriver(std::string name, Mcu& clock, const ParamValues& pa
         throw BadInput("part '" + this->name() + "': microsteps must be a power of two from 1 to 256");
     }
     configured_microsteps_ = static_cast<unsigned>(microsteps);
+    current_a_ = params.quantity("current");
+    motor_supply_v_ = params.quantity("motor_supply");
     current_microsteps_ = configured_microsteps_;
 
     sig_step_ = add_signal("step", false);
@@ -160,6 +166,8 @@ void StepDirDriver::on_input(std::size_t pin, bool level) {
     } else if (pin == dir_pin_) {
         publish(sig_dir_, level ? 1 : 0);
         on_dir_change();
+    } else if (pin == enable_pin_) {
+        for (auto& fn : output_listeners_) fn();
     }
 }
 
@@ -223,6 +231,7 @@ void StepDirDriver::on_step_edge(bool active) {
     ++steps_taken_;
     publish(sig_position_, static_cast<double>(position_256_) * configured_microsteps_ / 256.0);
     for (auto& fn : step_listeners_) fn(delta);
+    for (auto& fn : output_listeners_) fn();
 }
 
 }  // namespace avrbench

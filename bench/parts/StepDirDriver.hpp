@@ -38,6 +38,21 @@ public:
     // Called after every step that moved the position (the axis listens).
     void on_step(std::function<void(int delta_256)> fn) { step_listeners_.push_back(std::move(fn)); }
 
+    // The winding currents, for a motor part driven by this driver (taken as
+    // an ideal chopper at the set current). The A4988's and DRV8825's
+    // microstep tables start at their home state, 45 electrical degrees
+    // (70.7 % on both windings; taken the same for the TMC2208), and advance
+    // 90 degrees per full step, so the present
+    // microstep's electrical angle is 45 deg + position_256 * 90 deg / 256 and
+    // the currents are current * (cos, sin) of it.
+    double electrical_angle() const {
+        return 0.7853981633974483 + static_cast<double>(position_256_) * (1.5707963267948966 / 256);
+    }
+    double set_current_a() const { return current_a_; }
+    double motor_supply_v() const { return motor_supply_v_; }
+    // Called after a step and after ENABLE changes (the motor listens).
+    void on_outputs_change(std::function<void()> fn) { output_listeners_.push_back(std::move(fn)); }
+
 private:
     void on_input(std::size_t pin, bool level) override;
     void on_step_edge(bool active);
@@ -65,6 +80,8 @@ private:
     Cycle last_active_edge_ = 0, last_inactive_edge_ = 0, last_dir_change_ = 0;
     std::size_t sig_step_, sig_dir_, sig_position_;
     std::vector<std::function<void(int)>> step_listeners_;
+    double current_a_, motor_supply_v_;
+    std::vector<std::function<void()>> output_listeners_;
 };
 
 }  // namespace avrbench

@@ -47,6 +47,12 @@ ISR(TIMER1_COMPA_vect)
     PINB = _BV(LED_BIT);
 }
 
+/* The compare value; blink_timer1_ocr250 is built with 250 to show a
+ * regression that shifts the timing (one timer count = 64 cycles per period). */
+#ifndef BLINK_OCR1A
+#define BLINK_OCR1A 249
+#endif
+
 int main(void)
 {
     /* Both pins as outputs. For OC1A the datasheet requires the DDR bit set:
@@ -56,7 +62,7 @@ int main(void)
 
     /* TOP = OCR1A = 249 -> 250 timer counts per period. Written before the
      * clock starts, so the first period is already a full one. */
-    OCR1A = 249;
+    OCR1A = BLINK_OCR1A;
 
     /* TCCR1A: COM1A1:0 = 01 -> "Toggle OC1A on Compare Match" (Compare Output
      * Mode, non-PWM). WGM11:10 = 00; together with WGM13:12 = 01 in TCCR1B

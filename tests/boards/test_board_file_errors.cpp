@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "boards/Board.hpp"
+#include "boards/PartRegistry.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 
@@ -57,6 +58,12 @@ TEST_P(BoardFileError, NamesFileLineAndProblem) {
     const Case& c = GetParam();
     std::string expected = c.expected;
     if (auto at = expected.find("{elf}"); at != std::string::npos) expected.replace(at, 5, test::firmware("step_pattern"));
+    if (auto at = expected.find("{types}"); at != std::string::npos) {
+        // Every registered part type, in name order (the list grows with each part).
+        std::string types;
+        for (const auto& [name, type] : part_types()) types += (types.empty() ? "" : ", ") + name;
+        expected.replace(at, 7, types);
+    }
     EXPECT_EQ(error_of(board_with(c.line, c.replacement)), expected);
 }
 
@@ -64,8 +71,7 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BoardFileError,
     ::testing::Values(
         Case{"unknown_part_type", 4, "  x_driver: {type: step_dir_drvr}",
-             "bad.yaml:4: part 'x_driver': unknown part type 'step_dir_drvr' (known: limit_switch, linear_axis, "
-             "rotary_axis, step_dir_driver)"},
+             "bad.yaml:4: part 'x_driver': unknown part type 'step_dir_drvr' (known: {types})"},
         Case{"unknown_pin", 8, "  x_step: [uno.PD9, x_driver.step]",
              "bad.yaml:8: unknown pin 'PD9': atmega328p has no such pin"},
         Case{"pin_the_part_lacks", 8, "  x_step: [uno.PC7, x_driver.step]",
@@ -82,7 +88,8 @@ INSTANTIATE_TEST_SUITE_P(
              "bad.yaml:5: part 'x': travel: '200' needs a unit (m, mm, um, cm)"},
         Case{"unknown_parameter", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_hi_min: 2us}",
              "bad.yaml:4: part 'x_driver': unknown parameter 'step_hi_min' (known: preset, step_edge, step_high_min, "
-             "step_low_min, dir_setup, dir_hold, max_step_rate, enable_active, microsteps, forward_dir)"},
+             "step_low_min, dir_setup, dir_hold, max_step_rate, enable_active, microsteps, forward_dir, current, "
+             "motor_supply)"},
         Case{"bad_preset", 4, "  x_driver: {type: step_dir_driver, preset: a4989}",
              "bad.yaml:4: part 'x_driver': preset: 'a4989' is not one of a4988, drv8825, tmc2208, generic"},
         Case{"unknown_part_pin", 8, "  x_step: [uno.PD2, x_driver.stp]",

@@ -1,0 +1,184 @@
+#include "core/fixes/CompareOutputPins.hpp"
+
+#include <string_view>
+
+extern "C" {
+#include <avr_ioport.h>
+#include <sim_io.h>
+#include <sim_irq.h>
+}
+
+#include "core/fixes/Interrupts.hpp"
+
+namespace avrbench {
+
+struct CompareOutputPins::Port {
+    CompareOutputPins* owner = nullptr;
+    avr_ioport_t* io = nullptr;
+    std::uint8_t connected = 0;  // pins a connected OCnx drives
+    std::uint8_t level = 0;      // their OCnx level
+    std::uint8_t shared = 0;     // pins with more than one comparator (2560 PB7: OC0A, OC1C)
+    std::unique_ptr<IoWriteHook> port_write, pin_write, ddr_write;
+    std::unique_ptr<IoReadHook> pin_read;
+
+    std::uint8_t overridden(const avr_t* avr) const { return connected & avr->data[io->r_ddr]; }
+    std::uint8_t effective(std::uint8_t port_value, std::uint8_t mask) const {
+        return static_cast<std::uint8_t>((port_value & ~mask) | (level & mask));
+    }
+};
+
+CompareOutputPins::CompareOutputPins(avr_t* avr)
+    : avr_(avr), pin_write_toggles_(part_facts(avr).pin_write_toggles) {}
+
+CompareOutputPins::~CompareOutputPins() = default;
+
+CompareOutputPins::Port* CompareOutputPins::port_for(avr_ioport_t* io) {
+    for (auto& p : ports_) {
+        if (p->io == io) return p.get();
+    }
+    auto p = std::make_unique<Port>();
+    p->owner = this;
+    p->io = io;
+    p->port_write = std::make_unique<IoWriteHook>(avr_, io->r_port, &on_port_write, p.get());
+    p->pin_write = std::make_unique<IoWriteHook>(avr_, io->r_pin, &on_pin_write, p.get());
+    p->ddr_write = std::make_unique<IoWriteHook>(avr_, io->r_ddr, &on_ddr_write, p.get());
+    p->pin_read = std::make_unique<IoReadHook>(avr_, io->r_pin, &on_pin_read, p.get());
+    ports_.push_back(std::move(p));
+    return ports_.back().get();
+}
+
+int CompareOutputPins::add(avr_regbit_t com_pin, avr_irq_t* compare_irq) {
+    if (com_pin.reg == 0) return -1;
+    avr_ioport_t* io = nullptr;
+    for (avr_io_t* m = avr_->io_port; m != nullptr; m = m->next) {
+        if (m->kind == nullptr || std::string_view(m->kind) != "port") continue;
+        auto* p = reinterpret_cast<avr_ioport_t*>(m);
+        if (p->r_port == com_pin.reg) io = p;
+    }
+    if (io == nullptr) return -1;
+    Driver d;
+    d.port = port_for(io);
+    d.bit = static_cast<std::uint8_t>(com_pin.bit);
+    d.compare_irq = compare_irq;
+    d.pin_irq = io->io.irq + com_pin.bit;
+    for (const Driver& other : drivers_) {
+        if (other.port == d.port && other.bit == d.bit) d.port->shared = static_cast<std::uint8_t>(d.port->shared | (1u << d.bit));
+    }
+    drivers_.push_back(d);
+    avr_unconnect_irq(d.compare_irq, d.pin_irq);
+    return static_cast<int>(drivers_.size() - 1);
+}
+
+void CompareOutputPins::after_reset() {
+    for (Driver& d : drivers_) {
+        d.connected = false;
+        d.level = false;
+        avr_unconnect_irq(d.compare_irq, d.pin_irq);
+    }
+    for (auto& p : ports_) {
+        p->connected = 0;
+        p->level = 0;
+    }
+}
+
+void CompareOutputPins::set(int id, bool connected, bool level) {
+    if (id < 0) return;
+    Driver& d = drivers_[static_cast<std::size_t>(id)];
+    if (d.connected == connected && d.level == level) return;
+    const bool level_changed = d.level != level;
+    d.connected = connected;
+    d.level = level;
+    // For anyone watching the comparator's own IRQ (it no longer reaches the pin).
+    if (level_changed) avr_raise_irq(d.compare_irq, level ? 1 : 0);
+    update_pin(*d.port, d.bit);
+}
+
+void CompareOutputPins::combine(Port& port, std::uint8_t bit, std::uint8_t port_value) {
+    const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
+    int n = 0;
+    bool any = false, all = true;
+    for (const Driver& d : drivers_) {
+        if (d.port != &port || d.bit != bit || !d.connected) continue;
+        ++n;
+        any = any || d.level;
+        all = all && d.level;
+    }
+    // ATmega2560 §19 "Output Compare Modulator (OCM1C0A)": with OC0A and OC1C
+    // both connected to PB7, PORTB7 selects OR (1) or AND (0) of the two.
+    const bool on = n == 1 ? any : ((port_value & mask) != 0 ? any : all);
+    port.connected = static_cast<std::uint8_t>(n != 0 ? (port.connected | mask) : (port.connected & ~mask));
+    port.level = static_cast<std::uint8_t>(n != 0 && on ? (port.level | mask) : (port.level & ~mask));
+}
+
+void CompareOutputPins::update_pin(Port& port, std::uint8_t bit) {
+    avr_t* avr = avr_;
+    const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
+    combine(port, bit, avr->data[port.io->r_port]);
+    if ((avr->data[port.io->r_ddr] & mask) == 0) return;  // an input: OCnx is not visible (§15.6)
+    const bool level = (port.connected & mask) != 0 ? (port.level & mask) != 0 : (avr->data[port.io->r_port] & mask) != 0;
+    // The port module's pin IRQ: sets PINxn, raises pin change interrupts,
+    // tells the pin's listeners (filtered: nothing happens when unchanged).
+    avr_raise_irq(port.io->io.irq + bit, level ? 1 : 0);
+}
+
+void CompareOutputPins::on_port_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    auto* port = static_cast<Port*>(hook.context());
+    if (port->connected == 0) {
+        hook.write_original(avr, addr, value);
+        return;
+    }
+    for (std::uint8_t bit = 0; port->shared != 0 && bit < 8; ++bit) {
+        if ((port->shared >> bit) & 1) port->owner->combine(*port, bit, value);
+    }
+    const std::uint8_t ovr = port->overridden(avr);
+    // simavr's port module raises every output pin from PORTx: let it see the
+    // OCnx levels on the overridden pins, then keep the firmware's value.
+    hook.write_original(avr, addr, port->effective(value, ovr));
+    avr->data[addr] = value;
+}
+
+void CompareOutputPins::on_pin_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    auto* port = static_cast<Port*>(hook.context());
+    const std::uint8_t ovr = port->overridden(avr);
+    if (ovr == 0) {
+        hook.write_original(avr, addr, value);
+        return;
+    }
+    // Writing one to PINxn toggles PORTxn (§14.2.2); on an overridden pin that
+    // is the firmware's PORTxn, not the pin.
+    const avr_io_addr_t r_port = port->io->r_port;
+    const std::uint8_t before = avr->data[r_port];
+    const std::uint8_t toggles = port->owner->pin_write_toggles_ ? single_bit_write_value(avr, addr, value) : 0;
+    if (port->owner->pin_write_toggles_ && (toggles & ~ovr) == 0) {
+        // Only overridden pins: nothing for the port module to do.
+        avr->data[r_port] = static_cast<std::uint8_t>(before ^ toggles);
+        return;
+    }
+    avr->data[r_port] = port->effective(before, ovr);
+    hook.write_original(avr, addr, static_cast<std::uint8_t>(value & ~ovr));
+    avr->data[r_port] = static_cast<std::uint8_t>((avr->data[r_port] & ~ovr) | ((before ^ toggles) & ovr));
+}
+
+void CompareOutputPins::on_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    auto* port = static_cast<Port*>(hook.context());
+    if (port->connected == 0) {
+        hook.write_original(avr, addr, value);
+        return;
+    }
+    const avr_io_addr_t r_port = port->io->r_port;
+    const std::uint8_t firmware_port = avr->data[r_port];
+    const std::uint8_t ovr = static_cast<std::uint8_t>(port->connected & value);
+    avr->data[r_port] = port->effective(firmware_port, ovr);
+    hook.write_original(avr, addr, value);
+    avr->data[r_port] = firmware_port;
+}
+
+std::uint8_t CompareOutputPins::on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr) {
+    auto* port = static_cast<Port*>(hook.context());
+    const std::uint8_t value = hook.read_original(avr, addr);
+    const std::uint8_t ovr = port->overridden(avr);
+    // PINxn of an output reads the pin, i.e. OCnx while it is overridden.
+    return ovr == 0 ? value : static_cast<std::uint8_t>((value & ~ovr) | (port->level & ovr));
+}
+
+}  // namespace avrbench

@@ -1,0 +1,74 @@
+// The OCnx pins of the timers, for the timer model (TimerModel.cpp).
+//
+// Datasheet (ATmega328P §15.6 / §16.8 "Compare Match Output Unit", ATmega2560
+// §16.6 / §17.8): while the COMnx bits connect the
+// output compare OCnx, the Waveform Generator drives the pin in place of
+// PORTxn, and PORTxn keeps what the firmware last wrote (it is used again
+// once COMnx is cleared); OCnx reaches the pin only while DDxn is one.
+//
+// simavr 1.6 instead connects each comparator IRQ straight to its pin with
+// AVR_IOPORT_OUTPUT, which rewrites PORTxn on every compare match, and a PORTx
+// write by the firmware re-raises the pin from PORTxn. Here the timer model
+// drives the pin itself, and hooks on PORTx (write), PINx (read and write)
+// and DDRx (write) of the ports that carry OCnx pins keep simavr's port
+// module seeing the OCnx level on those pins while the firmware sees its own
+// PORTxn value.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/fixes/Fix.hpp"
+
+struct avr_irq_t;
+struct avr_ioport_t;
+
+namespace avrbench {
+
+class CompareOutputPins {
+public:
+    explicit CompareOutputPins(avr_t* avr);
+    ~CompareOutputPins();
+    CompareOutputPins(const CompareOutputPins&) = delete;
+    CompareOutputPins& operator=(const CompareOutputPins&) = delete;
+
+    // Adds the pin a timer comparator drives (its `com_pin` regbit); returns
+    // the driver's id, or -1 when the core has no such pin.
+    int add(avr_regbit_t com_pin, avr_irq_t* compare_irq);
+    // The comparator's state: whether COMnx connects OCnx to the pin, and the
+    // level of the OCnx register. Raises the pin when what it shows changes.
+    void set(int id, bool connected, bool level);
+    // After avr_reset(): simavr's timer reset has connected the comparator
+    // IRQs straight to their pins again, and every COMnx is zero.
+    void after_reset();
+
+private:
+    struct Port;
+    struct Driver {
+        Port* port = nullptr;
+        std::uint8_t bit = 0;
+        avr_irq_t* compare_irq = nullptr;
+        avr_irq_t* pin_irq = nullptr;
+        bool connected = false;
+        bool level = false;
+    };
+
+    Port* port_for(avr_ioport_t* io);
+    void update_pin(Port& port, std::uint8_t bit);
+    // Whether a connected OCnx drives pin `bit` of `port`, and its level when
+    // PORTx holds `port_value` (the 2560's modulator on PB7 reads PORTB7).
+    void combine(Port& port, std::uint8_t bit, std::uint8_t port_value);
+
+    static void on_port_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+    static void on_pin_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+    static void on_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+    static std::uint8_t on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr);
+
+    avr_t* avr_;
+    bool pin_write_toggles_;
+    std::vector<std::unique_ptr<Port>> ports_;
+    std::vector<Driver> drivers_;
+};
+
+}  // namespace avrbench

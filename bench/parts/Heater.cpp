@@ -1,0 +1,120 @@
+#include "parts/Heater.hpp"
+
+#include <algorithm>
+
+#include "core/Errors.hpp"
+#include "parts/ThermalPlant.hpp"
+
+namespace avrbench {
+
+std::vector<ParamSpec> Heater::param_specs() {
+    using PT = ParamType;
+    using D = Dimension;
+    return {
+        {"preset", PT::Choice, D::Dimensionless, false, "cartridge_40w_12v",
+         {"cartridge_40w_12v", "cartridge_40w_24v", "bed_12v", "custom"}, "", "heater element"},
+        {"plant", PT::Text, D::Dimensionless, true, "", {}, "", "the thermal_plant it heats"},
+        {"node", PT::Choice, D::Dimensionless, false, "block", {"block", "surface"}, "", "the plant node it heats"},
+        {"supply", PT::Quantity, D::Voltage, false, "", {}, "preset", "heater supply voltage"},
+        {"resistance", PT::Quantity, D::Resistance, false, "", {}, "preset", "heater element resistance"},
+        {"series_resistance", PT::Quantity, D::Resistance, false, "0ohm", {}, "assumed: negligible",
+         "MOSFET on-resistance plus wiring"},
+        {"gate_active", PT::Choice, D::Dimensionless, false, "high", {"high", "low"},
+         "RAMPS 1.4 schematic: the MCU pin drives the N-MOSFET gate directly, high = on",
+         "gate level that turns the heater on"},
+        {"sample_interval", PT::Quantity, D::Time, false, "100ms", {}, "assumed", "period of the duty trace"},
+    };
+}
+
+const std::map<std::string, std::map<std::string, std::string>>& Heater::presets() {
+    static const std::map<std::string, std::map<std::string, std::string>> table = {
+        // A 40 W cartridge at its rated voltage: R = V^2 / P = 144 / 40 = 3.6 ohm
+        // (12 V) and 576 / 40 = 14.4 ohm (24 V). (Marlin's Anycubic i3 Mega
+        // configuration notes "40W heater cartridge (3.6 ohm @ 22 degC)".)
+        {"cartridge_40w_12v", {{"supply", "12V"}, {"resistance", "3.6ohm"}}},
+        {"cartridge_40w_24v", {{"supply", "24V"}, {"resistance", "14.4ohm"}}},
+        // RepRap wiki "Heatbeds - A beginner's guide": a PCB heatbed makes about
+        // 120 W at 12 V, so its tracks measure about 1.2 ohm.
+        {"bed_12v", {{"supply", "12V"}, {"resistance", "1.2ohm"}}},
+        {"custom", {}},
+    };
+    return table;
+}
+
+Heater::Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant)
+    : Part(std::move(name), clock), plant_(plant) {
+    if (!params.has("supply") || !params.has("resistance")) {
+        throw BadInput("part '" + this->name() + "': a custom heater needs supply and resistance");
+    }
+    const double v = params.quantity("supply");
+    const double r = params.quantity("resistance");
+    const double rs = params.quantity("series_resistance");
+    if (!(r > 0) || rs < 0 || v < 0) throw BadInput("part '" + this->name() + "': resistance must be positive");
+    // P = I^2 R with I = V / (R + R_series).
+    power_on_W_ = v * v * r / ((r + rs) * (r + rs));
+    gate_active_level_ = params.text("gate_active") == "high";
+    try {
+        source_ = plant_.add_heat_source(params.text("node"));
+    } catch (const BadInput& e) {
+        throw BadInput("part '" + this->name() + "': " + e.what());
+    }
+    gate_pin_ = add_pin("gate", TerminalRole::Input);
+    const double interval = params.quantity("sample_interval");
+    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
+    sig_on_ = add_signal("on", false);
+    sig_duty_ = add_signal("duty", true, 0);
+    sig_power_ = add_signal("power_W", true, 0);
+}
+
+void Heater::start() {
+    last_sample_ = clock().cycle();
+    update();
+    clock().scheduler().at(last_sample_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
+}
+
+Cycle Heater::on_cycles() const { return on_total_ + (on_ ? clock().cycle() - on_since_ : 0); }
+
+double Heater::energy_J() const {
+    return static_cast<double>(on_cycles()) / clock().frequency_hz() * power_on_W_;
+}
+
+void Heater::inject(Fault fault, Cycle at_cycle) {
+    static const char* const kNames[] = {"none", "disconnected", "stuck_on"};
+    inject_fault(kNames[static_cast<int>(fault)], at_cycle);
+}
+
+void Heater::apply_fault(const std::string& fault) {
+    fault_state_ = fault == "disconnected" ? Fault::Disconnected : fault == "stuck_on" ? Fault::StuckOn : Fault::None;
+    update();
+}
+
+void Heater::on_input(std::size_t pin, bool) {
+    if (pin == gate_pin_) update();
+}
+
+void Heater::update() {
+    const bool gate_on = input_level(gate_pin_) == gate_active_level_;
+    const bool on = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on);
+    if (on == on_) return;
+    const Cycle now = clock().cycle();
+    if (on_) on_total_ += now - on_since_;
+    on_ = on;
+    on_since_ = now;
+    plant_.set_heat_source_power(source_, on ? power_on_W_ : 0.0);
+    publish(sig_on_, on ? 1 : 0);
+}
+
+void Heater::on_sample(Cycle scheduled) {
+    const Cycle now = clock().cycle();
+    const Cycle on_now = on_cycles();
+    const Cycle span = now - last_sample_;
+    const double duty = span > 0 ? static_cast<double>(on_now - on_at_last_sample_) / static_cast<double>(span) : 0.0;
+    last_sample_ = now;
+    on_at_last_sample_ = on_now;
+    publish(sig_duty_, duty);
+    publish(sig_power_, duty * power_on_W_);
+    clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });
+}
+
+}  // namespace avrbench

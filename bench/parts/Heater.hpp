@@ -1,0 +1,66 @@
+// A resistive heater (cartridge or bed) switched by a low-side MOSFET whose
+// gate is an MCU pin: hardware PWM, soft PWM or bang-bang all arrive as gate
+// edges. While on it dissipates P = V² R / (R + R_series)² (R_series: MOSFET
+// on-resistance and wiring, 0 unless given) into its plant's node; the energy
+// is integrated exactly between edges (in cycles of its clock).
+//
+// Faults: "disconnected" (open heater circuit: no power whatever the gate),
+// "stuck_on" (MOSFET failed short: full power whatever the gate).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+class ThermalPlant;
+
+class Heater final : public Part {
+public:
+    enum class Fault { None, Disconnected, StuckOn };
+
+    static std::vector<ParamSpec> param_specs();
+    static const std::map<std::string, std::map<std::string, std::string>>& presets();
+
+    Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant);
+    std::string_view type() const override { return "heater"; }
+    void start() override;
+
+    bool on() const { return on_; }
+    const ThermalPlant& plant() const { return plant_; }
+    double power_on_W() const { return power_on_W_; }  // dissipation while on
+    double power_W() const { return on_ ? power_on_W_ : 0.0; }
+    // Energy dissipated since power-on (exact to the cycle), J.
+    double energy_J() const;
+    // Cycles spent on since power-on.
+    Cycle on_cycles() const;
+
+    void inject(Fault fault, Cycle at_cycle);
+    std::vector<std::string> fault_names() const override { return {"disconnected", "stuck_on"}; }
+
+private:
+    void on_input(std::size_t pin, bool level) override;
+    void apply_fault(const std::string& fault) override;
+    void update();
+    void on_sample(Cycle scheduled);
+
+    ThermalPlant& plant_;
+    int source_;
+    std::size_t gate_pin_;
+    bool gate_active_level_;
+    double power_on_W_;
+    Fault fault_state_ = Fault::None;
+    bool on_ = false;
+    Cycle on_since_ = 0;
+    Cycle on_total_ = 0;           // completed on-intervals
+    Cycle sample_cycles_;
+    Cycle last_sample_ = 0;
+    Cycle on_at_last_sample_ = 0;
+    std::size_t sig_on_, sig_duty_, sig_power_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,463 @@
+#include "parts/HybridStepper.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/Adc.hpp"
+#include "core/Errors.hpp"
+#include "parts/L293D.hpp"
+#include "parts/LowSideSwitch.hpp"
+#include "parts/StepDirDriver.hpp"
+
+namespace avrbench {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2 * kPi;
+// A pole slip is counted when the rotor is more than this far (electrical)
+// from the equilibrium of its present count: past pi the torque pulls it to
+// the next equilibrium; the extra quarter turn keeps a rotor rocking on the
+// unstable point from counting slips back and forth.
+constexpr double kSlipThreshold = 1.25 * kPi;
+// Forward voltage of a step/dir driver's MOSFET body diodes while its
+// outputs are disabled (assumed: the drivers' datasheets give ~0.7-1 V).
+constexpr double kDriverBodyDiodeV = 0.7;
+
+HybridStepperModel::Params model_params(const ParamValues& p, const std::string& name) {
+    HybridStepperModel::Params m;
+    const double step = p.quantity("step_angle");
+    const double teeth = kTwoPi / (4 * step);
+    if (step <= 0 || std::fabs(teeth - std::round(teeth)) > 1e-6) {
+        throw BadInput("part '" + name + "': step_angle must be 90 degrees divided by a whole number of rotor teeth "
+                       "(1.8deg: 50 teeth, 0.9deg: 100)");
+    }
+    m.rotor_teeth = static_cast<int>(std::lround(teeth));
+    m.resistance_ohm = p.quantity("resistance");
+    m.inductance_h = p.quantity("inductance");
+    m.torque_constant = p.quantity("torque_constant");
+    m.detent_torque = p.quantity("detent_torque");
+    m.inertia = p.quantity("rotor_inertia") + p.quantity("load_inertia");
+    m.viscous = p.quantity("viscous_damping");
+    m.coulomb = p.quantity("coulomb_friction");
+    m.load_torque = p.quantity("load_torque");
+    m.max_step_s = p.quantity("max_step");
+    m.chopper_tau_s = p.quantity("chopper_tau");
+    if (m.resistance_ohm <= 0 || m.inductance_h <= 0 || m.torque_constant <= 0 || m.inertia <= 0) {
+        throw BadInput("part '" + name + "': resistance, inductance, torque_constant and inertia must be positive");
+    }
+    if (m.max_step_s <= 0 || m.max_step_s > 1e-3 || m.chopper_tau_s <= 0) {
+        throw BadInput("part '" + name + "': max_step must be in (0, 1ms], chopper_tau positive");
+    }
+    return m;
+}
+
+std::vector<HybridStepperModel::Winding> windings_for(bool unipolar) {
+    if (unipolar) return {{0, +1}, {1, +1}, {0, -1}, {1, -1}};  // A, B, C = A-, D = B-
+    return {{0, +1}, {1, +1}};
+}
+
+}  // namespace
+
+std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
+    using PT = ParamType;
+    using D = Dimension;
+    std::vector<ParamSpec> specs = {
+        {"preset", PT::Choice, D::Dimensionless, false, unipolar ? "unipolar-42-generic" : "sm-42byg011-25",
+         {"sm-42byg011-25", "42byghw208", "unipolar-42-generic", "none"}, "", "motor data preset (see presets())"},
+        {"step_angle", PT::Quantity, D::Angle, false, "1.8deg", {}, "", "full step angle (90 deg / rotor teeth)"},
+        {"resistance", PT::Quantity, D::Resistance, false, "", {}, "", "resistance per winding (half-winding: unipolar)"},
+        {"inductance", PT::Quantity, D::Inductance, false, "", {}, "", "inductance per winding"},
+        {"torque_constant", PT::Quantity, D::TorqueConstant, false, "", {}, "",
+         "torque constant = back-EMF constant, per winding"},
+        {"detent_torque", PT::Quantity, D::Torque, false, "", {}, "", "detent torque amplitude (unexcited)"},
+        {"rotor_inertia", PT::Quantity, D::Inertia, false, "", {}, "", "rotor inertia"},
+        {"load_inertia", PT::Quantity, D::Inertia, false, "0kg*m^2", {}, "no load unless given", "inertia on the shaft"},
+        {"viscous_damping", PT::Quantity, D::RotaryDamping, false, "", {}, "", "viscous friction and iron losses"},
+        {"coulomb_friction", PT::Quantity, D::Torque, false, "", {}, "", "bearing (Coulomb) friction"},
+        {"load_torque", PT::Quantity, D::Torque, false, "0N*m", {}, "no load unless given",
+         "constant load torque, acting against forward rotation"},
+        {"max_step", PT::Quantity, D::Time, false, "20us", {},
+         "docs/MOTOR.md: figures unchanged from 2 us to 40 us", "integration step bound (RK4)"},
+        {"sample_period", PT::Quantity, D::Time, false, "100us", {}, "",
+         "how often a moving motor is advanced without pin events (stall checks, traces)"},
+        {"chopper_tau", PT::Quantity, D::Time, false, "20us", {},
+         "assumed: about one PWM period of an A4988/DRV8825 chopper", "current tracking time constant (driver-driven)"},
+        {"release_delay", PT::Quantity, D::Time, false, "1ms", {}, "assumed",
+         "a winding switched off alone counts as released (not chopped) after this long"},
+        {"stall_quiet", PT::Quantity, D::Time, false, "100ms", {}, "assumed",
+         "a stall event ends after this long without another pole slip"},
+    };
+    if (unipolar) {
+        specs.push_back({"switches", PT::Text, D::Dimensionless, true, "", {}, "",
+                         "the low_side_switch part switching the half-windings"});
+        for (const char* c : {"a", "b", "c", "d"}) {
+            specs.push_back({std::string("coil_") + c, PT::Integer, D::Dimensionless, false,
+                             std::to_string(1 + (c[0] - 'a')), {}, "",
+                             std::string("switch channel of half-winding ") + static_cast<char>(c[0] - 32)});
+        }
+        specs.push_back({"supply", PT::Quantity, D::Voltage, false, "12V", {}, "assumed (seed 001 gives none)",
+                         "supply at the centre taps"});
+        specs.push_back({"sense_resistor", PT::Quantity, D::Resistance, false, "0ohm", {},
+                         "seed 001 §3.2: value absent", "R_sense per coil pair (A/C, B/D), 0 = none"});
+        specs.push_back({"sense_ac_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC0",
+                         "ADC channel of the clock MCU that sees the A/C sense voltage (-1: none)"});
+        specs.push_back({"sense_bd_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC1",
+                         "ADC channel that sees the B/D sense voltage (-1: none)"});
+    } else {
+        specs.push_back({"bridge", PT::Text, D::Dimensionless, false, "", {}, "", "the l293d part driving the windings"});
+        specs.push_back({"phase_a", PT::Text, D::Dimensionless, false, "1,2", {}, "",
+                         "bridge outputs of winding A: plus,minus"});
+        specs.push_back({"phase_b", PT::Text, D::Dimensionless, false, "3,4", {}, "",
+                         "bridge outputs of winding B: plus,minus"});
+        specs.push_back({"driver", PT::Text, D::Dimensionless, false, "", {}, "",
+                         "or: the step_dir_driver part driving the windings"});
+    }
+    return specs;
+}
+
+const std::map<std::string, std::map<std::string, std::string>>& HybridStepper::presets() {
+    static const std::map<std::string, std::map<std::string, std::string>> table = {
+        // Mercury Motor SM-42BYG011-25, the motor of seed 003 (§1.7): 1.8 deg,
+        // 12 V, 0.33 A, holding torque 0.23 N*m. R = 34 ohm, L = 46 mH and
+        // Ke = 0.0763 V per electrical Hz from ponoor/step-series-support
+        // configGenerator/motor_list.json; Km = Ke * 50 / (2 pi) = 0.607 N*m/A
+        // (seed 003 digest §6.2). Rotor inertia, detent torque and friction
+        // are not published: assumed, typical for a 34 mm NEMA 17 (digest
+        // §6.2); docs/MOTOR.md shows how the validation depends on them.
+        {"sm-42byg011-25",
+         {{"step_angle", "1.8deg"}, {"resistance", "34ohm"}, {"inductance", "46mH"},
+          {"torque_constant", "0.607N*m/A"}, {"detent_torque", "0.015N*m"}, {"rotor_inertia", "35g*cm^2"},
+          {"viscous_damping", "5e-4N*m*s/rad"}, {"coulomb_friction", "0.002N*m"}}},
+        // 42BYGHW208 (Wantai), the motors of seed 002 (§1): 1.8 deg, holding
+        // torque 2.8 kg*cm = 0.275 N*m, J_M = 1.5e-6 kg*m^2 [seed 002, from the
+        // datasheet]. 12 V / 0.4 A gives R = 30 ohm [rating]; L = 37 mH [the
+        // Wantai data as quoted in public build notes]; Km = 0.275 / (sqrt(2) *
+        // 0.4 A) = 0.49 N*m/A (holding torque with both phases at rated
+        // current). Detent and friction assumed as above.
+        {"42byghw208",
+         {{"step_angle", "1.8deg"}, {"resistance", "30ohm"}, {"inductance", "37mH"},
+          {"torque_constant", "0.49N*m/A"}, {"detent_torque", "0.012N*m"}, {"rotor_inertia", "15g*cm^2"},
+          {"viscous_damping", "5e-4N*m*s/rad"}, {"coulomb_friction", "0.002N*m"}}},
+        // A six-wire NEMA 17 for seed 001's unipolar drive boards, whose motor
+        // the thesis does not name: assumed values per half-winding, low
+        // enough in resistance that the board's current chopper has work.
+        {"unipolar-42-generic",
+         {{"step_angle", "1.8deg"}, {"resistance", "6.8ohm"}, {"inductance", "8mH"},
+          {"torque_constant", "0.2N*m/A"}, {"detent_torque", "0.01N*m"}, {"rotor_inertia", "35g*cm^2"},
+          {"viscous_damping", "5e-4N*m*s/rad"}, {"coulomb_friction", "0.002N*m"}}},
+        {"none", {}},
+    };
+    return table;
+}
+
+HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& params, bool unipolar)
+    : Part(std::move(name), clock),
+      unipolar_(unipolar),
+      model_([&] {
+          for (const char* needed : {"resistance", "inductance", "torque_constant", "detent_torque", "rotor_inertia",
+                                     "viscous_damping", "coulomb_friction"}) {
+              if (!params.has(needed)) {
+                  throw BadInput("part '" + this->name() + "': give " + needed + " (or a preset that has it)");
+              }
+          }
+          return model_params(params, this->name());
+      }(), windings_for(unipolar)) {
+    seconds_per_cycle_ = 1.0 / clock.frequency_hz();
+    auto cycles = [&](const char* param) {
+        const double s = params.quantity(param);
+        if (s <= 0) throw BadInput("part '" + this->name() + "': " + param + " must be positive");
+        return static_cast<Cycle>(std::max(1.0, std::round(s * clock.frequency_hz())));
+    };
+    sample_cycles_ = cycles("sample_period");
+    release_cycles_ = cycles("release_delay");
+    stall_quiet_cycles_ = cycles("stall_quiet");
+    if (unipolar_) {
+        supply_v_ = params.quantity("supply");
+        sense_ohm_ = params.quantity("sense_resistor");
+        sense_adc_[0] = static_cast<int>(params.integer("sense_ac_adc"));
+        sense_adc_[1] = static_cast<int>(params.integer("sense_bd_adc"));
+    }
+
+    sig_angle_ = add_signal("angle_deg", true);
+    sig_command_ = add_signal("commanded_deg", true);
+    sig_error_ = add_signal("following_error_deg", true);
+    sig_speed_ = add_signal("speed_rpm", true);
+    sig_ia_ = add_signal("current_a_A", true);
+    sig_ib_ = add_signal("current_b_A", true);
+    sig_lost_ = add_signal("lost_steps", true);
+    sig_stalled_ = add_signal("stalled", false);
+    if (unipolar_) {
+        sig_sense_[0] = add_signal("sense_ac_V", true);
+        sig_sense_[1] = add_signal("sense_bd_V", true);
+    }
+}
+
+void HybridStepper::listen(DriveSource& source) {
+    source.on_drive_change([this] { on_drive_change(); });
+}
+
+void HybridStepper::attach_bridge(L293D& bridge, int a_plus, int a_minus, int b_plus, int b_minus) {
+    for (int o : {a_plus, a_minus, b_plus, b_minus}) {
+        if (o < 1 || o > 4) throw BadInput("part '" + name() + "': L293D outputs are 1..4");
+    }
+    sources_ = {[&bridge, a_plus, a_minus] { return bridge.winding(a_plus, a_minus); },
+                [&bridge, b_plus, b_minus] { return bridge.winding(b_plus, b_minus); }};
+    listen(bridge);
+}
+
+void HybridStepper::attach_switches(LowSideSwitch& switches, const std::array<int, 4>& channels) {
+    sources_.clear();
+    for (int k = 0; k < 4; ++k) {
+        const int ch = channels[static_cast<std::size_t>(k)];
+        if (ch < 1 || ch > switches.channels()) {
+            throw BadInput("part '" + name() + "': coil channel " + std::to_string(ch) + " is not a channel of '" +
+                           switches.name() + "' (1.." + std::to_string(switches.channels()) + ")");
+        }
+        sources_.push_back([&switches, ch, this] { return switches.winding(ch, supply_v_, sense_ohm_); });
+    }
+    listen(switches);
+    for (int pair = 0; pair < 2; ++pair) {
+        const int channel = sense_adc_[pair];
+        if (channel < 0) continue;
+        Adc& adc = clock().adc();
+        if (!adc.present() || channel >= adc.channel_count()) {
+            throw BadInput("part '" + name() + "': MCU '" + clock().name() + "' has no ADC channel " +
+                           std::to_string(channel));
+        }
+        adc.connect(channel, [this, pair](Cycle) {
+            sync();
+            return sense_voltage(pair);
+        });
+    }
+}
+
+void HybridStepper::attach_driver(StepDirDriver& driver) {
+    driver_ = &driver;
+    driver.on_outputs_change([this] { on_drive_change(); });
+}
+
+void HybridStepper::start() {
+    // A driver with its ENABLE unwired energizes the windings at power-on.
+    on_drive_change();
+}
+
+void HybridStepper::sync() {
+    const Cycle now = clock().cycle();
+    if (now > last_cycle_) {
+        model_.advance(static_cast<double>(now - last_cycle_) * seconds_per_cycle_);
+        last_cycle_ = now;
+    }
+    check_slip();
+}
+
+double HybridStepper::angle_deg() const { return model_.angle() * 180.0 / kPi; }
+
+double HybridStepper::commanded_deg() const {
+    // Before the first excitation the rotor is where it is told to be.
+    if (!have_command_) return angle_deg();
+    return command_e_ / model_.params().rotor_teeth * 180.0 / kPi;
+}
+
+double HybridStepper::speed_rpm() const { return model_.speed() * 60.0 / kTwoPi; }
+
+double HybridStepper::sense_voltage(int pair) const {
+    if (!unipolar_) return 0;
+    double amps = 0;
+    for (std::size_t k = 0; k < model_.winding_count(); ++k) {
+        if (static_cast<int>(k % 2) == pair && model_.drive(k).polarity != 0) amps += model_.current(k);
+    }
+    return amps * sense_ohm_;
+}
+
+void HybridStepper::refresh_drive() {
+    if (driver_ != nullptr) {
+        const double vs = driver_->motor_supply_v();
+        if (driver_->enabled()) {
+            const double e = driver_->electrical_angle();
+            const double amps[2] = {driver_->set_current_a() * std::cos(e), driver_->set_current_a() * std::sin(e)};
+            for (int k = 0; k < 2; ++k) {
+                WindingDrive d;
+                d.current_mode = true;
+                d.target_a = amps[k];
+                d.supply_v = vs;
+                d.polarity = 1;
+                model_.set_drive(static_cast<std::size_t>(k), d);
+            }
+        } else {
+            // Outputs off: the current decays through the body diodes into the supply.
+            WindingDrive d;
+            d.v_pos = -(vs + 2 * kDriverBodyDiodeV);
+            d.v_neg = vs + 2 * kDriverBodyDiodeV;
+            for (std::size_t k = 0; k < 2; ++k) model_.set_drive(k, d);
+        }
+        return;
+    }
+    for (std::size_t k = 0; k < sources_.size(); ++k) model_.set_drive(k, sources_[k]());
+}
+
+void HybridStepper::on_drive_change() {
+    sync();
+    refresh_drive();
+    if (driver_ != nullptr) {
+        if (driver_->enabled()) set_command(driver_->electrical_angle());
+    } else {
+        update_command_from_polarity();
+    }
+    check_slip();
+    publish_all();
+    arm_tick();
+}
+
+// The commanded angle of a coil-driven motor follows the excitation the
+// firmware selects: per phase +1, -1 or 0 (not driven). A phase that goes to
+// 0 while the other phase takes a new value at the same cycle (a step of a
+// wave or full-step sequence) is released at once; one that goes to 0 alone
+// (a current chopper, PWM on the enable pins, or the first half of a
+// pin-by-pin update) keeps its last value until it has stayed off for
+// `release_delay` or the other phase changes.
+void HybridStepper::update_command_from_polarity() {
+    const Cycle now = clock().cycle();
+    int wanted[2] = {0, 0};
+    for (std::size_t k = 0; k < model_.winding_count(); ++k) {
+        const int phase = static_cast<int>(k % 2);
+        const int sign = k < 2 ? 1 : -1;
+        wanted[phase] += sign * model_.drive(k).polarity;
+    }
+    bool new_value = false;
+    for (int p = 0; p < 2; ++p) {
+        const int w = wanted[p] > 0 ? 1 : wanted[p] < 0 ? -1 : 0;
+        if (w != 0) {
+            release_pending_[p] = false;
+            if (w != latched_[p]) {
+                latched_[p] = w;
+                new_value = true;
+            }
+        } else if (latched_[p] != 0 && !release_pending_[p]) {
+            release_pending_[p] = true;
+            release_since_[p] = now;
+            const std::uint64_t generation = ++release_generation_[p];
+            clock().scheduler().at(now + release_cycles_, [this, p, generation](Cycle) {
+                if (generation != release_generation_[p] || !release_pending_[p]) return;
+                sync();
+                // Phases switched off by the same update (or earlier) go together:
+                // releasing one alone would swing the command half a step.
+                const Cycle since = release_since_[p];
+                for (int q = 0; q < 2; ++q) {
+                    if (release_pending_[q] && release_since_[q] <= since) {
+                        release_pending_[q] = false;
+                        latched_[q] = 0;
+                    }
+                }
+                if (latched_[0] != 0 || latched_[1] != 0) {
+                    set_command(std::atan2(latched_[1], latched_[0]));
+                    check_slip();
+                }
+                publish_all();
+            });
+        }
+    }
+    if (new_value) last_on_change_ = now;
+    for (int p = 0; p < 2; ++p) {
+        if (release_pending_[p] && (new_value || release_since_[p] == last_on_change_)) {
+            release_pending_[p] = false;
+            latched_[p] = 0;
+        }
+    }
+    if (latched_[0] != 0 || latched_[1] != 0) set_command(std::atan2(latched_[1], latched_[0]));
+}
+
+void HybridStepper::set_command(double electrical) {
+    const Cycle now = clock().cycle();
+    const double rotor_e = model_.electrical_angle();
+    if (!have_command_) {
+        // The first excitation: the rotor turns to the nearest equilibrium of it.
+        if (driver_ != nullptr) {
+            driver_offset_ = kTwoPi * std::round((rotor_e - electrical) / kTwoPi);
+            command_e_ = electrical + driver_offset_;
+        } else {
+            command_e_ = electrical + kTwoPi * std::round((rotor_e - electrical) / kTwoPi);
+        }
+        have_command_ = true;
+        last_command_change_ = prev_command_change_ = now;
+        return;
+    }
+    double next;
+    if (driver_ != nullptr) {
+        next = electrical + driver_offset_;
+    } else {
+        next = command_e_ + std::remainder(electrical - command_e_, kTwoPi);
+    }
+    if (next == command_e_) return;
+    if (now == last_command_change_) {
+        // Several pins of one update (a 74HC595 latching its outputs one by one).
+        last_command_delta_e_ += next - command_e_;
+    } else {
+        last_command_delta_e_ = next - command_e_;
+        prev_command_change_ = last_command_change_;
+        last_command_change_ = now;
+    }
+    command_e_ = next;
+}
+
+void HybridStepper::check_slip() {
+    if (!have_command_) return;
+    const double error = command_e_ - model_.electrical_angle();
+    const long before = slip_count_;
+    while (error - kTwoPi * static_cast<double>(slip_count_) > kSlipThreshold) ++slip_count_;
+    while (error - kTwoPi * static_cast<double>(slip_count_) < -kSlipThreshold) --slip_count_;
+    if (slip_count_ == before) return;
+    slips_total_ += static_cast<std::uint64_t>(std::labs(slip_count_ - before));
+    const Cycle now = clock().cycle();
+    const bool new_event = !in_stall_ || now - last_slip_ > stall_quiet_cycles_;
+    in_stall_ = true;
+    last_slip_ = now;
+    if (!new_event) return;
+    ++stalls_;
+    StallEvent ev;
+    ev.cycle = now;
+    ev.commanded_deg = commanded_deg();
+    ev.rotor_deg = angle_deg();
+    const Cycle interval = last_command_change_ - prev_command_change_;
+    ev.commanded_rpm = interval == 0 ? 0
+                                     : std::fabs(last_command_delta_e_) / model_.params().rotor_teeth /
+                                           (static_cast<double>(interval) * seconds_per_cycle_) * 60.0 / kTwoPi;
+    ev.lost_steps = lost_steps();
+    char detail[240];
+    std::snprintf(detail, sizeof detail,
+                  "rotor lost synchronism with its excitation (excitation at %.0f rpm): rotor %.1f deg, commanded "
+                  "%.1f deg, %ld full steps lost so far",
+                  ev.commanded_rpm, ev.rotor_deg, ev.commanded_deg, ev.lost_steps);
+    report(FindingKind::MotorStall, detail);
+    for (auto& fn : stall_listeners_) fn(ev);
+}
+
+void HybridStepper::arm_tick() {
+    if (tick_armed_) return;
+    tick_armed_ = true;
+    clock().scheduler().at(clock().cycle() + sample_cycles_, [this](Cycle) { on_tick(); });
+}
+
+void HybridStepper::on_tick() {
+    tick_armed_ = false;
+    sync();
+    if (in_stall_ && clock().cycle() - last_slip_ > stall_quiet_cycles_) in_stall_ = false;
+    publish_all();
+    if (!model_.settled() || in_stall_) arm_tick();
+}
+
+void HybridStepper::publish_all() {
+    publish(sig_angle_, angle_deg());
+    publish(sig_command_, commanded_deg());
+    publish(sig_error_, following_error_deg());
+    publish(sig_speed_, speed_rpm());
+    publish(sig_ia_, model_.phase_current(0));
+    publish(sig_ib_, model_.phase_current(1));
+    publish(sig_lost_, static_cast<double>(lost_steps()));
+    publish(sig_stalled_, in_stall_ ? 1 : 0);
+    if (unipolar_) {
+        publish(sig_sense_[0], sense_voltage(0));
+        publish(sig_sense_[1], sense_voltage(1));
+    }
+}
+
+}  // namespace avrbench

@@ -1,0 +1,131 @@
+// A two-phase hybrid stepper motor as a board part: the physics of
+// HybridStepperModel, driven by
+//   - an L293D bridge (bipolar, coil-driven: the firmware switches the bridge
+//     inputs, directly or through a 74HC595),
+//   - low-side switches (unipolar six-wire motor, centre taps to `supply`,
+//     flyback diodes, one sense resistor per coil pair feeding an ADC channel),
+//   - or a step/dir driver (its microstep current vector, ideal chopper).
+//
+// Outputs: rotor angle, commanded angle (from the excitation), following
+// error, lost steps and stall events (findings), and traces of the phase
+// currents, angle and speed. docs/MOTOR.md describes the model and its
+// validation against seed 003.
+//
+// Time: the model is integrated lazily, from the last update to the cycle of
+// each drive change, and on a periodic tick (`sample_period`) while it moves,
+// so stalls are seen without pin edges. Never the wall clock.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "parts/HybridStepperModel.hpp"
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+#include "parts/WindingDrive.hpp"
+
+namespace avrbench {
+
+class L293D;
+class LowSideSwitch;
+class StepDirDriver;
+
+class HybridStepper final : public Part {
+public:
+    static std::vector<ParamSpec> param_specs(bool unipolar);
+    static const std::map<std::string, std::map<std::string, std::string>>& presets();
+
+    struct StallEvent {
+        Cycle cycle;
+        double commanded_deg, rotor_deg;
+        double commanded_rpm;  // the excitation's speed when synchronism was lost
+        long lost_steps;       // full steps lost so far (after this slip)
+    };
+
+    HybridStepper(std::string name, Mcu& clock, const ParamValues& params, bool unipolar);
+    std::string_view type() const override { return unipolar_ ? "unipolar_stepper" : "hybrid_stepper"; }
+    void start() override;
+
+    // Wiring, one of (the part registry calls it after construction):
+    // a bipolar motor on an L293D, phase A from output a_plus to a_minus, B likewise;
+    void attach_bridge(L293D& bridge, int a_plus, int a_minus, int b_plus, int b_minus);
+    // a unipolar motor on low-side switch channels for half-windings A, B, C (= A-), D (= B-);
+    void attach_switches(LowSideSwitch& switches, const std::array<int, 4>& channels);
+    // a bipolar motor on a step/dir driver.
+    void attach_driver(StepDirDriver& driver);
+
+    // Brings the model up to the clock's present cycle.
+    void sync();
+    // Outputs, as of the last sync (call sync() first for "now").
+    double angle_deg() const;
+    double commanded_deg() const;
+    double following_error_deg() const { return commanded_deg() - angle_deg(); }
+    double speed_rpm() const;
+    double phase_current(int phase) const { return model_.phase_current(phase); }
+    // Full steps the rotor is behind its excitation, counted in whole pole
+    // slips (4 full steps each); negative when ahead.
+    long lost_steps() const { return 4 * slip_count_; }
+    unsigned stalls() const { return stalls_; }
+    std::uint64_t slips() const { return slips_total_; }
+    bool energized() const { return have_command_; }
+    // Voltage across the A/C (0) or B/D (1) sense resistor (unipolar).
+    double sense_voltage(int pair) const;
+    const HybridStepperModel& model() const { return model_; }
+
+    void on_stall(std::function<void(const StallEvent&)> fn) { stall_listeners_.push_back(std::move(fn)); }
+
+private:
+    void listen(DriveSource& source);
+    void on_drive_change();
+    void refresh_drive();
+    void update_command_from_polarity();
+    void set_command(double electrical);
+    void check_slip();
+    void arm_tick();
+    void on_tick();
+    void publish_all();
+
+    bool unipolar_;
+    HybridStepperModel model_;
+    double seconds_per_cycle_;
+    Cycle sample_cycles_, release_cycles_, stall_quiet_cycles_;
+    Cycle last_cycle_ = 0;
+
+    // Drive sources, one per winding; or the step/dir driver.
+    std::vector<std::function<WindingDrive()>> sources_;
+    StepDirDriver* driver_ = nullptr;
+    double driver_offset_ = 0;  // 2*pi*m aligning the driver's angle with the rotor
+
+    // Unipolar sense resistors.
+    double supply_v_ = 0, sense_ohm_ = 0;
+    int sense_adc_[2] = {-1, -1};
+
+    // The commanded (electrical) angle, from the excitation.
+    bool have_command_ = false;
+    double command_e_ = 0;
+    int latched_[2] = {0, 0};
+    bool release_pending_[2] = {false, false};
+    Cycle release_since_[2] = {0, 0};
+    std::uint64_t release_generation_[2] = {0, 0};
+    Cycle last_on_change_ = ~Cycle{0};
+    Cycle last_command_change_ = 0, prev_command_change_ = 0;
+    double last_command_delta_e_ = 0;
+
+    // Synchronism.
+    long slip_count_ = 0;
+    std::uint64_t slips_total_ = 0;
+    unsigned stalls_ = 0;
+    bool in_stall_ = false;
+    Cycle last_slip_ = 0;
+    std::vector<std::function<void(const StallEvent&)>> stall_listeners_;
+
+    bool tick_armed_ = false;
+    std::size_t sig_angle_, sig_command_, sig_error_, sig_speed_, sig_ia_, sig_ib_, sig_lost_, sig_stalled_;
+    std::size_t sig_sense_[2] = {0, 0};
+};
+
+}  // namespace avrbench

@@ -1,0 +1,263 @@
+#include "parts/ThermalPlant.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/Errors.hpp"
+#include "parts/StepDirDriver.hpp"
+
+namespace avrbench {
+
+std::vector<ParamSpec> ThermalPlant::param_specs() {
+    using PT = ParamType;
+    using D = Dimension;
+    return {
+        {"preset", PT::Choice, D::Dimensionless, false, "e3d_v6", {"e3d_v6", "heated_bed", "custom"}, "",
+         "e3d_v6: Marlin's MPC defaults (40 W hot end); heated_bed: 220 mm PCB bed with glass; custom: give every value"},
+        {"ambient", PT::Quantity, D::Temperature, false, "25degC", {}, "assumed: room temperature", "air temperature"},
+        {"initial", PT::Quantity, D::Temperature, false, "", {}, "", "temperature of every node at power-on (default: ambient)"},
+        {"heat_capacity", PT::Quantity, D::HeatCapacity, false, "", {}, "preset", "heat capacity of the block"},
+        {"ambient_conductance", PT::Quantity, D::ThermalConductance, false, "", {}, "preset",
+         "block to ambient, fan off"},
+        {"ambient_conductance_fan", PT::Quantity, D::ThermalConductance, false, "", {}, "preset",
+         "block to ambient with the fan at full speed (default: as fan off)"},
+        {"surface_heat_capacity", PT::Quantity, D::HeatCapacity, false, "0J/K", {}, "",
+         "second mass joined to the block (0: none)"},
+        {"surface_conductance", PT::Quantity, D::ThermalConductance, false, "0W/K", {}, "", "block to surface"},
+        {"surface_ambient_conductance", PT::Quantity, D::ThermalConductance, false, "0W/K", {}, "",
+         "surface to ambient"},
+        {"sensor_time_constant", PT::Quantity, D::Time, false, "", {}, "preset",
+         "thermistor bead lag behind the block (0: reads the block itself)"},
+        {"filament_driver", PT::Text, D::Dimensionless, false, "", {}, "",
+         "the extruder's step_dir_driver: its steps feed cold filament into the block"},
+        {"filament_steps_per_mm", PT::Quantity, D::Dimensionless, false, "500", {},
+         "Marlin Configuration.h DEFAULT_AXIS_STEPS_PER_UNIT E = 500 (at the driver's configured microsteps)",
+         "driver steps per mm of filament"},
+        {"filament_J_per_K_per_mm", PT::Quantity, D::Dimensionless, false, "0.0056", {},
+         "Marlin Configuration.h FILAMENT_HEAT_CAPACITY_PERMM 5.6e-3 J/K/mm (1.75 mm PLA)",
+         "heat to warm 1 mm of filament by 1 K"},
+        {"max_temperature", PT::Quantity, D::Temperature, false, "", {}, "preset",
+         "an overheat finding when the block passes it"},
+        {"sample_interval", PT::Quantity, D::Time, false, "100ms", {}, "assumed",
+         "period of the temperature traces and of the filament-feed update"},
+    };
+}
+
+const std::map<std::string, std::map<std::string, std::string>>& ThermalPlant::presets() {
+    static const std::map<std::string, std::map<std::string, std::string>> table = {
+        // Marlin 2.1 Configuration.h, MPCTEMP section, "Measured physical
+        // constants from M306": MPC_BLOCK_HEAT_CAPACITY 16.7 J/K,
+        // MPC_SENSOR_RESPONSIVENESS 0.22 K/s per K (tau = 1/0.22 s),
+        // MPC_AMBIENT_XFER_COEFF 0.068 W/K, MPC_AMBIENT_XFER_COEFF_FAN255
+        // 0.097 W/K, for a 40 W cartridge hot end (MPC_HEATER_POWER 40).
+        // max_temperature: assumed 285 degC (an all-metal V6-class hot end).
+        {"e3d_v6", {{"heat_capacity", "16.7J/K"}, {"ambient_conductance", "0.068W/K"},
+                    {"ambient_conductance_fan", "0.097W/K"}, {"sensor_time_constant", "4.5454545s"},
+                    {"max_temperature", "285degC"}}},
+        // A 220 x 220 mm PCB bed (FR4, 1.6 mm) under 3 mm borosilicate glass;
+        // every value derived in docs/THERMAL.md from material data
+        // (FR4: 1850 kg/m3, 1100 J/(kg K), assumed; glass: Schott Borofloat 33
+        // datasheet 2230 kg/m3, 830 J/(kg K)) and assumed film coefficients.
+        {"heated_bed", {{"heat_capacity", "158J/K"}, {"ambient_conductance", "0.44W/K"},
+                        {"ambient_conductance_fan", "0.44W/K"}, {"surface_heat_capacity", "269J/K"},
+                        {"surface_conductance", "10W/K"}, {"surface_ambient_conductance", "0.65W/K"},
+                        {"sensor_time_constant", "2s"}, {"max_temperature", "130degC"}}},
+        {"custom", {}},
+    };
+    return table;
+}
+
+ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver* filament_driver)
+    : Part(std::move(name), clock), filament_driver_(filament_driver) {
+    auto need = [&](const char* param) {
+        if (!params.has(param)) {
+            throw BadInput("part '" + this->name() + "': a " + params.text("preset") + " plant needs " + param);
+        }
+        return params.quantity(param);
+    };
+    const double ambient = params.quantity("ambient");
+    const double initial = params.has("initial") ? params.quantity("initial") : ambient;
+    const double capacity = need("heat_capacity");
+    g_ambient_ = need("ambient_conductance");
+    g_ambient_fan_ = params.has("ambient_conductance_fan") ? params.quantity("ambient_conductance_fan") : g_ambient_;
+    const double tau = need("sensor_time_constant");
+    max_degC_ = params.has("max_temperature") ? params.quantity("max_temperature") : 1e9;
+    filament_J_per_K_mm_ = params.quantity("filament_J_per_K_per_mm");
+    filament_steps_per_mm_ = params.quantity("filament_steps_per_mm");
+    if (!(capacity > 0)) throw BadInput("part '" + this->name() + "': heat_capacity must be positive");
+    if (g_ambient_ < 0 || g_ambient_fan_ < 0 || tau < 0 || filament_J_per_K_mm_ < 0 || !(filament_steps_per_mm_ > 0)) {
+        throw BadInput("part '" + this->name() + "': conductances, time constants and filament values must not be negative");
+    }
+    network_.set_ambient(ambient);
+    block_ = network_.add_mass("block", capacity, initial);
+    const double surface_capacity = params.quantity("surface_heat_capacity");
+    if (surface_capacity > 0) {
+        surface_ = network_.add_mass("surface", surface_capacity, initial);
+        network_.set_conductance(block_, surface_, params.quantity("surface_conductance"));
+        network_.set_ambient_conductance(surface_, params.quantity("surface_ambient_conductance"));
+    }
+    sensor_ = tau > 0 ? network_.add_follower("sensor", block_, tau, initial) : block_;
+    apply_conductance();
+    network_.reset_energy();
+
+    const double interval = params.quantity("sample_interval");
+    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
+
+    sig_block_ = add_signal("block_degC", true, initial);
+    sig_sensor_ = add_signal("sensor_degC", true, initial);
+    if (surface_ >= 0) sig_surface_ = add_signal("surface_degC", true, initial);
+    sig_fan_ = add_signal("fan_speed", true, 0);
+
+    if (filament_driver_ != nullptr) {
+        filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
+    }
+}
+
+void ThermalPlant::start() {
+    last_cycle_ = clock().cycle();
+    clock().scheduler().at(last_cycle_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
+}
+
+void ThermalPlant::advance() {
+    const Cycle now = clock().cycle();
+    if (now > last_cycle_) {
+        network_.advance(static_cast<double>(now - last_cycle_) / clock().frequency_hz());
+        last_cycle_ = now;
+    }
+    const double block = network_.temperature(block_);
+    if (!overheated_ && block > max_degC_) {
+        overheated_ = true;
+        char detail[120];
+        std::snprintf(detail, sizeof detail, "block at %.1f degC, above the plant's maximum of %.1f degC", block,
+                      max_degC_);
+        report(FindingKind::Overheat, detail);
+    } else if (overheated_ && block < max_degC_ - 5.0) {
+        overheated_ = false;  // re-armed after cooling 5 K below the limit
+    }
+}
+
+double ThermalPlant::block_degC() {
+    advance();
+    return network_.temperature(block_);
+}
+
+double ThermalPlant::sensor_degC() {
+    advance();
+    if (sensor_ == block_ && detached_) return network_.ambient();
+    return network_.temperature(sensor_);
+}
+
+double ThermalPlant::surface_degC() {
+    advance();
+    return network_.temperature(surface_ >= 0 ? surface_ : block_);
+}
+
+void ThermalPlant::set_ambient_degC(double degC) {
+    advance();
+    network_.set_ambient(degC);
+}
+
+int ThermalPlant::add_heat_source(const std::string& node) {
+    int n = -1;
+    if (node == "block") n = block_;
+    if (node == "surface") n = surface_;
+    if (n < 0) throw BadInput("plant '" + name() + "' has no node '" + node + "' to heat (block" +
+                              (surface_ >= 0 ? ", surface" : "") + ")");
+    sources_.emplace_back(n, 0.0);
+    return static_cast<int>(sources_.size()) - 1;
+}
+
+double ThermalPlant::heater_power_W() const {
+    double p = 0;
+    for (const auto& s : sources_) p += s.second;
+    return p;
+}
+
+void ThermalPlant::set_heat_source_power(int source, double watts) {
+    auto& s = sources_.at(static_cast<std::size_t>(source));
+    if (s.second == watts) return;
+    advance();
+    s.second = watts;
+    double node_power = 0;
+    for (const auto& o : sources_) {
+        if (o.first == s.first) node_power += o.second;
+    }
+    network_.set_power(s.first, node_power);
+}
+
+void ThermalPlant::set_fan_speed(double fraction) {
+    fraction = std::clamp(fraction, 0.0, 1.0);
+    if (fraction == fan_speed_) return;
+    advance();
+    fan_speed_ = fraction;
+    apply_conductance();
+}
+
+void ThermalPlant::set_filament_feed_mm_per_s(double rate) {
+    rate = std::max(rate, 0.0);
+    if (rate == feed_mm_per_s_) return;
+    advance();
+    feed_mm_per_s_ = rate;
+    apply_conductance();
+}
+
+void ThermalPlant::apply_conductance() {
+    // Marlin MPC: ambient transfer linear in fan speed between the fan-off and
+    // full-speed coefficients; the filament carries heat away as
+    // feed (mm/s) x heat capacity per mm (J/(K mm)) x (T_block - T_ambient).
+    const double g = g_ambient_ + fan_speed_ * (g_ambient_fan_ - g_ambient_) + feed_mm_per_s_ * filament_J_per_K_mm_;
+    network_.set_ambient_conductance(block_, g);
+}
+
+void ThermalPlant::set_sensor_detached(bool detached) {
+    if (detached == detached_) return;
+    advance();
+    detached_ = detached;
+    if (sensor_ != block_) network_.set_follower_source(sensor_, detached ? ThermalNetwork::kAmbient : block_);
+}
+
+double ThermalPlant::energy_in_J() {
+    advance();
+    return network_.energy_in_J();
+}
+
+double ThermalPlant::energy_stored_J() {
+    advance();
+    return network_.energy_stored_J();
+}
+
+double ThermalPlant::energy_lost_J() {
+    advance();
+    return network_.energy_lost_J();
+}
+
+void ThermalPlant::reset_energy() {
+    advance();
+    network_.reset_energy();
+}
+
+void ThermalPlant::on_sample(Cycle scheduled) {
+    advance();
+    if (filament_driver_ != nullptr) {
+        // Fresh filament only: a retraction pulls molten filament back, and
+        // pushing it in again does not take it from ambient a second time.
+        const double steps = static_cast<double>(feed_256_) * filament_driver_->configured_microsteps() / 256.0;
+        feed_256_ = 0;
+        filament_position_mm_ += steps / filament_steps_per_mm_;
+        double fresh = 0;
+        if (filament_position_mm_ > filament_high_water_mm_) {
+            fresh = filament_position_mm_ - filament_high_water_mm_;
+            filament_high_water_mm_ = filament_position_mm_;
+        }
+        set_filament_feed_mm_per_s(fresh / (static_cast<double>(sample_cycles_) / clock().frequency_hz()));
+    }
+    publish(sig_block_, network_.temperature(block_));
+    publish(sig_sensor_, sensor_ == block_ && detached_ ? network_.ambient() : network_.temperature(sensor_));
+    if (surface_ >= 0) publish(sig_surface_, network_.temperature(surface_));
+    publish(sig_fan_, fan_speed_);
+    clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });
+}
+
+}  // namespace avrbench

@@ -1,0 +1,442 @@
+#include "stimulus/UartHost.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "core/Errors.hpp"
+#include "core/Mcu.hpp"
+#include "core/Scheduler.hpp"
+
+namespace avrbench {
+
+namespace {
+
+bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::string strip_comments(std::string_view raw) {
+    std::string out;
+    out.reserve(raw.size());
+    bool in_paren = false;
+    for (char c : raw) {
+        if (in_paren) {
+            if (c == ')') in_paren = false;
+            continue;
+        }
+        if (c == ';') break;
+        if (c == '(') {
+            in_paren = true;
+            continue;
+        }
+        out.push_back(c);
+    }
+    std::size_t begin = 0, end = out.size();
+    while (begin < end && is_space(out[begin])) ++begin;
+    while (end > begin && is_space(out[end - 1])) --end;
+    return out.substr(begin, end - begin);
+}
+
+// Printable form of a transcript text for tail(): control bytes as \xNN.
+std::string printable(const std::string& text) {
+    std::string out;
+    for (char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c >= 0x20 && c < 0x7f) {
+            out.push_back(ch);
+        } else {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\x%02x", c);
+            out += buf;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+const char* to_string(FlowControl flow) {
+    switch (flow) {
+        case FlowControl::SendAndWait: return "send_and_wait";
+        case FlowControl::CharacterCounting: return "character_counting";
+    }
+    return "?";
+}
+
+FlowControl parse_flow_control(std::string_view text, std::string_view what) {
+    if (text == "send_and_wait") return FlowControl::SendAndWait;
+    if (text == "character_counting") return FlowControl::CharacterCounting;
+    throw BadInput(std::string(what) + ": flow '" + std::string(text) +
+                   "' is not send_and_wait or character_counting");
+}
+
+const char* to_string(HostEventKind kind) {
+    switch (kind) {
+        case HostEventKind::Error: return "error";
+        case HostEventKind::Alarm: return "alarm";
+        case HostEventKind::Fatal: return "fatal";
+        case HostEventKind::Timeout: return "timeout";
+        case HostEventKind::BannerTimeout: return "banner-timeout";
+        case HostEventKind::LineTooLong: return "line-too-long";
+    }
+    return "?";
+}
+
+std::vector<GcodeLine> parse_gcode(std::string_view text, const std::string& origin, std::size_t first_number) {
+    std::vector<GcodeLine> out;
+    std::size_t number = first_number;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        std::size_t end = text.find('\n', start);
+        const bool last = end == std::string_view::npos;
+        if (last) end = text.size();
+        // A final '\n' ends the last line; it does not start an empty one.
+        if (last && start == text.size() && start != 0) break;
+        std::string stripped = strip_comments(text.substr(start, end - start));
+        if (!stripped.empty()) out.push_back(GcodeLine{std::move(stripped), number, origin});
+        ++number;
+        if (last) break;
+        start = end + 1;
+    }
+    return out;
+}
+
+UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
+    : mcu_(mcu), uart_(mcu.uart(uart_index)), options_(std::move(options)), alive_(std::make_shared<bool>(true)) {
+    if (options_.flow == FlowControl::CharacterCounting && options_.rx_buffer_bytes == 0) {
+        throw BadInput("UART host: rx_buffer_bytes must be at least 1 for character counting");
+    }
+    if (!(options_.line_timeout_s > 0.0)) throw BadInput("UART host: line timeout must be positive");
+
+    std::weak_ptr<bool> alive = alive_;
+    uart_.on_transmit([this, alive](Cycle cycle, std::uint8_t byte) {
+        if (alive.expired()) return;
+        on_byte(cycle, byte);
+    });
+
+    switch (options_.startup) {
+        case Startup::Immediately:
+            ready_ = true;
+            break;
+        case Startup::FixedDelay:
+            mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.startup_delay_s), [this, alive](Cycle) {
+                if (alive.expired()) return;
+                become_ready();
+            });
+            break;
+        case Startup::WaitForBanner:
+            mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.banner_timeout_s), [this, alive](Cycle) {
+                if (alive.expired() || ready_ || failed_) return;
+                HostEvent e;
+                e.kind = HostEventKind::BannerTimeout;
+                e.cycle = mcu_.cycle();
+                e.message = options_.banner_contains.empty()
+                                ? "no banner from the firmware within " + seconds_text(options_.banner_timeout_s)
+                                : "no banner containing '" + options_.banner_contains + "' from the firmware within " +
+                                      seconds_text(options_.banner_timeout_s);
+                fail(std::move(e));
+            });
+            break;
+    }
+}
+
+UartHost::~UartHost() {
+    // The Uart and the Scheduler keep the callbacks; they see the host gone.
+    alive_.reset();
+}
+
+// --- the job -----------------------------------------------------------------
+
+void UartHost::load_file(const std::string& path) {
+    if (options_.raw_bytes) throw std::logic_error("UartHost: raw_bytes mode sends no lines; use send_bytes()");
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw BadInput(path + ": no such file");
+    if (std::filesystem::is_directory(path, ec)) throw BadInput(path + ": cannot read (a directory)");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(path + ": cannot read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    auto parsed = parse_gcode(text.str(), path);
+    lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
+    pump();
+}
+
+void UartHost::add_lines(std::string_view text) {
+    if (options_.raw_bytes) throw std::logic_error("UartHost: raw_bytes mode sends no lines; use send_bytes()");
+    auto parsed = parse_gcode(text, "<lines>", added_raw_lines_ + 1);
+    // Count the raw lines (comments and blanks included) for the numbering.
+    std::size_t raw = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        if (text[i] == '\n' && i + 1 < text.size()) ++raw;
+    }
+    added_raw_lines_ += raw;
+    lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
+    pump();
+}
+
+// --- raw bytes ---------------------------------------------------------------
+
+void UartHost::send_bytes(const std::string& bytes) {
+    transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, bytes, 0});
+    uart_.send(bytes);
+}
+
+std::string UartHost::received_text() const {
+    std::string out;
+    out.reserve(received_.size());
+    for (const auto& b : received_) out.push_back(static_cast<char>(b.value));
+    return out;
+}
+
+// --- state -------------------------------------------------------------------
+
+bool UartHost::done() const {
+    return ready_ && !failed_ && next_ == lines_.size() && outstanding_.empty();
+}
+
+std::string UartHost::failure_message() const {
+    if (!failure_event_) return "";
+    return events_[*failure_event_].message;
+}
+
+// --- receiving -----------------------------------------------------------------
+
+void UartHost::on_byte(Cycle cycle, std::uint8_t byte) {
+    received_.push_back({cycle, byte});
+    if (options_.raw_bytes) {
+        if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) become_ready();
+        return;
+    }
+    // Lines end in "\n", "\r\n" or a lone "\r".
+    if (byte == '\n') {
+        if (last_was_cr_) {
+            last_was_cr_ = false;  // the '\n' of "\r\n": the line already ended at the '\r'
+            return;
+        }
+        on_line(cycle, std::move(partial_line_));
+        partial_line_.clear();
+        return;
+    }
+    last_was_cr_ = byte == '\r';
+    if (byte == '\r') {
+        on_line(cycle, std::move(partial_line_));
+        partial_line_.clear();
+        return;
+    }
+    partial_line_.push_back(static_cast<char>(byte));
+}
+
+void UartHost::on_line(Cycle cycle, std::string text) {
+    // A copy: answering may send lines, which grows the transcript.
+    const TranscriptEntry entry{cycle, Direction::Received, text, 0};
+    transcript_.push_back(entry);
+
+    if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) {
+        if (options_.banner_contains.empty() || text.find(options_.banner_contains) != std::string::npos) {
+            banner_ = text;
+            become_ready();
+        }
+    } else if (starts_with(text, "ok")) {
+        ++oks_;
+        acknowledge();
+    } else if (starts_with(text, "error") || starts_with(text, "Error")) {
+        ++errors_;
+        HostEvent e;
+        e.kind = HostEventKind::Error;
+        e.cycle = cycle;
+        e.response = text;
+        if (!outstanding_.empty()) {
+            const GcodeLine& line = lines_[outstanding_.front().index];
+            e.line = line;
+            e.message = "line " + std::to_string(line.number) + " '" + line.text + "' got '" + text + "'";
+        } else {
+            e.message = "'" + text + "' with no line outstanding";
+        }
+        const bool stop = options_.stop_on_error;
+        if (stop) {
+            fail(e);
+        } else {
+            record(e);
+        }
+        if (options_.error_acknowledges) acknowledge();
+    } else if (starts_with(text, "ALARM")) {
+        ++alarms_;
+        HostEvent e;
+        e.kind = HostEventKind::Alarm;
+        e.cycle = cycle;
+        e.response = text;
+        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
+        e.message = "firmware alarm '" + text + "'" +
+                    (e.line ? " after line " + std::to_string(e.line->number) + " '" + e.line->text + "'" : "");
+        if (options_.stop_on_alarm) {
+            fail(std::move(e));
+        } else {
+            record(std::move(e));
+        }
+    } else if (starts_with(text, "!!")) {
+        ++fatals_;
+        HostEvent e;
+        e.kind = HostEventKind::Fatal;
+        e.cycle = cycle;
+        e.response = text;
+        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
+        e.message = "firmware fatal error '" + text + "'" +
+                    (e.line ? " after line " + std::to_string(e.line->number) + " '" + e.line->text + "'" : "");
+        if (options_.stop_on_fatal) {
+            fail(std::move(e));
+        } else {
+            record(std::move(e));
+        }
+    }
+    // Anything else (echo:, [MSG:...], banners, reports) is transcript only.
+
+    for (auto& fn : line_listeners_) fn(entry);
+}
+
+void UartHost::acknowledge() {
+    if (outstanding_.empty()) {
+        ++unsolicited_acks_;
+        return;
+    }
+    outstanding_bytes_ -= outstanding_.front().bytes;
+    outstanding_.pop_front();
+    ++acknowledged_;
+    if (failed_) return;
+    // Progress: the next unanswered line (if any) gets a fresh timeout.
+    if (!outstanding_.empty()) {
+        arm_line_timeout();
+    } else {
+        ++timeout_generation_;  // nothing outstanding: no timeout pending
+    }
+    pump();
+    check_finished();
+}
+
+// --- sending -------------------------------------------------------------------
+
+void UartHost::become_ready() {
+    if (ready_ || failed_) return;
+    ready_ = true;
+    pump();
+    check_finished();
+}
+
+void UartHost::pump() {
+    if (!ready_ || failed_) return;
+    while (next_ < lines_.size()) {
+        const std::size_t bytes = lines_[next_].text.size() + 1;
+        if (options_.flow == FlowControl::SendAndWait) {
+            if (!outstanding_.empty()) break;
+        } else {
+            if (bytes > options_.rx_buffer_bytes) {
+                const GcodeLine& line = lines_[next_];
+                HostEvent e;
+                e.kind = HostEventKind::LineTooLong;
+                e.cycle = mcu_.cycle();
+                e.line = line;
+                e.message = "line " + std::to_string(line.number) + " '" + line.text + "' is " +
+                            std::to_string(bytes) + " bytes with its newline, more than the " +
+                            std::to_string(options_.rx_buffer_bytes) + "-byte receive buffer";
+                fail(std::move(e));
+                return;
+            }
+            if (outstanding_bytes_ + bytes > options_.rx_buffer_bytes) break;
+        }
+        send_line(next_++);
+    }
+}
+
+void UartHost::send_line(std::size_t index) {
+    const GcodeLine& line = lines_[index];
+    const std::size_t bytes = line.text.size() + 1;
+    const bool was_idle = outstanding_.empty();
+    outstanding_.push_back(Outstanding{index, bytes});
+    outstanding_bytes_ += bytes;
+    if (outstanding_.size() > max_outstanding_lines_) max_outstanding_lines_ = outstanding_.size();
+    if (outstanding_bytes_ > max_outstanding_bytes_) max_outstanding_bytes_ = outstanding_bytes_;
+    transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
+    if (was_idle) arm_line_timeout();
+    uart_.send(line.text + "\n");
+}
+
+// The oldest unanswered line must be answered within line_timeout_s of the
+// later of its sending and the previous answer: a firmware that is busy with
+// earlier lines is not timed out while it keeps answering them.
+void UartHost::arm_line_timeout() {
+    const std::uint64_t generation = ++timeout_generation_;
+    std::weak_ptr<bool> alive = alive_;
+    mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.line_timeout_s), [this, alive, generation](Cycle) {
+        if (alive.expired() || generation != timeout_generation_) return;
+        on_line_timeout();
+    });
+}
+
+void UartHost::on_line_timeout() {
+    if (failed_ || outstanding_.empty()) return;
+    const GcodeLine& line = lines_[outstanding_.front().index];
+    HostEvent e;
+    e.kind = HostEventKind::Timeout;
+    e.cycle = mcu_.cycle();
+    e.line = line;
+    e.message = "line " + std::to_string(line.number) + " '" + line.text + "' got no answer within " +
+                seconds_text(options_.line_timeout_s);
+    fail(std::move(e));
+}
+
+void UartHost::record(HostEvent event) { events_.push_back(std::move(event)); }
+
+void UartHost::fail(HostEvent event) {
+    if (failed_) {
+        record(std::move(event));
+        return;
+    }
+    failed_ = true;
+    ++timeout_generation_;  // no timeout after the stop
+    failure_event_ = events_.size();
+    record(std::move(event));
+    check_finished();
+}
+
+void UartHost::check_finished() {
+    if (stop_mcu_when_finished_ && finished()) mcu_.request_stop();
+}
+
+bool UartHost::run_until_finished(double max_seconds) {
+    const Cycle target = mcu_.cycle() + mcu_.cycles_from_seconds(max_seconds);
+    stop_mcu_when_finished_ = true;
+    while (!finished() && mcu_.cycle() < target) {
+        if (mcu_.run_until(target) == StopReason::Halted) break;
+    }
+    stop_mcu_when_finished_ = false;
+    return finished();
+}
+
+// --- transcript -----------------------------------------------------------------
+
+std::string UartHost::seconds_text(double seconds) const {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g s", seconds);
+    return buf;
+}
+
+std::string UartHost::tail(std::size_t n) const {
+    std::string out;
+    const std::size_t first = transcript_.size() > n ? transcript_.size() - n : 0;
+    for (std::size_t i = first; i < transcript_.size(); ++i) {
+        const auto& e = transcript_[i];
+        char stamp[48];
+        std::snprintf(stamp, sizeof stamp, "%12.6f s %c ",
+                      static_cast<double>(e.cycle) / static_cast<double>(mcu_.frequency_hz()),
+                      e.direction == Direction::Sent ? '>' : '<');
+        out += stamp;
+        out += printable(e.text);
+        out += '\n';
+    }
+    return out;
+}
+
+}  // namespace avrbench

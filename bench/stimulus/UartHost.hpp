@@ -1,0 +1,244 @@
+// A host on one USART of one MCU that streams G-code the way real senders do:
+// Marlin/Teacup "send one line, wait for ok", or grbl's character counting
+// (keep the firmware's receive buffer as full as it can take). It parses the
+// firmware's answers into lines (ok, error[:N], !!, ALARM:N, anything else),
+// keeps a transcript with cycles, and stops with a message naming the line
+// when the firmware does not answer within a simulated-time timeout.
+//
+//   Mcu mcu(ElfImage::load("grbl.elf"));
+//   UartHost host(mcu, 0, {.flow = FlowControl::CharacterCounting});
+//   host.load_file("job.gcode");
+//   host.run_until_finished(10.0);   // simulated seconds
+//   EXPECT_TRUE(host.done()) << host.failure_message() << host.tail(10);
+//
+// All time is the MCU's simulated time (its Scheduler); nothing waits on the
+// wall clock.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Time.hpp"
+#include "core/Uart.hpp"
+
+namespace avrbench {
+
+class Mcu;
+
+enum class FlowControl {
+    // Marlin / Teacup / grbl's simple mode: one line, then wait for its
+    // answer; never more than one unanswered line.
+    SendAndWait,
+    // grbl's stream.py "aggressive" mode: send while the bytes of all
+    // unanswered lines (each with its '\n') plus the next line fit the
+    // firmware's receive buffer; each ok/error answers the oldest line.
+    CharacterCounting,
+};
+
+const char* to_string(FlowControl flow);
+// "send_and_wait" or "character_counting" (the board files' spelling).
+// Throws BadInput naming `what` for anything else.
+FlowControl parse_flow_control(std::string_view text, std::string_view what);
+
+enum class Startup {
+    Immediately,    // send as soon as there are lines (Uart::send still waits for RXEN)
+    WaitForBanner,  // wait for the firmware's first output line (or one containing banner_contains)
+    FixedDelay,     // wait startup_delay_s of simulated time
+};
+
+struct UartHostOptions {
+    FlowControl flow = FlowControl::SendAndWait;
+    // Character counting: the firmware's receive buffer. 128 = grbl 1.1's
+    // RX_BUFFER_SIZE on the ATmega328P (grbl/serial.h).
+    std::size_t rx_buffer_bytes = 128;
+    // No answer for this long (simulated) while a line is unanswered: stop
+    // and record a timeout. Assumed: 2 s, far longer than any short move.
+    double line_timeout_s = 2.0;
+    Startup startup = Startup::Immediately;
+    std::string banner_contains;     // WaitForBanner: empty = the first line, whatever it says
+    double banner_timeout_s = 2.0;   // WaitForBanner: give up (failed) after this long
+    double startup_delay_s = 0.0;    // FixedDelay
+    // Does "error..." answer a line? grbl: yes (error:N replaces ok). Marlin
+    // follows its "Error:" with "Resend:" and its own "ok": set false there.
+    bool error_acknowledges = true;
+    bool stop_on_error = false;  // stop streaming (failed) at the first error
+    bool stop_on_alarm = true;   // grbl ALARM:N stops streaming (failed)
+    bool stop_on_fatal = true;   // Marlin/Teacup "!!" stops streaming (failed)
+    // Binary protocols: no line parsing of the firmware's output; use
+    // send_bytes() and received(). Lines cannot be queued in this mode.
+    bool raw_bytes = false;
+};
+
+// One line of a job after comment stripping, with where it came from.
+struct GcodeLine {
+    std::string text;        // as sent, without the '\n'
+    std::size_t number = 0;  // 1-based line number in `origin`
+    std::string origin;      // the file path, or "<lines>" for add_line(s)
+};
+
+// Strips "; ..." to the end of the line and "( ... )" comments (an unclosed
+// '(' runs to the end of the line), leading and trailing whitespace, and
+// drops the lines left empty. Accepts '\n' and "\r\n" line ends.
+// `first_number` is the number of the first line of `text`.
+std::vector<GcodeLine> parse_gcode(std::string_view text, const std::string& origin, std::size_t first_number = 1);
+
+enum class Direction { Sent, Received };
+
+struct TranscriptEntry {
+    Cycle cycle = 0;        // Sent: when the host handed the line to the port;
+                            // Received: the UDR write of the line's last byte
+    Direction direction = Direction::Sent;
+    std::string text;       // without line end
+    std::size_t source_line = 0;  // Sent lines: their number in the job (0: raw bytes)
+};
+
+enum class HostEventKind {
+    Error,          // "error..." / "Error..." answer
+    Alarm,          // "ALARM..." (grbl)
+    Fatal,          // "!!..." (Marlin, Teacup)
+    Timeout,        // a line got no answer within line_timeout_s
+    BannerTimeout,  // WaitForBanner: no banner within banner_timeout_s
+    LineTooLong,    // character counting: a line longer than the receive buffer can never be sent
+};
+
+const char* to_string(HostEventKind kind);
+
+struct HostEvent {
+    HostEventKind kind = HostEventKind::Error;
+    Cycle cycle = 0;
+    std::string response;            // the firmware's line, empty for timeouts
+    std::optional<GcodeLine> line;   // Error: the line it answered; Timeout/LineTooLong: that line;
+                                     // Alarm/Fatal: the oldest unanswered line, if any
+    std::string message;             // one line for people
+};
+
+class UartHost {
+public:
+    using LineListener = std::function<void(const TranscriptEntry& entry)>;
+
+    // Attaches to USART `uart_index` of `mcu` from its current cycle on (the
+    // startup timers start now). The host must not outlive the MCU; the MCU
+    // may outlive the host.
+    UartHost(Mcu& mcu, int uart_index = 0, UartHostOptions options = {});
+    ~UartHost();
+    UartHost(const UartHost&) = delete;
+    UartHost& operator=(const UartHost&) = delete;
+
+    const UartHostOptions& options() const { return options_; }
+
+    // --- the job ---------------------------------------------------------
+    // Throws BadInput "<path>: no such file" / "<path>: cannot read".
+    void load_file(const std::string& path);
+    // Lines of text ('\n'-separated), numbered on from the previous add_line(s).
+    void add_lines(std::string_view text);
+    void add_line(std::string_view text) { add_lines(text); }
+    const std::vector<GcodeLine>& lines() const { return lines_; }
+
+    // --- raw bytes (binary protocols; grbl's real-time '?', '!', '~') ----
+    // Sent at once (not counted against the receive buffer, as grbl's
+    // real-time commands are not), recorded in the transcript as Sent with
+    // source_line 0.
+    void send_bytes(const std::string& bytes);
+    // Every byte the firmware transmitted since the host attached.
+    const std::vector<UartByte>& received() const { return received_; }
+    std::string received_text() const;
+
+    // --- state -------------------------------------------------------------
+    bool ready() const { return ready_; }         // startup finished, lines may go out
+    std::size_t lines_sent() const { return next_; }
+    std::size_t lines_acknowledged() const { return acknowledged_; }
+    // All lines sent and answered, and not failed.
+    bool done() const;
+    // Streaming stopped for good: timeout, ALARM/!! (per options), an error
+    // with stop_on_error, a banner timeout, a line too long.
+    bool failed() const { return failed_; }
+    bool finished() const { return done() || failed(); }
+    // The event that stopped the host, as one line ("" while not failed).
+    std::string failure_message() const;
+
+    std::size_t outstanding_lines() const { return outstanding_.size(); }
+    std::size_t outstanding_bytes() const { return outstanding_bytes_; }
+    std::size_t max_outstanding_lines() const { return max_outstanding_lines_; }
+    std::size_t max_outstanding_bytes() const { return max_outstanding_bytes_; }
+
+    // --- answers -----------------------------------------------------------
+    std::size_t oks() const { return oks_; }
+    std::size_t errors() const { return errors_; }
+    std::size_t alarms() const { return alarms_; }
+    std::size_t fatals() const { return fatals_; }
+    // ok/error answers that arrived with no line outstanding.
+    std::size_t unsolicited_acks() const { return unsolicited_acks_; }
+    const std::vector<HostEvent>& events() const { return events_; }
+    const std::optional<std::string>& banner() const { return banner_; }
+
+    // --- transcript ----------------------------------------------------------
+    const std::vector<TranscriptEntry>& transcript() const { return transcript_; }
+    // The last `n` entries, one per line: "   0.012345 s > G1 X10" / "< ok".
+    std::string tail(std::size_t n) const;
+    // Called for every line received (after the host has handled it).
+    void on_line_received(LineListener fn) { line_listeners_.push_back(std::move(fn)); }
+
+    // --- running -------------------------------------------------------------
+    // Runs the MCU until finished() or `max_seconds` of simulated time from
+    // now (or the MCU halts). Returns finished(). For several MCUs in
+    // lockstep, run the lockstep and poll finished() instead.
+    bool run_until_finished(double max_seconds);
+
+private:
+    struct Outstanding {
+        std::size_t index;  // into lines_
+        std::size_t bytes;  // text + '\n'
+    };
+
+    void on_byte(Cycle cycle, std::uint8_t byte);
+    void on_line(Cycle cycle, std::string text);
+    void acknowledge();
+    void become_ready();
+    void pump();
+    void send_line(std::size_t index);
+    void arm_line_timeout();
+    void on_line_timeout();
+    void fail(HostEvent event);
+    void record(HostEvent event);
+    void check_finished();
+    std::string seconds_text(double seconds) const;
+
+    Mcu& mcu_;
+    Uart& uart_;
+    UartHostOptions options_;
+    std::shared_ptr<bool> alive_;  // callbacks held by the Uart and the Scheduler check it
+
+    std::vector<GcodeLine> lines_;
+    std::size_t next_ = 0;           // next line to send
+    std::size_t acknowledged_ = 0;
+    std::size_t added_raw_lines_ = 0;  // numbering for add_lines
+    std::deque<Outstanding> outstanding_;
+    std::size_t outstanding_bytes_ = 0;
+    std::size_t max_outstanding_lines_ = 0;
+    std::size_t max_outstanding_bytes_ = 0;
+
+    bool ready_ = false;
+    bool failed_ = false;
+    std::uint64_t timeout_generation_ = 0;
+    bool stop_mcu_when_finished_ = false;
+
+    std::vector<UartByte> received_;
+    std::string partial_line_;
+    bool last_was_cr_ = false;
+
+    std::size_t oks_ = 0, errors_ = 0, alarms_ = 0, fatals_ = 0, unsolicited_acks_ = 0;
+    std::vector<HostEvent> events_;
+    std::optional<std::size_t> failure_event_;
+    std::optional<std::string> banner_;
+    std::vector<TranscriptEntry> transcript_;
+    std::vector<LineListener> line_listeners_;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,162 @@
+#include "verify/Bench.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "parts/Heater.hpp"
+#include "parts/StepDirDriver.hpp"
+#include "parts/ThermalPlant.hpp"
+
+namespace avrbench {
+
+const char* to_string(IdleResult result) {
+    switch (result) {
+        case IdleResult::Idle: return "idle";
+        case IdleResult::TimeLimit: return "time limit";
+        case IdleResult::Halted: return "halted";
+        case IdleResult::HostFailed: return "host failed";
+    }
+    return "?";
+}
+
+Bench::Bench(const std::string& board_file, const std::string& elf) {
+    BoardSpec spec = load_board_file(board_file);
+    const std::string first = spec.mcus.front().name;
+    board_ = std::make_unique<Board>(std::move(spec), std::map<std::string, std::string>{{first, elf}});
+    watch_motion();
+}
+
+Bench::Bench(const std::string& board_file, const std::map<std::string, std::string>& firmware)
+    : Bench(load_board_file(board_file), firmware) {}
+
+Bench::Bench(BoardSpec spec, const std::map<std::string, std::string>& firmware)
+    : board_(std::make_unique<Board>(std::move(spec), firmware)) {
+    watch_motion();
+}
+
+Bench::~Bench() = default;
+
+void Bench::watch_motion() {
+    for (StepDirDriver* driver : board_->parts_of_type<StepDirDriver>()) {
+        driver->on_step([this, driver](int) {
+            last_step_s_ = static_cast<double>(driver->clock().cycle()) / driver->clock().frequency_hz();
+        });
+    }
+}
+
+UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> options) {
+    const auto& serial = board_->spec().serial;
+    if (serial.empty()) throw BadInput(board_->spec().path + ": the board declares no serial port for a host");
+    const SerialDecl* decl = port.empty() ? &serial.front() : board_->spec().find_serial(port);
+    if (decl == nullptr) throw BadInput(board_->spec().path + ": no serial port '" + port + "'");
+    auto& slot = hosts_[decl->name];
+    if (!slot) {
+        UartHostOptions o;
+        if (options) {
+            o = *options;
+        } else {
+            o.flow = parse_flow_control(decl->flow, decl->location);
+            o.rx_buffer_bytes = decl->rx_buffer_bytes;
+        }
+        slot = std::make_unique<UartHost>(board_->mcu(decl->mcu), decl->usart, o);
+    }
+    return *slot;
+}
+
+void Bench::trace_board() {
+    if (traced_) return;
+    traced_ = true;
+    std::set<std::string> traced_pins;
+    auto trace = [&](const Endpoint& e) {
+        if (board_->spec().find_mcu(e.owner) == nullptr || !traced_pins.insert(e.text()).second) return;
+        recorder_.trace_pin(board_->mcu(e.owner), board_->mcu(e.owner).pin(e.pin));
+    };
+    for (const auto& net : board_->spec().nets) {
+        for (const auto& e : net.endpoints) trace(e);
+    }
+    for (const auto& label : board_->spec().labels) trace(label.endpoint);
+    for (const auto& s : board_->spec().serial) {
+        Mcu& m = board_->mcu(s.mcu);
+        recorder_.trace_uart_tx(m, m.uart(s.usart));
+    }
+    for (Part* p : board_->parts()) recorder_.trace_part(*p);
+}
+
+IdleResult Bench::run_until_idle(double max_seconds, double settle_seconds) {
+    const double end = now_seconds() + max_seconds;
+    // Small slices so idleness is noticed promptly; each is one Lockstep run.
+    const double slice = std::min(1e-3, std::max(settle_seconds / 4, 1e-5));
+    for (;;) {
+        bool all_finished = true;
+        for (auto& [name, host] : hosts_) {
+            if (host->failed()) return IdleResult::HostFailed;
+            all_finished = all_finished && host->finished();
+        }
+        const double now = now_seconds();
+        const bool motion_settled = last_step_s_ < 0 ? now >= settle_seconds : now - last_step_s_ >= settle_seconds;
+        if (all_finished && motion_settled) return IdleResult::Idle;
+        if (now >= end) return IdleResult::TimeLimit;
+        if (board_->run_until_seconds(std::min(end, now + slice)) == StopReason::Halted) return IdleResult::Halted;
+    }
+}
+
+std::vector<Finding> Bench::findings() const {
+    std::vector<Finding> out = board_->findings();
+    for (const auto& [name, host] : hosts_) {
+        for (const auto& e : host->events()) {
+            Finding f;
+            f.kind = FindingKind::HostProtocol;
+            f.source = name;
+            f.cycle = e.cycle;
+            f.has_pc = false;
+            f.detail = e.message;
+            out.push_back(f);
+        }
+    }
+    return out;
+}
+
+RunReport Bench::make_report(const std::string& title) const {
+    RunReport r;
+    r.title = title;
+    for (Mcu* m : board_->mcus()) {
+        r.facts.push_back("MCU " + m->name() + ": " + m->mcu_type() + " at " +
+                          std::to_string(m->frequency_hz() / 1000000.0).substr(0, 5) + " MHz, firmware " +
+                          m->elf().path());
+    }
+    r.facts.push_back("board: " + board_->spec().path);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "simulated: %.6f s", now_seconds());
+    r.facts.push_back(buf);
+    r.timeline = &timeline_;
+    Mcu& first = *board_->mcus().front();
+    r.end_cycle = first.cycle();
+    r.end_clock_hz = first.frequency_hz();
+    for (Axis* a : board_->parts_of_type<Axis>()) {
+        if (a->steps() == 0) continue;  // an axis that never moved has nothing to plot
+        const long id = timeline_.find(a->name(), a->rotary() ? "angle_deg" : "position_mm");
+        if (id >= 0) r.axes.push_back({a->name(), static_cast<SignalId>(id), a->rotary()});
+    }
+    for (ThermalPlant* plant : board_->parts_of_type<ThermalPlant>()) {
+        const long temperature = timeline_.find(plant->name(), "block_degC");
+        if (temperature < 0) continue;
+        TemperatureSeries series;
+        series.name = plant->name();
+        series.temperature_degC = static_cast<SignalId>(temperature);
+        for (Heater* heater : board_->parts_of_type<Heater>()) {
+            const long duty = timeline_.find(heater->name(), "duty");
+            if (&heater->plant() == plant && duty >= 0) series.duty = static_cast<SignalId>(duty);
+        }
+        r.temperatures.push_back(series);
+    }
+    for (const auto& [name, host] : hosts_) {
+        const std::uint32_t hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
+        for (const auto& e : host->transcript()) {
+            r.transcript.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
+        }
+    }
+    r.findings = findings();
+    return r;
+}
+
+}  // namespace avrbench

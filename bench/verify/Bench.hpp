@@ -1,0 +1,88 @@
+// The bench as one object: a board with its firmware, UART hosts on its
+// serial ports, a recorder, and the run that waits for a job to finish. The
+// CLI and the scenario runner are thin layers over this; tests use it
+// directly:
+//
+//   Bench bench{"bench/boards/arduino-uno-cnc-shield-v3.yaml", "grbl.elf"};
+//   bench.host().load_file("job.gcode");
+//   bench.run_until_idle(10.0);
+//   EXPECT_EQ(bench.axis("x").steps(), 1600u);
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boards/Board.hpp"
+#include "parts/Axis.hpp"
+#include "stimulus/UartHost.hpp"
+#include "trace/Recorder.hpp"
+#include "trace/RunReport.hpp"
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+
+enum class IdleResult {
+    Idle,        // every host finished its job and no STEP edge for the settle time
+    TimeLimit,   // the simulated-time limit came first
+    Halted,      // every MCU halted (crash findings say why)
+    HostFailed,  // a host stopped: no answer (timeout), ALARM, !!, ...
+};
+
+const char* to_string(IdleResult result);
+
+class Bench {
+public:
+    // The ELF runs on the board's first MCU.
+    Bench(const std::string& board_file, const std::string& elf);
+    // MCU name -> ELF; MCUs not listed use the board file's `firmware:`.
+    Bench(const std::string& board_file, const std::map<std::string, std::string>& firmware);
+    explicit Bench(BoardSpec spec, const std::map<std::string, std::string>& firmware);
+    ~Bench();
+    Bench(const Bench&) = delete;
+    Bench& operator=(const Bench&) = delete;
+
+    Board& board() { return *board_; }
+    Mcu& mcu(const std::string& name = "") { return board_->mcu(name); }
+    Axis& axis(const std::string& name) { return board_->part_as<Axis>(name); }
+
+    // The UART host on serial port `port` of the board file ("" = the first),
+    // created on first use with the port's flow control and buffer size
+    // unless `options` is given then.
+    UartHost& host(const std::string& port = "", std::optional<UartHostOptions> options = std::nullopt);
+    bool has_host() const { return !hosts_.empty(); }
+
+    // Records every MCU pin on a net or named by a label, every serial port's
+    // transmitted bytes, and every part signal (call before running).
+    void trace_board();
+    Timeline& timeline() { return timeline_; }
+    Recorder& recorder() { return recorder_; }
+
+    void run_for(double seconds) { board_->run_for_seconds(seconds); }
+    // Runs until idle (see IdleResult) or `max_seconds` of simulated time from now.
+    IdleResult run_until_idle(double max_seconds, double settle_seconds = 0.05);
+    double now_seconds() const { return board_->now_seconds(); }
+    // Simulated time of the last STEP edge any driver counted, or -1.
+    double last_step_seconds() const { return last_step_s_; }
+
+    // Board findings plus one HostProtocol finding per host error, alarm,
+    // fatal answer or timeout.
+    std::vector<Finding> findings() const;
+
+    // What the HTML report needs about this run (the timeline must be traced).
+    RunReport make_report(const std::string& title) const;
+
+private:
+    void watch_motion();
+
+    std::unique_ptr<Board> board_;
+    Timeline timeline_;
+    Recorder recorder_{timeline_};
+    std::map<std::string, std::unique_ptr<UartHost>> hosts_;
+    double last_step_s_ = -1;
+    bool traced_ = false;
+};
+
+}  // namespace avrbench

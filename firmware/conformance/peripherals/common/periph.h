@@ -1,0 +1,42 @@
+/*
+ * periph.h - the few names that differ between the parts the peripheral
+ * conformance firmware runs on (ATmega328P, ATmega2560, ATmega32), so that
+ * one source builds for all three.
+ *
+ *   INT0_PIN/INT1_PIN  bit in PORTD/PIND of the INT0/INT1 pin
+ *                      (328P, m32: PD2/PD3; 2560: PD0/PD1)
+ *   EXT_SENSE          sense control register (EICRA; MCUCR on the m32)
+ *   EXT_MASK           enable register (EIMSK; GICR on the m32)
+ *   EXT_FLAGS          flag register (EIFR; GIFR on the m32)
+ *
+ * Marker pins are PORTB bits: the bench stamps their edges with the cycle of
+ * the instruction that writes them (sbi/cbi, 2 cycles each).
+ */
+#ifndef PERIPH_H
+#define PERIPH_H
+
+#include <avr/io.h>
+
+#if defined(__AVR_ATmega2560__) || defined(__AVR_ATmega1280__)
+#define INT0_PIN PD0
+#define INT1_PIN PD1
+#else
+#define INT0_PIN PD2
+#define INT1_PIN PD3
+#endif
+
+#if defined(__AVR_ATmega32__) || defined(__AVR_ATmega16__)
+#define EXT_SENSE MCUCR
+#define EXT_MASK GICR
+#define EXT_FLAGS GIFR
+#else
+#define EXT_SENSE EICRA
+#define EXT_MASK EIMSK
+#define EXT_FLAGS EIFR
+#endif
+
+/* I/O addresses for inline assembly (sbi/cbi/out). */
+#define IO_PORTB _SFR_IO_ADDR(PORTB)
+#define IO_PINB _SFR_IO_ADDR(PINB)
+
+#endif

@@ -1,0 +1,123 @@
+// USART0 baud rate, frame format, double-buffered transmitter and its
+// UDRE/TXC/RXC flags and interrupts (firmware/conformance/peripherals/usart_modes).
+#include <vector>
+
+extern "C" {
+#include <avr_uart.h>
+#include <sim_avr.h>
+#include <sim_irq.h>
+}
+
+#include "conformance_periph/PeriphSupport.hpp"
+#include "core/fixes/Fix.hpp"
+
+namespace avrbench {
+namespace {
+
+using test::kJmp;
+using test::Markers;
+using test::Part;
+
+// Phases 1-3: U2X = 1, UBRR = 16: 8 * (16 + 1) = 136 cycles per bit
+// (§20.3.1 Table 20-1); 8N1 = 10 bits per frame (§20.4).
+constexpr Cycle kFrame8N1 = 10 * 8 * (16 + 1);  // 1360
+// Phase 4: U2X = 0, UBRR = 103: 16 * 104 = 1664 cycles per bit; 8E2 =
+// start + 8 data + parity + 2 stop = 12 bits.
+constexpr Cycle kFrame8E2 = 12 * 16 * (103 + 1);  // 19968
+
+class UsartModes : public ::testing::TestWithParam<const Part*> {};
+
+TEST_P(UsartModes, TransmitterAndReceiverAreOffAfterReset) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("usart_modes", part);
+    mcu.run_for(1000);
+    // §20.11.3 (UCSRnB), ATmega32 "UCSRB": initial value 0x00.
+    EXPECT_EQ(mcu.read_ram_u8("ucsrb_at_reset"), 0) << part.name;
+}
+
+TEST_P(UsartModes, PolledBytesLeaveExactlyOneFrameApartAndTxcEndsTheLast) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("usart_modes", part);
+    Markers m(mcu);
+    Uart& uart = mcu.uart(0);
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 0, 100000));
+    const auto& tx = uart.transmitted();
+    ASSERT_GE(tx.size(), 4u);
+    EXPECT_EQ(uart.transmitted_text().substr(0, 4), "ABCD");
+    // §20.6: the second byte waits in the transmit buffer and follows the first
+    // frame's stop bit at once; each later one as soon as UDRE lets it in.
+    for (int i = 1; i < 4; ++i) EXPECT_EQ(tx[i].cycle - tx[i - 1].cycle, kFrame8N1) << part.name << " byte " << i;
+    // TXC rises when the last frame is out; the polling loop (in, sbrs, rjmp)
+    // and the sbi take a handful of cycles more.
+    EXPECT_GE(m.rise(0) - tx[3].cycle, kFrame8N1) << part.name;
+    EXPECT_LE(m.rise(0) - tx[3].cycle, kFrame8N1 + 10) << part.name;
+}
+
+TEST_P(UsartModes, UdreInterruptStreamsOneFramePerByteAndTxcInterruptsOnce) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("usart_modes", part);
+    Markers m(mcu);
+    Uart& uart = mcu.uart(0);
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 1, 100000));
+    const auto& tx = uart.transmitted();
+    ASSERT_GE(tx.size(), 8u);
+    EXPECT_EQ(uart.transmitted_text().substr(4, 4), "EFGH");
+    for (int i = 5; i < 8; ++i) EXPECT_EQ(tx[i].cycle - tx[i - 1].cycle, kFrame8N1) << part.name << " byte " << i;
+    // TXC at the end of H's frame wakes the sleeping core: wake-up (4; 2560: 5)
+    // + response (4; 5) + jmp (3), then the ISR's sbi (§7.7.1).
+    EXPECT_EQ(m.rise(1) - tx[7].cycle, kFrame8N1 + part.response + part.response + kJmp) << part.name;
+    EXPECT_EQ(m.rises(1).size(), 1u) << part.name;
+}
+
+TEST_P(UsartModes, ReceivedFramesSetRxcOneFrameAfterTheirStart) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("usart_modes", part);
+    Markers m(mcu);
+    Uart& uart = mcu.uart(0);
+    auto* u = reinterpret_cast<avr_uart_t*>(find_io_module(mcu.avr(), "uart", '0'));
+    std::vector<Cycle> rxc;
+    std::pair<avr_t*, std::vector<Cycle>*> param{mcu.avr(), &rxc};
+    avr_irq_register_notify(
+        u->rxc.irq + AVR_INT_IRQ_PENDING,
+        [](avr_irq_t*, std::uint32_t value, void* p) {
+            auto* pr = static_cast<std::pair<avr_t*, std::vector<Cycle>*>*>(p);
+            if (value != 0 && (pr->second->empty() || pr->second->back() != pr->first->cycle)) {
+                pr->second->push_back(pr->first->cycle);
+            }
+        },
+        &param);
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 3, 200000));
+    mcu.run_for(100);
+    const Cycle sent = mcu.cycle();
+    uart.send("xyz");
+    mcu.run_for(5 * kFrame8N1);
+    const auto base = static_cast<std::uint16_t>(mcu.elf().symbol_address("rx").value() - 0x800000);
+    EXPECT_EQ(mcu.avr()->data[base], 'x') << part.name;
+    EXPECT_EQ(mcu.avr()->data[base + 1], 'y') << part.name;
+    EXPECT_EQ(mcu.avr()->data[base + 2], 'z') << part.name;
+    ASSERT_GE(rxc.size(), 3u) << part.name;
+    // The host sends back to back: frame k is complete (k + 1) frames after the first start bit.
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(rxc[k] - sent, (k + 1) * kFrame8N1) << part.name << " byte " << k;
+    avr_irq_unregister_notify(u->rxc.irq + AVR_INT_IRQ_PENDING, nullptr, &param);
+}
+
+TEST_P(UsartModes, ParityAndTwoStopBitsAtU2xOffMakeTwelveBitFrames) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("usart_modes", part);
+    Markers m(mcu);
+    Uart& uart = mcu.uart(0);
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 3, 200000));
+    uart.send("xyz");
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 4, 400000));
+    EXPECT_EQ(uart.cycles_per_frame(), kFrame8E2) << part.name;
+    const auto& tx = uart.transmitted();
+    ASSERT_GE(tx.size(), 10u);
+    EXPECT_EQ(uart.transmitted_text().substr(8, 2), "IJ");
+    EXPECT_EQ(tx[9].cycle - tx[8].cycle, kFrame8E2) << part.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Parts, UsartModes,
+                         ::testing::Values(&test::kAtmega328p, &test::kAtmega2560, &test::kAtmega32), test::part_name);
+
+}  // namespace
+}  // namespace avrbench

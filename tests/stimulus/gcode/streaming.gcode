@@ -1,0 +1,45 @@
+; streaming.gcode: 40 short moves, each 50 steps x 50 us = 2.5 ms of work for
+; 4 or 5 bytes (0.34 or 0.43 ms on the wire at 117647 baud), so a character-
+; counting host gets ahead of the firmware and fills its 128-byte buffer.
+E1
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+X50
+X-50
+?

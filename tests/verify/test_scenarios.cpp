@@ -1,0 +1,126 @@
+// The regression workflow end to end through the CLI: a firmware change that
+// shifts timing fails its scenario with a diff naming the channel and the
+// first divergent edge; `avrbench golden update` accepts it; the next check
+// passes. Plus JUnit output and sharding.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/Paths.hpp"
+#include "trace/TimelineText.hpp"
+#include "support/RunCommand.hpp"
+
+namespace avrbench {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kCli = AVRBENCH_CLI;
+
+// A blink scenario in `dir` running `firmware`, with its golden in `dir`.
+fs::path write_blink_scenario(const fs::path& dir, const std::string& name, const std::string& firmware) {
+    const fs::path path = dir / (name + ".yaml");
+    std::ofstream(path) << "name: " << name << "\n"
+                        << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
+                        << "firmware: {uno: " << firmware << "}\n"
+                        << "steps:\n  - delay: 20ms\n"
+                        << "expect:\n  - findings: 0\n"
+                        << "golden: " << name << ".timeline\n";
+    return path;
+}
+
+std::string check(const fs::path& scenario, const fs::path& dir, int* exit_code, const std::string& extra = "") {
+    const auto r = test::run_command(kCli + " check " + scenario.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR +
+                                         " --report-dir " + (dir / "reports").string() + extra, dir);
+    *exit_code = r.exit_code;
+    return r.out + r.err;
+}
+
+TEST(Scenarios, ShiftedTimerFailsNamingTheChannelAndFirstEdgeThenGoldenUpdateAccepts) {
+    const auto dir = test::scratch_dir("scenario-regression");
+    // The golden made from the committed blink firmware (OCR1A = 249)...
+    fs::copy_file(test::source_path("golden/blink_timer1.timeline"), dir / "blink.timeline");
+    // ...checked against the same source built with OCR1A = 250.
+    const fs::path scenario = write_blink_scenario(dir, "blink", "blink_timer1_ocr250");
+    int code = 0;
+    const std::string out = check(scenario, dir, &code, " --junit " + (dir / "junit.xml").string());
+    EXPECT_EQ(code, 1) << out;
+    // OC1A (PB1) toggles at the first compare match, (249 + 1) * 64 = 16000
+    // cycles after Timer1 starts in the golden; with OCR1A = 250 one timer
+    // count (64 cycles) later, give or take the few cycles by which the
+    // rebuilt start-up code moves the timer start. PB1's edge is the earliest
+    // divergence (the ISR's PB5 edge follows it).
+    const ParsedTimeline golden = read_timeline_text((dir / "blink.timeline").string());
+    const long pb1 = golden.timeline.find("uno", "PB1");
+    ASSERT_GE(pb1, 0);
+    const Cycle golden_edge = changes_of(golden.timeline, static_cast<SignalId>(pb1)).at(1).cycle;
+    EXPECT_NE(out.find("first divergence: uno.PB1 at "), std::string::npos) << out;
+    EXPECT_NE(out.find("(cycle " + std::to_string(golden_edge) + ")"), std::string::npos) << out;
+    EXPECT_NE(out.find("expected 1 at cycle " + std::to_string(golden_edge)), std::string::npos) << out;
+    const auto at = out.find("actual   1 at cycle ");
+    ASSERT_NE(at, std::string::npos) << out;
+    const auto actual_edge = static_cast<Cycle>(std::stol(out.substr(at + 20)));
+    EXPECT_GE(actual_edge, golden_edge + 64 - 8);
+    EXPECT_LE(actual_edge, golden_edge + 64 + 8);
+    // The per-channel table lists both toggling pins as differing.
+    EXPECT_NE(out.find("uno.PB5"), std::string::npos) << out;
+    EXPECT_TRUE(fs::exists(dir / "reports" / "blink.html"));
+    const std::string junit = test::slurp(dir / "junit.xml");
+    EXPECT_NE(junit.find("<testsuite name=\"avrbench\" tests=\"1\" failures=\"1\""), std::string::npos) << junit;
+    EXPECT_NE(junit.find("<failure message=\"golden: uno.PB1 diverges"), std::string::npos) << junit;
+
+    // Accept the change explicitly; the check passes afterwards.
+    const auto update = test::run_command(kCli + " golden update " + scenario.string() + " --firmware-dir " +
+                                              AVRBENCH_FIRMWARE_DIR, dir);
+    ASSERT_EQ(update.exit_code, 0) << update.out << update.err;
+    // The new golden toggles every (250 + 1) * 64 = 16064 cycles.
+    EXPECT_NE(test::slurp(dir / "blink.timeline").find("*9 +16064 0 +16064 1"), std::string::npos)
+        << test::slurp(dir / "blink.timeline");
+    const std::string again = check(scenario, dir, &code);
+    EXPECT_EQ(code, 0) << again;
+    EXPECT_NE(again.find("PASS blink"), std::string::npos) << again;
+}
+
+TEST(Scenarios, CheckNeverWritesAGolden) {
+    const auto dir = test::scratch_dir("scenario-no-golden");
+    const fs::path scenario = write_blink_scenario(dir, "fresh", "blink_timer1");
+    int code = 0;
+    const std::string out = check(scenario, dir, &code);
+    EXPECT_EQ(code, 1) << out;
+    EXPECT_NE(out.find("no golden timeline at"), std::string::npos) << out;
+    EXPECT_NE(out.find("avrbench golden update"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(dir / "fresh.timeline"));
+}
+
+TEST(Scenarios, ShardingSplitsTheScenarioList) {
+    const auto dir = test::scratch_dir("scenario-shards");
+    const fs::path a = write_blink_scenario(dir, "first", "blink_timer1");
+    const fs::path b = write_blink_scenario(dir, "second", "blink_timer1");
+    for (const auto& s : {a, b}) {
+        ASSERT_EQ(test::run_command(kCli + " golden update " + s.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir)
+                      .exit_code,
+                  0);
+    }
+    const auto shard1 = test::run_command("GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=1 " + kCli + " check " + a.string() +
+                                              " " + b.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir);
+    EXPECT_EQ(shard1.exit_code, 0) << shard1.out;
+    EXPECT_EQ(shard1.out.find("first"), std::string::npos) << shard1.out;
+    EXPECT_NE(shard1.out.find("PASS second"), std::string::npos) << shard1.out;
+    EXPECT_NE(shard1.out.find("1 passed, 0 failed"), std::string::npos) << shard1.out;
+}
+
+TEST(Scenarios, MalformedScenarioIsOneLineWithExitCode2) {
+    const auto dir = test::scratch_dir("scenario-bad");
+    const fs::path path = dir / "bad.yaml";
+    std::ofstream(path) << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
+                        << "firmware: {uno: blink_timer1}\n"
+                        << "steps:\n  - dance: 3\n";
+    const auto r = test::run_command(kCli + " check " + path.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, "avrbench: error: " + path.string() +
+                         ":4: unknown step 'dance' (known: delay, inject_fault, release_input, send, send_file, set_input, "
+                         "wait_for_text, wait_idle, wait_pin)\n");
+}
+
+}  // namespace
+}  // namespace avrbench
