@@ -47,10 +47,9 @@ void Pin::on_change(Listener fn) {
     }
 }
 
-// simavr raises a port's pin IRQs on every PORT write, changed or not, and a
-// timer's compare output raises the pin twice for one edge (once with
-// AVR_IOPORT_OUTPUT = 0x100 or'ed in, once nested from the port write), so an
-// edge is a change from the level the listeners last heard.
+// simavr raises a port's pin IRQs on every PORT write, changed or not, so an
+// edge is a change from the level the listeners last heard. (The low byte is
+// the level: simavr ors AVR_IOPORT_OUTPUT = 0x100 into some raises.)
 void Pin::notify(avr_irq_t*, std::uint32_t value, void* param) {
     auto* self = static_cast<Pin*>(param);
     const bool level = (value & 0xff) != 0;

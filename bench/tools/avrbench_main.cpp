@@ -95,6 +95,21 @@ std::string with_extension(const std::string& path, const std::string& extension
     return path + extension;
 }
 
+// Writes the VCD and, beside it, a gtkwave save file zoomed to the whole run
+// (which ends at `clock`'s current cycle). Returns the save file's path.
+std::string write_waveforms(const Timeline& timeline, const std::string& vcd_path, const Mcu& clock) {
+    VcdOptions vcd_options;
+    vcd_options.end_cycle = clock.cycle();
+    vcd_options.end_clock_hz = clock.frequency_hz();
+    const VcdResult vcd = write_vcd(timeline, vcd_path, vcd_options);
+    const std::string gtkw_path = with_extension(vcd_path, ".gtkw");
+    GtkwOptions gtkw_options;
+    gtkw_options.fit_end_time = vcd.end_time;
+    gtkw_options.fit_timescale = vcd.timescale;
+    write_gtkw(timeline, gtkw_path, vcd_path, gtkw_options);
+    return gtkw_path;
+}
+
 void print_findings(const std::vector<Finding>& findings) {
     std::printf("  findings   %zu\n", findings.size());
     for (const auto& f : findings) std::printf("    %s\n", f.describe().c_str());
@@ -171,15 +186,7 @@ int run_board_command(const RunArgs& args) {
     std::string gtkw_path;
     const Timeline& timeline = bench.timeline();
     if (!args.vcd.empty()) {
-        VcdOptions vcd_options;
-        vcd_options.end_cycle = board.mcu().cycle();
-        vcd_options.end_clock_hz = board.mcu().frequency_hz();
-        const VcdResult vcd = write_vcd(timeline, args.vcd, vcd_options);
-        gtkw_path = with_extension(args.vcd, ".gtkw");
-        GtkwOptions gtkw_options;
-        gtkw_options.fit_end_time = vcd.end_time;
-        gtkw_options.fit_timescale = vcd.timescale;
-        write_gtkw(timeline, gtkw_path, args.vcd, gtkw_options);
+        gtkw_path = write_waveforms(timeline, args.vcd, board.mcu());
     }
     const auto findings = bench.findings();
     if (!args.report.empty()) {
@@ -313,15 +320,7 @@ int run_command(const RunArgs& args) {
     }
     std::string gtkw_path;
     if (!args.vcd.empty()) {
-        VcdOptions vcd_options;
-        vcd_options.end_cycle = mcu.cycle();
-        vcd_options.end_clock_hz = mcu.frequency_hz();
-        const VcdResult vcd = write_vcd(timeline, args.vcd, vcd_options);
-        gtkw_path = with_extension(args.vcd, ".gtkw");
-        GtkwOptions gtkw_options;
-        gtkw_options.fit_end_time = vcd.end_time;
-        gtkw_options.fit_timescale = vcd.timescale;
-        write_gtkw(timeline, gtkw_path, args.vcd, gtkw_options);
+        gtkw_path = write_waveforms(timeline, args.vcd, mcu);
     }
 
     const double simulated_s = mcu.seconds();

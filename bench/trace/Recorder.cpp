@@ -22,10 +22,9 @@ struct Recorder::PinSink {
     SignalId id;
     bool level;
 
-    // simavr raises pin IRQs on every PORT write, changed or not, and a timer's
-    // compare output raises the pin twice for one edge (once with
-    // AVR_IOPORT_OUTPUT = 0x100 or'ed in, once nested from the port write), so
-    // an edge is a change from the level this sink last recorded.
+    // simavr raises pin IRQs on every PORT write, changed or not, so an edge
+    // is a change from the level this sink last recorded (the low byte is the
+    // level: simavr ors AVR_IOPORT_OUTPUT = 0x100 into some raises).
     static void notify(avr_irq_t*, std::uint32_t value, void* param) {
         auto* sink = static_cast<PinSink*>(param);
         const bool level = (value & 0xff) != 0;
