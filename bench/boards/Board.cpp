@@ -4,6 +4,7 @@
 #include <set>
 
 #include "boards/PartRegistry.hpp"
+#include "core/Units.hpp"
 
 namespace avrbench {
 namespace {
@@ -236,11 +237,12 @@ Pin& Board::pin(const std::string& endpoint_or_label) {
 }
 
 StopReason Board::run_until_seconds(double seconds) {
-    const auto end_ps = static_cast<std::uint64_t>(std::llround(seconds * 1e12));
-    return lockstep_.run_until_ps(end_ps);
+    return run_until_ps(ps_from_seconds(seconds, "run_until_seconds"));
 }
 
-double Board::now_seconds() const { return static_cast<double>(lockstep_.now_ps()) * 1e-12; }
+StopReason Board::run_for_seconds(double seconds) {
+    return run_until_ps(add_ps(now_ps(), ps_from_seconds(seconds, "run_for_seconds")));
+}
 
 std::vector<Finding> Board::findings() const {
     std::vector<Finding> out;

@@ -53,10 +53,15 @@ public:
     Pin& pin(const std::string& endpoint_or_label);
 
     Lockstep& lockstep() { return lockstep_; }
-    // Advances every MCU to `seconds` of simulated time.
+    // Advances every MCU to `end_ps` of simulated time: afterwards now_ps() >=
+    // end_ps exactly, unless the board halted or a callback asked to stop.
+    StopReason run_until_ps(Picoseconds end_ps) { return lockstep_.run_until_ps(end_ps); }
+    // The time of the MCU furthest behind.
+    Picoseconds now_ps() const { return lockstep_.now_ps(); }
+    // Conveniences for a single call (never for a loop's condition).
     StopReason run_until_seconds(double seconds);
-    StopReason run_for_seconds(double seconds) { return run_until_seconds(now_seconds() + seconds); }
-    double now_seconds() const;
+    StopReason run_for_seconds(double seconds);
+    double now_seconds() const { return seconds_from_ps(now_ps()); }
 
     // Every finding of every MCU and part, in the order they happened per source.
     std::vector<Finding> findings() const;

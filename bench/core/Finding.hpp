@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/Time.hpp"
 
@@ -47,5 +48,10 @@ struct Finding {
     // "mcu: stack-overflow at cycle 1234 (77.125 us), PC 0x01a4 recurse+0x6: SP 0x0213 below __bss_end 0x0300"
     std::string describe() const;
 };
+
+// For people: the first `first_n` findings described in full, then one line
+// counting the rest per kind and source ("... and 4990 more:
+// step-high-too-short (x_driver) x4990"), so a flood stays readable.
+std::vector<std::string> summarize_findings(const std::vector<Finding>& findings, std::size_t first_n = 10);
 
 }  // namespace avrbench

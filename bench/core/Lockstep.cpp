@@ -6,7 +6,6 @@ namespace avrbench {
 namespace {
 
 __extension__ using u128 = unsigned __int128;  // exact products of 64-bit cycles and 32-bit clocks
-constexpr std::uint64_t kPsPerSecond = 1'000'000'000'000ULL;
 
 // a.cycle / a.f  <  b.cycle / b.f, exactly.
 bool earlier(const Mcu& a, const Mcu& b) {

@@ -43,6 +43,22 @@ double parse_quantity(std::string_view text, Dimension dimension, std::string_vi
 // Seconds from "2s", "250ms", "100us", "500ns", "1.5min".
 double parse_seconds(std::string_view text, std::string_view what);
 
+// Picoseconds from a time as parse_seconds reads it, rejecting spans longer
+// than kMaxRunSeconds (core/Time.hpp) so that cycle counts never overflow.
+std::uint64_t parse_duration_ps(std::string_view text, std::string_view what);
+
+// Picoseconds from seconds (rounded to the nearest), with the same checks:
+// finite, not negative, at most kMaxRunSeconds. `what` names the value.
+std::uint64_t ps_from_seconds(double seconds, std::string_view what);
+
+// A whole number from user text ("1600", "1.6e3"), checked: it must be
+// integral and within [min_value, max_value]; otherwise BadInput naming `what`.
+// The one way user numbers become integers (never a bare cast: converting an
+// out-of-range double to an integer is undefined behaviour).
+std::int64_t parse_integer(std::string_view text, std::string_view what, std::int64_t min_value, std::int64_t max_value);
+// The same check for a value already parsed as a double.
+std::int64_t checked_integer(double value, std::string_view what, std::int64_t min_value, std::int64_t max_value);
+
 // Hertz from "16MHz", "20 MHz", "32768Hz", or a bare number of Hz.
 std::uint32_t parse_frequency_hz(std::string_view text, std::string_view what);
 

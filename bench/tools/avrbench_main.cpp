@@ -21,7 +21,9 @@
 #include "parts/Axis.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
+#include "core/OutputFile.hpp"
 #include "trace/GtkwWriter.hpp"
+#include "trace/Junit.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/VcdWriter.hpp"
@@ -50,8 +52,8 @@ struct RunArgs {
     std::string duration = "1s";
     bool duration_given = false;
     bool until_sleep = false;
-    std::string uart_in;
-    std::string uart_out;
+    std::vector<std::string> uart_in;   // FILE, or PORT=FILE on a board
+    std::vector<std::string> uart_out;  // FILE, or PORT=FILE on a board
     bool quiet = false;
     std::string gcode;
     std::string host;
@@ -60,6 +62,28 @@ struct RunArgs {
     std::string settle = "50ms";
     std::string report;
 };
+
+// "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
+struct PortFile {
+    std::string port;  // "" = the first
+    std::string path;
+};
+
+std::vector<PortFile> port_files(const std::vector<std::string>& items, const char* option) {
+    std::vector<PortFile> out;
+    for (const auto& item : items) {
+        const auto eq = item.find('=');
+        PortFile pf = eq == std::string::npos ? PortFile{"", item} : PortFile{item.substr(0, eq), item.substr(eq + 1)};
+        if (pf.path.empty()) throw BadInput(std::string(option) + " '" + item + "': no file name");
+        for (const auto& other : out) {
+            if (other.port == pf.port) {
+                throw BadInput(std::string(option) + ": port " + (pf.port.empty() ? "(default)" : pf.port) + " given twice");
+            }
+        }
+        out.push_back(pf);
+    }
+    return out;
+}
 
 std::string read_file(const std::string& path, const char* what) {
     std::ifstream in(path, std::ios::binary);
@@ -88,6 +112,22 @@ private:
     bool enabled_;
 };
 
+// Bytes as one line of text: printable ASCII kept, anything else as \xNN.
+std::string printable(const std::string& text) {
+    std::string out;
+    for (char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u >= 0x20 && u < 0x7f) {
+            out.push_back(c);
+        } else {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\x%02x", u);
+            out += buf;
+        }
+    }
+    return out;
+}
+
 std::string with_extension(const std::string& path, const std::string& extension) {
     const auto slash = path.find_last_of('/');
     const auto dot = path.find_last_of('.');
@@ -106,13 +146,45 @@ std::string write_waveforms(const Timeline& timeline, const std::string& vcd_pat
     GtkwOptions gtkw_options;
     gtkw_options.fit_end_time = vcd.end_time;
     gtkw_options.fit_timescale = vcd.timescale;
-    write_gtkw(timeline, gtkw_path, vcd_path, gtkw_options);
+    // The save file names the dump relative to its own folder, which gtkwave
+    // resolves from wherever it is started.
+    std::error_code ec;
+    const auto gtkw_folder = std::filesystem::absolute(gtkw_path, ec).parent_path();
+    std::string dump = std::filesystem::relative(std::filesystem::absolute(vcd_path, ec), gtkw_folder, ec).generic_string();
+    if (ec || dump.empty()) dump = std::filesystem::absolute(vcd_path, ec).string();
+    write_gtkw(timeline, gtkw_path, dump, gtkw_options);
     return gtkw_path;
 }
 
 void print_findings(const std::vector<Finding>& findings) {
     std::printf("  findings   %zu\n", findings.size());
-    for (const auto& f : findings) std::printf("    %s\n", f.describe().c_str());
+    for (const auto& line : summarize_findings(findings)) std::printf("    %s\n", line.c_str());
+}
+
+// Every output path of a run, checked before the run starts.
+void check_run_outputs(const RunArgs& args, const std::vector<PortFile>& uart_out) {
+    if (!args.vcd.empty()) {
+        check_output_path(args.vcd, "--vcd");
+        check_output_path(with_extension(args.vcd, ".gtkw"), "--vcd (its gtkwave save file)");
+    }
+    if (!args.report.empty()) check_output_path(args.report, "--report");
+    for (const auto& pf : uart_out) check_output_path(pf.path, "--uart-out");
+}
+
+void print_text_tail(const std::string& text, std::size_t max_lines) {
+    std::vector<std::string> lines;
+    std::string line;
+    for (char c : text) {
+        if (c == '\n') {
+            lines.push_back(line);
+            line.clear();
+        } else if (c != '\r') {
+            line.push_back(c);
+        }
+    }
+    if (!line.empty()) lines.push_back(line);
+    const std::size_t from = lines.size() > max_lines ? lines.size() - max_lines : 0;
+    for (std::size_t i = from; i < lines.size(); ++i) std::printf("    %s\n", printable(lines[i]).c_str());
 }
 
 bool is_mcu_finding(const Finding& f) { return f.has_pc; }
@@ -130,29 +202,50 @@ int run_board_command(const RunArgs& args) {
         firmware[item.substr(0, eq)] = item.substr(eq + 1);
     }
     // With a job, --for is the limit for finishing it (default 60 s).
-    const double duration_s = parse_seconds(args.duration_given || args.gcode.empty() ? args.duration : "60s", "--for");
-    const double settle_s = parse_seconds(args.settle, "--settle");
+    const Picoseconds duration_ps = parse_duration_ps(args.duration_given || args.gcode.empty() ? args.duration : "60s", "--for");
+    const double duration_s = seconds_from_ps(duration_ps);
+    const Picoseconds settle_ps = parse_duration_ps(args.settle, "--settle");
+    const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
+    const std::vector<PortFile> uart_out = port_files(args.uart_out, "--uart-out");
+    check_run_outputs(args, uart_out);
+    std::vector<std::pair<std::string, std::string>> uart_in_bytes;  // port -> bytes
+    for (const auto& pf : uart_in) uart_in_bytes.emplace_back(pf.port, read_file(pf.path, "--uart-in"));
+    if (!args.gcode.empty()) {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(args.gcode, ec)) throw BadInput("--gcode: " + args.gcode + ": no such file");
+    }
+
     Bench bench(std::move(spec), firmware);
     Board& board = bench.board();
+    if (board.spec().serial.empty() && (!uart_in.empty() || !uart_out.empty() || !args.gcode.empty())) {
+        throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --uart-in, --uart-out)");
+    }
+    // Resolve every named port now, so a typo fails before the run.
+    for (const auto& pf : uart_in) bench.serial_decl(pf.port);
+    for (const auto& pf : uart_out) bench.serial_decl(pf.port);
+    if (!args.host.empty()) bench.serial_decl(args.host);
 
     UartHost* host = nullptr;
     if (!args.gcode.empty()) {
+        const SerialDecl& decl = bench.serial_decl(args.host);
+        for (const auto& pf : uart_in) {
+            if (bench.serial_decl(pf.port).name == decl.name) {
+                throw BadInput("--uart-in: port " + decl.name + " already streams --gcode; give another port (PORT=FILE)");
+            }
+        }
         std::optional<UartHostOptions> options;
         if (!args.flow.empty() || args.wait_banner) {
-            const SerialDecl* decl = args.host.empty() ? (board.spec().serial.empty() ? nullptr : &board.spec().serial.front())
-                                                       : board.spec().find_serial(args.host);
             UartHostOptions o;
-            if (decl != nullptr) {
-                o.flow = parse_flow_control(decl->flow, decl->location);
-                o.rx_buffer_bytes = decl->rx_buffer_bytes;
-            }
+            o.flow = parse_flow_control(decl.flow, decl.location);
+            o.rx_buffer_bytes = decl.rx_buffer_bytes;
             if (!args.flow.empty()) o.flow = parse_flow_control(args.flow, "--flow");
             if (args.wait_banner) o.startup = Startup::WaitForBanner;
             options = o;
         }
-        host = &bench.host(args.host, options);
+        host = &bench.host(decl.name, options);
         host->load_file(args.gcode);
     }
+    for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
     if (!args.vcd.empty() || !args.report.empty()) {
         if (!args.trace.empty()) {
             for (Mcu* m : board.mcus()) bench.recorder().trace_pins(*m, args.trace);
@@ -164,21 +257,19 @@ int run_board_command(const RunArgs& args) {
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
     IdleResult outcome = IdleResult::TimeLimit;
-    const double chunk_s = std::max(duration_s / 100, 1e-6);
-    if (host != nullptr) {
-        while (bench.now_seconds() < duration_s) {
-            outcome = bench.run_until_idle(std::min(chunk_s, duration_s - bench.now_seconds()), settle_s);
+    const Picoseconds end_ps = duration_ps;
+    const Picoseconds chunk_ps = std::max<Picoseconds>(duration_ps / 100, 1'000'000);
+    // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
+    while (bench.now_ps() < end_ps) {
+        const Picoseconds target = std::min(end_ps, add_ps(bench.now_ps(), chunk_ps));
+        if (host != nullptr) {
+            outcome = bench.run_until_idle_ps(target - bench.now_ps(), settle_ps);
             if (outcome != IdleResult::TimeLimit) break;
-            progress.show(bench.now_seconds() / duration_s, bench.now_seconds());
+        } else if (board.run_until_ps(target) == StopReason::Halted) {
+            outcome = IdleResult::Halted;
+            break;
         }
-    } else {
-        while (bench.now_seconds() < duration_s) {
-            if (board.run_until_seconds(std::min(duration_s, bench.now_seconds() + chunk_s)) == StopReason::Halted) {
-                outcome = IdleResult::Halted;
-                break;
-            }
-            progress.show(bench.now_seconds() / duration_s, bench.now_seconds());
-        }
+        progress.show(static_cast<double>(bench.now_ps()) / static_cast<double>(end_ps), bench.now_seconds());
     }
     progress.finish();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -188,6 +279,7 @@ int run_board_command(const RunArgs& args) {
     if (!args.vcd.empty()) {
         gtkw_path = write_waveforms(timeline, args.vcd, board.mcu());
     }
+    for (const auto& pf : uart_out) write_output_file(pf.path, bench.serial(pf.port).transmitted_text(), "--uart-out");
     const auto findings = bench.findings();
     if (!args.report.empty()) {
         write_html_report(bench.make_report(std::string(board.mcu().elf().path()) + " on " + board.spec().name),
@@ -227,13 +319,15 @@ int run_board_command(const RunArgs& args) {
     print_findings(findings);
     if (host != nullptr) {
         std::printf("  transcript (last lines):\n");
-        std::string tail = host->tail(10);
-        std::size_t at = 0;
-        while (at < tail.size()) {
-            const std::size_t nl = tail.find('\n', at);
-            std::printf("    %s\n", tail.substr(at, nl - at).c_str());
-            at = nl == std::string::npos ? tail.size() : nl + 1;
-        }
+        print_text_tail(host->tail(10), 10);
+    }
+    for (const auto& decl : board.spec().serial) {
+        if (host != nullptr && bench.serial_decl(args.host).name == decl.name) continue;
+        const Uart& u = bench.serial(decl.name);
+        std::printf("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s\n", decl.name.c_str(),
+                    u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
+                    u.transmitted().empty() ? "" : "; last lines:");
+        print_text_tail(u.transmitted_text(), 10);
     }
     if (!args.vcd.empty()) {
         std::printf("  vcd        %s (%zu signals, %zu events), gtkwave save file %s\n", args.vcd.c_str(),
@@ -275,9 +369,20 @@ int run_command(const RunArgs& args) {
     options.name = "mcu";
     options.mcu_type = args.mcu;
     if (!args.freq.empty()) options.frequency_hz = parse_frequency_hz(args.freq, "--freq");
-    const double duration_s = parse_seconds(args.duration, "--for");
+    const Picoseconds duration_ps = parse_duration_ps(args.duration, "--for");
+    // Without a board there is one port: USART0 ("0=FILE" is accepted too).
+    const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
+    const std::vector<PortFile> uart_out = port_files(args.uart_out, "--uart-out");
+    for (const auto* list : {&uart_in, &uart_out}) {
+        for (const auto& pf : *list) {
+            if (!pf.port.empty() && pf.port != "0") {
+                throw BadInput("serial port '" + pf.port + "': without --board only USART0 is connected");
+            }
+        }
+    }
+    check_run_outputs(args, uart_out);
     std::string uart_in_bytes;
-    if (!args.uart_in.empty()) uart_in_bytes = read_file(args.uart_in, "--uart-in");
+    if (!uart_in.empty()) uart_in_bytes = read_file(uart_in.front().path, "--uart-in");
 
     Mcu mcu(elf, options);
     Timeline timeline;
@@ -294,7 +399,7 @@ int run_command(const RunArgs& args) {
     if (uart0 != nullptr && tracing) recorder.trace_uart_tx(mcu, *uart0);
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
-    const Cycle end_cycle = mcu.cycles_from_seconds(duration_s);
+    const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
     bool slept = false;
@@ -312,12 +417,7 @@ int run_command(const RunArgs& args) {
     progress.finish();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
-    if (!args.uart_out.empty()) {
-        std::ofstream out(args.uart_out, std::ios::binary);
-        if (!out) throw BadInput("--uart-out: " + args.uart_out + ": cannot write");
-        const std::string text = uart0->transmitted_text();
-        out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    }
+    if (!uart_out.empty()) write_output_file(uart_out.front().path, uart0->transmitted_text(), "--uart-out");
     std::string gtkw_path;
     if (!args.vcd.empty()) {
         gtkw_path = write_waveforms(timeline, args.vcd, mcu);
@@ -356,6 +456,7 @@ std::string default_firmware_dir() {
 }
 
 struct CheckArgs {
+    bool force = false;
     std::vector<std::string> scenarios;
     std::string junit;
     std::string report_dir;
@@ -377,36 +478,68 @@ std::vector<std::string> shard(const std::vector<std::string>& all) {
     return mine;
 }
 
+JunitCase junit_case(const ScenarioResult& r) {
+    JunitCase c;
+    c.name = r.name;
+    c.time_s = r.wall_s;
+    c.outcome = r.error ? JunitCase::Outcome::Error : r.passed ? JunitCase::Outcome::Passed : JunitCase::Outcome::Failed;
+    c.message = r.failures.empty() ? "" : r.failures.front();
+    c.text = r.text();
+    return c;
+}
+
+// Runs every scenario it is given: one that cannot load or run is an error
+// result (its file:line message in the output and the JUnit file), never the
+// end of the batch. Exit: 2 if any scenario had an error, else 1 if any
+// failed (or, updating goldens, was refused), else 0.
 int check_command(const CheckArgs& args, bool update_golden) {
     const std::string firmware_dir = args.firmware_dir.empty() ? default_firmware_dir() : args.firmware_dir;
-    std::vector<ScenarioSpec> specs;
-    for (const auto& path : update_golden ? args.scenarios : shard(args.scenarios)) specs.push_back(load_scenario(path, firmware_dir));
-    std::vector<ScenarioResult> results;
+    if (!args.junit.empty()) check_output_path(args.junit, "--junit");
+    if (!args.report_dir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(args.report_dir, ec);
+        if (ec || !std::filesystem::is_directory(args.report_dir, ec)) {
+            throw BadInput("--report-dir: " + args.report_dir + ": cannot create the folder");
+        }
+    }
     ScenarioRunOptions options;
     options.report_dir = args.report_dir;
     options.update_golden = update_golden;
-    for (const auto& spec : specs) {
-        results.push_back(run_scenario(spec, options));
-        const auto& r = results.back();
-        if (update_golden) {
-            std::printf("%s: golden timeline written to %s (%.3f s simulated)\n", spec.name.c_str(),
-                        spec.golden_path.empty() ? "(none: the scenario names no golden)" : spec.golden_path.c_str(),
-                        r.simulated_s);
-            for (const auto& f : r.failures) std::printf("  note: %s\n", f.c_str());
-        } else {
-            std::fputs(r.text().c_str(), stdout);
+    options.force = args.force;
+    std::vector<ScenarioResult> results;
+    for (const auto& path : update_golden ? args.scenarios : shard(args.scenarios)) {
+        try {
+            const ScenarioSpec spec = load_scenario(path, firmware_dir);
+            results.push_back(run_scenario(spec, options));
+            if (update_golden && results.back().passed && !spec.golden_path.empty()) {
+                std::printf("%s: golden timeline written to %s (%.3f s simulated)\n", spec.name.c_str(),
+                            spec.golden_path.c_str(), results.back().simulated_s);
+                continue;
+            }
+            if (update_golden && results.back().passed) {
+                std::printf("%s: no golden timeline (the scenario names none)\n", spec.name.c_str());
+                continue;
+            }
+        } catch (const BadInput& e) {
+            results.push_back(error_result(path, e.what()));
+            std::fflush(stdout);
+            std::fprintf(stderr, "avrbench: error: %s\n", e.what());
         }
+        std::fputs(results.back().text().c_str(), stdout);
     }
     if (!args.junit.empty()) {
-        std::ofstream out(args.junit, std::ios::binary);
-        if (!out) throw BadInput("--junit: " + args.junit + ": cannot write");
-        out << junit_xml(results, "avrbench");
+        std::vector<JunitCase> cases;
+        for (const auto& r : results) cases.push_back(junit_case(r));
+        write_output_file(args.junit, junit_xml(cases, "avrbench"), "--junit");
     }
-    if (update_golden) return kExitOk;
-    std::size_t failed = 0;
-    for (const auto& r : results) failed += r.passed ? 0 : 1;
-    std::printf("%zu passed, %zu failed\n", results.size() - failed, failed);
-    return failed == 0 ? kExitOk : kExitFinding;
+    std::size_t failed = 0, errors = 0;
+    for (const auto& r : results) {
+        errors += r.error ? 1 : 0;
+        failed += !r.error && !r.passed ? 1 : 0;
+    }
+    if (errors > 0) std::printf("%zu scenario(s) could not be loaded or run (ERROR above)\n", errors);
+    std::printf("%zu passed, %zu failed\n", results.size() - failed - errors, failed + errors);
+    return errors > 0 ? kExitBadInput : failed > 0 ? kExitFinding : kExitOk;
 }
 
 }  // namespace
@@ -437,8 +570,10 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--settle", run.settle, "motion has stopped after no STEP edge for this long (default 50ms)");
     run_cmd->add_option("--report", run.report, "write an HTML report of the run (with --board)");
     run_cmd->add_flag("--until-sleep", run.until_sleep, "stop when the firmware first executes SLEEP (bounded by --for)");
-    run_cmd->add_option("--uart-in", run.uart_in, "bytes to send to USART0");
-    run_cmd->add_option("--uart-out", run.uart_out, "write what the firmware sent on USART0 to this file");
+    run_cmd->add_option("--uart-in", run.uart_in,
+                        "FILE or PORT=FILE: raw bytes to send to a serial port (the board's first, or USART0; repeatable)");
+    run_cmd->add_option("--uart-out", run.uart_out,
+                        "FILE or PORT=FILE: write what the firmware sent on a serial port (repeatable)");
     run_cmd->add_flag("-q,--quiet", run.quiet, "no progress bar");
 
     CheckArgs check;
@@ -453,6 +588,7 @@ int main(int argc, char** argv) {
     CLI::App* update_cmd = golden_cmd->add_subcommand("update", "rerun scenarios and rewrite their golden timelines (never done implicitly)");
     update_cmd->add_option("scenarios", golden.scenarios, "scenario files")->required();
     update_cmd->add_option("--firmware-dir", golden.firmware_dir, "where bare firmware names resolve");
+    update_cmd->add_flag("--force", golden.force, "write the golden even when the run fails its steps or expectations");
 
     try {
         app.parse(argc, argv);
@@ -466,16 +602,24 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "avrbench: usage error: %s (see avrbench --help)\n", e.what());
         return kExitBadInput;
     }
+    int code = 0;
     try {
-        if (run_cmd->parsed()) return run_command(run);
-        if (check_cmd->parsed()) return check_command(check, false);
-        if (update_cmd->parsed()) return check_command(golden, true);
+        if (run_cmd->parsed()) code = run_command(run);
+        if (check_cmd->parsed()) code = check_command(check, false);
+        if (update_cmd->parsed()) code = check_command(golden, true);
     } catch (const BadInput& e) {
+        std::fflush(stdout);
         std::fprintf(stderr, "avrbench: error: %s\n", e.what());
-        return kExitBadInput;
+        code = kExitBadInput;
     } catch (const std::exception& e) {
+        std::fflush(stdout);
         std::fprintf(stderr, "avrbench: internal error: %s\n", e.what());
-        return kExitInternal;
+        code = kExitInternal;
     }
-    return 0;
+    // A summary that could not be written is a failed run (a full disk, a closed pipe).
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+        std::fprintf(stderr, "avrbench: error: cannot write to standard output\n");
+        return kExitBadInput;
+    }
+    return code;
 }

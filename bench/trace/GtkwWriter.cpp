@@ -1,5 +1,7 @@
 #include "trace/GtkwWriter.hpp"
 
+#include "core/OutputFile.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -83,14 +85,7 @@ void write_gtkw(const Timeline& timeline, const std::string& gtkw_path, const st
                 const GtkwOptions& options) {
     const std::string text =
         format_gtkw(timeline, dump_path, std::filesystem::path(gtkw_path).filename().string(), options);
-    std::FILE* file = std::fopen(gtkw_path.c_str(), "wb");
-    if (file == nullptr)
-        throw std::runtime_error("cannot write gtkwave save file '" + gtkw_path + "': " + std::strerror(errno));
-    const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-    const int saved_errno = errno;
-    if (std::fclose(file) != 0 || !written)
-        throw std::runtime_error("cannot write gtkwave save file '" + gtkw_path +
-                                 "': " + std::strerror(written ? errno : saved_errno));
+    write_output_file(gtkw_path, text, "gtkwave save file");
 }
 
 }  // namespace avrbench

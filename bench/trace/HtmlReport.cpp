@@ -1,5 +1,7 @@
 #include "trace/HtmlReport.hpp"
 
+#include "core/OutputFile.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -1336,11 +1338,7 @@ std::string format_html_report(const RunReport& report) {
 
 void write_html_report(const RunReport& report, const std::string& path) {
     const std::string html = format_html_report(report);
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write HTML report " + path);
-    out.write(html.data(), static_cast<std::streamsize>(html.size()));
-    out.close();
-    if (!out) throw std::runtime_error("cannot write HTML report " + path);
+    write_output_file(path, html, "HTML report");
 }
 
 }  // namespace avrbench

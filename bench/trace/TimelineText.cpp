@@ -1,5 +1,7 @@
 #include "trace/TimelineText.hpp"
 
+#include "core/OutputFile.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
@@ -118,10 +120,7 @@ std::string format_timeline_text(const Timeline& timeline, const TimelineHeader&
 }
 
 void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw BadInput(path + ": cannot write");
-    out << format_timeline_text(timeline, header);
-    if (!out) throw BadInput(path + ": write failed");
+    write_output_file(path, format_timeline_text(timeline, header), "golden timeline");
 }
 
 ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source) {

@@ -1,5 +1,8 @@
 #include "trace/VcdWriter.hpp"
 
+#include "core/Errors.hpp"
+#include "core/OutputFile.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
@@ -56,7 +59,7 @@ public:
     void flush() {
         if (file_ == nullptr || buffer_.empty()) return;
         if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-            throw std::runtime_error("cannot write VCD file '" + path_ + "': " + std::strerror(errno));
+            throw BadInput("VCD: " + path_ + ": write failed: " + std::strerror(errno));
         buffer_.clear();
     }
 
@@ -353,25 +356,14 @@ std::string format_vcd(const Timeline& timeline, const VcdOptions& options, VcdR
 }
 
 VcdResult write_vcd(const Timeline& timeline, const std::string& path, const VcdOptions& options) {
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    if (file == nullptr) throw std::runtime_error("cannot write VCD file '" + path + "': " + std::strerror(errno));
+    // Written beside the target and renamed into place when complete: a
+    // failed write leaves whatever was at `path` untouched (core/OutputFile).
+    OutputFile file(path, "VCD");
     std::string buffer;
     buffer.reserve(kFlushBytes + 4096);
-    Output out(buffer, file, path);
-    VcdResult result;
-    try {
-        result = VcdEmitter(timeline, options, out).run();
-    } catch (...) {
-        // A truncated dump would look like a run that stopped early: leave none.
-        std::fclose(file);
-        std::remove(path.c_str());
-        throw;
-    }
-    if (std::fclose(file) != 0) {
-        const int error = errno;
-        std::remove(path.c_str());
-        throw std::runtime_error("cannot write VCD file '" + path + "': " + std::strerror(error));
-    }
+    Output out(buffer, file.stream(), path);
+    const VcdResult result = VcdEmitter(timeline, options, out).run();
+    file.commit();
     return result;
 }
 

@@ -1,8 +1,10 @@
 #include "verify/Bench.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
+#include "core/Units.hpp"
 #include "parts/Heater.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
@@ -37,18 +39,32 @@ Bench::Bench(BoardSpec spec, const std::map<std::string, std::string>& firmware)
 Bench::~Bench() = default;
 
 void Bench::watch_motion() {
+    // Every declared serial port records what the firmware sends from power-on.
+    for (const auto& decl : board_->spec().serial) board_->mcu(decl.mcu).uart(decl.usart);
     for (StepDirDriver* driver : board_->parts_of_type<StepDirDriver>()) {
-        driver->on_step([this, driver](int) {
-            last_step_s_ = static_cast<double>(driver->clock().cycle()) / driver->clock().frequency_hz();
-        });
+        driver->on_step([this, driver](int) { last_step_ps_ = ps_at_cycle(driver->clock(), driver->clock().cycle()); });
     }
 }
 
-UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> options) {
+const SerialDecl& Bench::serial_decl(const std::string& port) const {
     const auto& serial = board_->spec().serial;
-    if (serial.empty()) throw BadInput(board_->spec().path + ": the board declares no serial port for a host");
+    if (serial.empty()) throw BadInput(board_->spec().path + ": the board declares no serial port");
     const SerialDecl* decl = port.empty() ? &serial.front() : board_->spec().find_serial(port);
-    if (decl == nullptr) throw BadInput(board_->spec().path + ": no serial port '" + port + "'");
+    if (decl == nullptr) {
+        std::string list;
+        for (const auto& s : serial) list += (list.empty() ? "" : ", ") + s.name;
+        throw BadInput(board_->spec().path + ": no serial port '" + port + "' (ports: " + list + ")");
+    }
+    return *decl;
+}
+
+Uart& Bench::serial(const std::string& port) {
+    const SerialDecl& decl = serial_decl(port);
+    return board_->mcu(decl.mcu).uart(decl.usart);
+}
+
+UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> options) {
+    const SerialDecl* decl = &serial_decl(port);
     auto& slot = hosts_[decl->name];
     if (!slot) {
         UartHostOptions o;
@@ -83,20 +99,25 @@ void Bench::trace_board() {
 }
 
 IdleResult Bench::run_until_idle(double max_seconds, double settle_seconds) {
-    const double end = now_seconds() + max_seconds;
+    return run_until_idle_ps(ps_from_seconds(max_seconds, "run_until_idle"), ps_from_seconds(settle_seconds, "settle time"));
+}
+
+IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
+    const Picoseconds end = add_ps(now_ps(), max_ps);
     // Small slices so idleness is noticed promptly; each is one Lockstep run.
-    const double slice = std::min(1e-3, std::max(settle_seconds / 4, 1e-5));
+    const Picoseconds slice = std::clamp<Picoseconds>(settle_ps / 4, 10'000'000, kPsPerMs);
     for (;;) {
         bool all_finished = true;
         for (auto& [name, host] : hosts_) {
             if (host->failed()) return IdleResult::HostFailed;
             all_finished = all_finished && host->finished();
         }
-        const double now = now_seconds();
-        const bool motion_settled = last_step_s_ < 0 ? now >= settle_seconds : now - last_step_s_ >= settle_seconds;
+        const Picoseconds now = now_ps();
+        const bool motion_settled = last_step_ps_ ? now - std::min(now, *last_step_ps_) >= settle_ps : now >= settle_ps;
         if (all_finished && motion_settled) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
-        if (board_->run_until_seconds(std::min(end, now + slice)) == StopReason::Halted) return IdleResult::Halted;
+        // now < target, and afterwards now_ps() >= target (core/Time.hpp): progress.
+        if (board_->run_until_ps(std::min(end, add_ps(now, slice))) == StopReason::Halted) return IdleResult::Halted;
     }
 }
 
@@ -108,6 +129,7 @@ std::vector<Finding> Bench::findings() const {
             f.kind = FindingKind::HostProtocol;
             f.source = name;
             f.cycle = e.cycle;
+            f.clock_hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
             f.has_pc = false;
             f.detail = e.message;
             out.push_back(f);
@@ -149,11 +171,30 @@ RunReport Bench::make_report(const std::string& title) const {
         }
         r.temperatures.push_back(series);
     }
-    for (const auto& [name, host] : hosts_) {
-        const std::uint32_t hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
-        for (const auto& e : host->transcript()) {
-            r.transcript.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
+    for (const auto& decl : board_->spec().serial) {
+        Mcu& m = board_->mcu(decl.mcu);
+        const std::uint32_t hz = m.frequency_hz();
+        auto host = hosts_.find(decl.name);
+        if (host != hosts_.end()) {
+            for (const auto& e : host->second->transcript()) {
+                r.transcript.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
+            }
+            continue;
         }
+        // No host on this port: the firmware's output, one entry per line,
+        // stamped with the cycle of the line's first byte.
+        std::string line;
+        Cycle line_start = 0;
+        for (const auto& b : m.uart(decl.usart).transmitted()) {
+            if (line.empty()) line_start = b.cycle;
+            if (b.value == '\n') {
+                r.transcript.push_back({line_start, hz, false, line});
+                line.clear();
+            } else if (b.value != '\r') {
+                line.push_back(static_cast<char>(b.value));
+            }
+        }
+        if (!line.empty()) r.transcript.push_back({line_start, hz, false, line});
     }
     r.findings = findings();
     return r;

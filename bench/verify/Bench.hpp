@@ -24,6 +24,8 @@
 
 namespace avrbench {
 
+constexpr Picoseconds kPsPerMs = 1'000'000'000ULL;
+
 enum class IdleResult {
     Idle,        // every host finished its job and no STEP edge for the settle time
     TimeLimit,   // the simulated-time limit came first
@@ -53,6 +55,10 @@ public:
     // unless `options` is given then.
     UartHost& host(const std::string& port = "", std::optional<UartHostOptions> options = std::nullopt);
     bool has_host() const { return !hosts_.empty(); }
+    // The USART behind serial port `port` of the board file ("" = the first):
+    // raw bytes to the firmware (send) and everything it transmitted.
+    Uart& serial(const std::string& port = "");
+    const SerialDecl& serial_decl(const std::string& port = "") const;
 
     // Records every MCU pin on a net or named by a label, every serial port's
     // transmitted bytes, and every part signal (call before running).
@@ -61,11 +67,14 @@ public:
     Recorder& recorder() { return recorder_; }
 
     void run_for(double seconds) { board_->run_for_seconds(seconds); }
-    // Runs until idle (see IdleResult) or `max_seconds` of simulated time from now.
+    // Runs until idle (see IdleResult) or until `max_ps` of simulated time
+    // from now has passed. Every pass of its loop advances simulated time.
+    IdleResult run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps = 50 * kPsPerMs);
     IdleResult run_until_idle(double max_seconds, double settle_seconds = 0.05);
+    Picoseconds now_ps() const { return board_->now_ps(); }
     double now_seconds() const { return board_->now_seconds(); }
     // Simulated time of the last STEP edge any driver counted, or -1.
-    double last_step_seconds() const { return last_step_s_; }
+    double last_step_seconds() const { return last_step_ps_ ? seconds_from_ps(*last_step_ps_) : -1.0; }
 
     // Board findings plus one HostProtocol finding per host error, alarm,
     // fatal answer or timeout.
@@ -81,7 +90,7 @@ private:
     Timeline timeline_;
     Recorder recorder_{timeline_};
     std::map<std::string, std::unique_ptr<UartHost>> hosts_;
-    double last_step_s_ = -1;
+    std::optional<Picoseconds> last_step_ps_;
     bool traced_ = false;
 };
 

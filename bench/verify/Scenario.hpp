@@ -1,53 +1,69 @@
 // Scenario files: a board, its firmware, stimulus steps, expectations, and a
 // golden timeline with tolerances, as a person would describe a bench test.
+// Every key is listed with an example in docs/SCENARIOS.md.
 //
 //   name: stepdir_x_move
 //   board: ../../bench/boards/arduino-uno-cnc-shield-v3.yaml  # relative to this file
-//   firmware: {uno: stepdir_test}       # a name: <build>/firmware/<name>.elf; or a path
+//   firmware: {uno: stepdir_test}       # a name: <firmware dir>/<name>.elf; or a path
 //   time_limit: 2s                      # for the whole scenario (simulated)
 //   steps:
-//     - wait_for_text: ready            # a line from the firmware containing it
-//     - send: X1600                     # one line through the serial host
-//     - send_file: jobs/square.gcode    # a job, streamed with the port's flow control
-//     - wait_idle: 50ms                 # hosts finished, no STEP edge for 50 ms
-//     - wait_pin: {pin: uno.PB0, level: 0}
-//     - delay: 10ms
-//     - set_input: {pin: uno.PC5, level: 0}   # drive an MCU pin (a label works too)
-//     - release_input: uno.PC5
+//     - wait_for_text: ready
+//     - send: X1600
+//     - wait_idle: 50ms
 //   expect:
 //     - steps: {axis: x, count: 1600}
-//     - position: {axis: x, mm: 106.4, within: 0.001}
-//     - pin: {pin: uno.PB0, level: 0}
-//     - text: "X:1600"                  # somewhere in what the firmware sent
-//     - findings: 0                     # or a list of kinds: [step-high-too-short]
 //   golden: ../../golden/stepdir_x_move.timeline
-//   golden_signals: ["uno.*", "hotend.temperature_degC"]  # default: every wire and bus
-//   tolerances:                         # first match wins; unmatched signals are exact
-//     - {signals: "uno.PD*", rule: steps, cycles: 4}
-//     - {signals: "*.position_mm", rule: band, band: 0.001}
 //
-// Errors in the file are BadInput "file:line: ...".
+// load_scenario() checks the whole file before anything runs: YAML types,
+// units, files, and every axis, part, pin, label and serial port it names
+// against the board file. Errors are BadInput "file:line: ...".
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
+#include "core/Time.hpp"
 #include "verify/TimelineCompare.hpp"
 
 namespace avrbench {
 
+// --- steps: what a person does at the bench, in order ----------------------
+struct SendStep { std::string line; };                 // one line through the serial host
+struct SendFileStep { std::string path; };             // a job, with the port's flow control
+struct DelayStep { Picoseconds duration_ps = 0; };
+struct WaitIdleStep { Picoseconds settle_ps = 0; };    // hosts finished, no STEP edge for settle
+struct WaitForTextStep { std::string text; };          // a firmware line containing it
+struct WaitPinStep { std::string pin; bool level = false; };
+struct SetInputStep { std::string pin; bool level = false; };
+struct ReleaseInputStep { std::string pin; };
+struct InjectFaultStep { std::string part; std::string fault; };
+
+using StepAction = std::variant<SendStep, SendFileStep, DelayStep, WaitIdleStep, WaitForTextStep, WaitPinStep,
+                                SetInputStep, ReleaseInputStep, InjectFaultStep>;
+
 struct ScenarioStep {
-    std::string kind;  // wait_for_text, send, send_file, wait_idle, wait_pin, delay, set_input, release_input, inject_fault
-    std::map<std::string, std::string> args;  // "value" for the scalar form
-    std::string location;
+    StepAction action;
+    std::string kind;      // as written: "send", "wait_idle", ...
+    std::string location;  // file:line
 };
 
+// --- expectations: checked once the steps are done ---------------------------
+struct ExpectSteps { std::string axis; std::uint64_t count = 0; };
+struct ExpectPosition { std::string axis; double value = 0; double within = 1e-6; };  // mm, or deg on a rotary axis
+struct ExpectPin { std::string pin; bool level = false; };
+struct ExpectText { std::string text; };
+struct ExpectFindingCount { std::uint64_t count = 0; };
+struct ExpectFindingKinds { std::vector<std::string> kinds; };  // as a multiset
+
+using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectFindingCount, ExpectFindingKinds>;
+
 struct ScenarioExpectation {
-    std::string kind;  // steps, position, pin, text, findings
-    std::map<std::string, std::string> args;
-    std::vector<std::string> list;  // findings: [kinds]
+    ExpectAction action;
+    std::string kind;
     std::string location;
 };
 
@@ -55,41 +71,52 @@ struct ScenarioSpec {
     std::string path;
     std::string name;
     std::string description;
-    std::string board_path;                      // resolved
+    std::string board_path;                       // resolved
     std::map<std::string, std::string> firmware;  // MCU -> resolved ELF path
-    double time_limit_s = 10.0;
+    Picoseconds time_limit_ps = 10 * kPsPerSecond;
     std::vector<ScenarioStep> steps;
     std::vector<ScenarioExpectation> expectations;
     std::string golden_path;  // resolved; empty: no golden comparison
-    // Globs of the signals the golden holds. Empty: every wire and bus (real
-    // signals such as positions follow from the step edges and would only
-    // make the file long; list them to pin them, e.g. temperatures).
+    // Globs of the signals the golden holds. Empty: every wire and bus.
     std::vector<std::string> golden_signals;
     std::vector<ChannelRule> tolerances;
+    // Paths of send_file steps, resolved.
+    std::vector<std::string> stimulus_files() const;
 };
 
 // `firmware_dir` resolves bare firmware names (e.g. build/firmware).
 ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_dir);
 
+// A scenario name as it may appear in a file name, a JUnit attribute or an
+// HTML title: printable, no path separators, at most kMaxScenarioNameBytes.
+constexpr std::size_t kMaxScenarioNameBytes = 120;
+
 struct ScenarioResult {
     std::string name;
+    std::string path;                   // the scenario file
     bool passed = false;
-    std::vector<std::string> failures;  // one line each: steps, expectations, golden
+    bool error = false;                 // could not load or run: bad input, not a failed check
+    std::vector<std::string> failures;  // one line each: steps, expectations, golden; or the error
+    std::vector<std::string> expectation_failures;  // the subset of failures from steps and expectations
     std::optional<CompareResult> comparison;
     double simulated_s = 0;
     double wall_s = 0;
-    std::string report_path;  // HTML report, if written
+    std::string report_path;   // HTML report, if written
     std::string text() const;  // the human-readable outcome (failures, then the diff report)
 };
 
+// The result of a scenario that could not be loaded or run: `message` is the
+// BadInput line (file:line: ...).
+ScenarioResult error_result(const std::string& path, const std::string& message);
+
 struct ScenarioRunOptions {
-    std::string report_dir;      // write <report_dir>/<name>.html (and .vcd) when set
+    std::string report_dir;      // write <report_dir>/<name>.html when set
     bool update_golden = false;  // write the golden timeline instead of comparing
+    bool force = false;          // update_golden: also when steps or expectations failed
 };
 
+// Runs the scenario. Throws BadInput only for problems that show when the
+// board is built (e.g. an ELF built for another MCU, an unknown fault name).
 ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& options);
-
-// JUnit XML for CI systems: one <testsuite> with one <testcase> per result.
-std::string junit_xml(const std::vector<ScenarioResult>& results, const std::string& suite_name);
 
 }  // namespace avrbench

@@ -33,10 +33,24 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
     return dir;
 }
 
-inline CommandResult run_command(const std::string& command, const std::filesystem::path& dir) {
+inline std::string escape_single_quotes(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out;
+}
+
+// Exit code 124: the command ran past `wall_limit_s` of wall time and was
+// killed (coreutils timeout): a hang fails the test instead of CI.
+constexpr int kTimedOut = 124;
+
+inline CommandResult run_command(const std::string& command, const std::filesystem::path& dir, int wall_limit_s = 120) {
     const auto out = dir / "stdout.txt";
     const auto err = dir / "stderr.txt";
-    const std::string full = command + " >" + out.string() + " 2>" + err.string() + " </dev/null";
+    const std::string full = "timeout -k 5 " + std::to_string(wall_limit_s) + " sh -c '" +
+                             escape_single_quotes(command) + "' >" + out.string() + " 2>" + err.string() + " </dev/null";
     const int status = std::system(full.c_str());
     CommandResult r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

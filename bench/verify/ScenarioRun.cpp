@@ -1,0 +1,320 @@
+// Running a loaded scenario: its steps on a Bench, then its expectations,
+// then the golden comparison (or update), then the optional HTML report.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "core/Errors.hpp"
+#include "core/FileHash.hpp"
+#include "trace/HtmlReport.hpp"
+#include "core/OutputFile.hpp"
+#include "trace/TimelineText.hpp"
+#include "verify/Bench.hpp"
+#include "verify/Scenario.hpp"
+
+namespace fs = std::filesystem;
+
+namespace avrbench {
+namespace {
+
+// The part of the run's timeline that the golden holds.
+Timeline golden_view(const Timeline& all, const std::vector<std::string>& globs) {
+    Timeline out;
+    std::vector<long> map(all.signals().size(), -1);
+    for (SignalId id = 0; id < all.signals().size(); ++id) {
+        const SignalInfo& s = all.signals()[id];
+        bool keep = false;
+        if (globs.empty()) {
+            keep = s.kind != SignalKind::Real;
+        } else {
+            for (const auto& g : globs) keep = keep || glob_match(g, s.scope + "." + s.name);
+        }
+        if (keep) map[id] = static_cast<long>(out.add_signal(s));
+    }
+    for (const auto& e : all.events()) {
+        if (map[e.signal] < 0) continue;
+        const auto id = static_cast<SignalId>(map[e.signal]);
+        if (all.signals()[e.signal].kind == SignalKind::Real) {
+            out.record_real(id, e.cycle, e.value.real);
+        } else {
+            out.record(id, e.cycle, e.value.bits);
+        }
+    }
+    return out;
+}
+
+std::string seconds_text(Picoseconds ps) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.6f s", seconds_from_ps(ps));
+    return buf;
+}
+
+// A path as seen from `base_dir`, the same whatever the working directory.
+std::string relative_to(const std::string& path, const fs::path& base_dir) {
+    std::error_code ec;
+    const fs::path rel = fs::relative(fs::absolute(path, ec), fs::absolute(base_dir, ec), ec);
+    return ec || rel.empty() ? fs::path(path).filename().string() : rel.generic_string();
+}
+
+class StepRunner {
+public:
+    StepRunner(Bench& bench, Picoseconds deadline_ps) : bench_(bench), deadline_(deadline_ps) {}
+
+    // Runs one step; returns "" or why it failed.
+    std::string run(const ScenarioStep& step) {
+        return std::visit([this](const auto& action) { return (*this)(action); }, step.action);
+    }
+
+private:
+    std::string operator()(const SendStep& s) {
+        bench_.host().add_line(s.line);
+        return "";
+    }
+    std::string operator()(const SendFileStep& s) {
+        bench_.host().load_file(s.path);
+        return "";
+    }
+    std::string operator()(const DelayStep& s) {
+        bench_.board().run_until_ps(std::min(deadline_, add_ps(bench_.now_ps(), s.duration_ps)));
+        return "";
+    }
+    std::string operator()(const WaitIdleStep& s) {
+        const Picoseconds now = bench_.now_ps();
+        const IdleResult r = bench_.run_until_idle_ps(deadline_ - std::min(deadline_, now), s.settle_ps);
+        if (r == IdleResult::Idle) return "";
+        std::string why = to_string(r);
+        if (r == IdleResult::HostFailed) why += ": " + bench_.host().failure_message();
+        return "not idle within the time limit (" + why + ")";
+    }
+    std::string operator()(const WaitForTextStep& s) {
+        UartHost& host = bench_.host();
+        std::size_t checked = 0;
+        // Each pass either returns or runs the board to a later time (core/Time.hpp).
+        for (;;) {
+            const auto& transcript = host.transcript();
+            for (; checked < transcript.size(); ++checked) {
+                if (transcript[checked].direction == Direction::Received &&
+                    transcript[checked].text.find(s.text) != std::string::npos) {
+                    return "";
+                }
+            }
+            const Picoseconds now = bench_.now_ps();
+            if (now >= deadline_ || host.failed()) break;
+            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kSlicePs))) == StopReason::Halted) break;
+        }
+        return "the firmware sent no line containing '" + s.text + "' by " + seconds_text(deadline_) +
+               " (the time limit)";
+    }
+    std::string operator()(const WaitPinStep& s) {
+        Pin& pin = bench_.board().pin(s.pin);
+        while (pin.level() != s.level) {
+            const Picoseconds now = bench_.now_ps();
+            if (now >= deadline_) break;
+            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kPinSlicePs))) == StopReason::Halted) break;
+        }
+        if (pin.level() == s.level) return "";
+        return s.pin + " did not become " + (s.level ? "1" : "0") + " by " + seconds_text(deadline_) + " (the time limit)";
+    }
+    std::string operator()(const SetInputStep& s) {
+        bench_.board().pin(s.pin).drive(s.level);
+        return "";
+    }
+    std::string operator()(const ReleaseInputStep& s) {
+        bench_.board().pin(s.pin).release();
+        return "";
+    }
+    std::string operator()(const InjectFaultStep& s) {
+        Part& part = bench_.board().part(s.part);
+        part.inject_fault(s.fault, part.clock().cycle());
+        return "";
+    }
+
+    static constexpr Picoseconds kSlicePs = 100'000'000;    // 100 us between transcript checks
+    static constexpr Picoseconds kPinSlicePs = 10'000'000;  // 10 us between pin checks
+    Bench& bench_;
+    Picoseconds deadline_;
+};
+
+class ExpectationChecker {
+public:
+    ExpectationChecker(Bench& bench, const std::vector<Finding>& findings) : bench_(bench), findings_(findings) {}
+    std::string check(const ScenarioExpectation& e) {
+        return std::visit([this](const auto& action) { return (*this)(action); }, e.action);
+    }
+
+private:
+    std::string operator()(const ExpectSteps& e) {
+        Axis& axis = bench_.axis(e.axis);
+        if (axis.steps() == e.count) return "";
+        return "axis " + e.axis + " took " + std::to_string(axis.steps()) + " steps, expected " + std::to_string(e.count);
+    }
+    std::string operator()(const ExpectPosition& e) {
+        Axis& axis = bench_.axis(e.axis);
+        const double at = axis.rotary() ? axis.position_deg() : axis.position_mm();
+        if (std::fabs(at - e.value) <= e.within) return "";
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "axis %s at %.6f %s, expected %.6f +- %g", e.axis.c_str(), at,
+                      axis.rotary() ? "deg" : "mm", e.value, e.within);
+        return buf;
+    }
+    std::string operator()(const ExpectPin& e) {
+        Pin& pin = bench_.board().pin(e.pin);
+        if (pin.level() == e.level) return "";
+        return e.pin + " is " + (pin.level() ? "1" : "0");
+    }
+    std::string operator()(const ExpectText& e) {
+        if (bench_.host().received_text().find(e.text) != std::string::npos) return "";
+        return "the firmware never sent '" + e.text + "'";
+    }
+    std::string operator()(const ExpectFindingCount& e) {
+        if (findings_.size() == e.count) return "";
+        std::string list;
+        for (const auto& f : findings_) list += "\n      " + f.describe();
+        return std::to_string(findings_.size()) + " findings, expected " + std::to_string(e.count) + list;
+    }
+    std::string operator()(const ExpectFindingKinds& e) {
+        std::multiset<std::string> got, want(e.kinds.begin(), e.kinds.end());
+        for (const auto& f : findings_) got.insert(to_string(f.kind));
+        if (got == want) return "";
+        std::string g;
+        for (const auto& k : got) g += (g.empty() ? "" : ", ") + k;
+        return "findings are [" + g + "]";
+    }
+
+    Bench& bench_;
+    const std::vector<Finding>& findings_;
+};
+
+// Checks what only the built board can say (fault names), before anything runs.
+void bind(const ScenarioSpec& spec, Bench& bench) {
+    for (const auto& step : spec.steps) {
+        if (const auto* f = std::get_if<InjectFaultStep>(&step.action)) {
+            const Part& part = bench.board().part(f->part);
+            const auto names = part.fault_names();
+            if (f->fault != "none" && std::find(names.begin(), names.end(), f->fault) == names.end()) {
+                std::string list = "none";
+                for (const auto& n : names) list += ", " + n;
+                throw BadInput(step.location + ": part '" + f->part + "' (" + std::string(part.type()) + ") has no fault '" +
+                               f->fault + "' (faults: " + list + ")");
+            }
+        }
+    }
+}
+
+TimelineHeader golden_header(const ScenarioSpec& spec, const Mcu& first) {
+    TimelineHeader header;
+    header.bench_version = AVRBENCH_VERSION;
+    // Paths relative to the scenario's folder, so a golden reads the same
+    // whatever the working directory; the hashes say which inputs made it.
+    const fs::path base = fs::absolute(spec.path).parent_path();
+    for (const auto& [mcu, elf] : spec.firmware) {
+        header.inputs.push_back({"firmware." + mcu, sha256_of_file(elf), fs::path(elf).filename().string()});
+    }
+    header.inputs.push_back({"board", sha256_of_file(spec.board_path), relative_to(spec.board_path, base)});
+    header.inputs.push_back({"stimulus", sha256_of_file(spec.path), fs::path(spec.path).filename().string()});
+    for (const auto& file : spec.stimulus_files()) {
+        header.inputs.push_back({"stimulus.file", sha256_of_file(file), relative_to(file, base)});
+    }
+    header.end_cycle = first.cycle();
+    header.end_clock_hz = first.frequency_hz();
+    return header;
+}
+
+}  // namespace
+
+ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& options) {
+    ScenarioResult result;
+    result.name = spec.name;
+    result.path = spec.path;
+    const auto wall_start = std::chrono::steady_clock::now();
+    Bench bench(spec.board_path, spec.firmware);
+    bind(spec, bench);
+    bench.trace_board();
+    auto fail = [&](const std::string& message) {
+        result.failures.push_back(message);
+        result.expectation_failures.push_back(message);
+    };
+
+    StepRunner runner(bench, spec.time_limit_ps);
+    std::size_t index = 0;
+    for (const auto& step : spec.steps) {
+        ++index;
+        const std::string why = runner.run(step);
+        if (!why.empty()) {
+            fail("step " + std::to_string(index) + " (" + step.location + ", " + step.kind + "): " + why);
+            break;
+        }
+    }
+
+    const std::vector<Finding> findings = bench.findings();
+    ExpectationChecker checker(bench, findings);
+    for (const auto& e : spec.expectations) {
+        const std::string why = checker.check(e);
+        if (!why.empty()) fail("expect " + e.kind + " (" + e.location + "): " + why);
+    }
+
+    const TimelineHeader header = golden_header(spec, bench.mcu());
+    const Timeline actual = golden_view(bench.timeline(), spec.golden_signals);
+    std::optional<ParsedTimeline> golden;
+    if (!spec.golden_path.empty()) {
+        if (options.update_golden) {
+            if (!result.expectation_failures.empty() && !options.force) {
+                result.failures.push_back("golden: not updated, because the run failed its steps or expectations "
+                                          "(use --force to write it anyway)");
+            } else {
+                write_timeline_text(actual, header, spec.golden_path);
+            }
+        } else if (!fs::exists(spec.golden_path)) {
+            result.failures.push_back("golden: no golden timeline at " + spec.golden_path +
+                                      " (create it with: avrbench golden update " + spec.path + ")");
+        } else {
+            golden = read_timeline_text(spec.golden_path);
+            CompareOptions compare;
+            compare.rules = spec.tolerances;
+            compare.golden_end_cycle = golden->header.end_cycle;
+            compare.actual_end_cycle = header.end_cycle;
+            result.comparison = compare_timelines(golden->timeline, actual, compare);
+            if (!result.comparison->passed) {
+                const ChannelResult* d = result.comparison->first_divergence();
+                char at[96] = "";
+                if (d != nullptr) {
+                    std::snprintf(at, sizeof at, " diverges at %.6f s (cycle %llu): ", d->seconds(),
+                                  static_cast<unsigned long long>(d->divergence_cycle));
+                }
+                result.failures.push_back("golden: " + (d ? d->signal + at + d->detail : std::string("channels differ")));
+            }
+        }
+    }
+
+    result.simulated_s = bench.now_seconds();
+    result.passed = result.failures.empty();
+    if (!options.report_dir.empty()) {
+        RunReport report = bench.make_report(spec.name);
+        report.facts.push_back("scenario: " + spec.path);
+        report.facts.push_back(std::string("verdict: ") + (result.passed ? "PASS" : "FAIL"));
+        for (const auto& f : result.failures) report.facts.push_back(f);
+        if (result.comparison && golden) {
+            ComparisonView view;
+            view.passed = result.comparison->passed;
+            view.golden = golden->timeline;
+            if (const ChannelResult* d = result.comparison->first_divergence()) {
+                view.first_divergence_signal = d->signal;
+                view.first_divergence_cycle = d->divergence_cycle;
+                view.first_divergence_clock_hz = d->clock_hz;
+            }
+            view.summary = result.comparison->report();
+            for (const auto& c : result.comparison->channels) view.channels.push_back({c.signal, c.verdict, c.detail});
+            report.comparison = std::move(view);
+        }
+        // The name was checked when the file loaded: no separators, so the
+        // report stays inside report_dir.
+        result.report_path = (fs::path(options.report_dir) / (spec.name + ".html")).string();
+        write_html_report(report, result.report_path);
+    }
+    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    return result;
+}
+
+}  // namespace avrbench
