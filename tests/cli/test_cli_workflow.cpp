@@ -1,0 +1,193 @@
+// The CI workflow as a firmware team uses it: batches of scenarios with one
+// broken file, serial I/O on boards, output paths, golden updates.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
+
+namespace avrbench {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kCli = AVRBENCH_CLI;
+const std::string kFw = std::string(" --firmware-dir ") + AVRBENCH_FIRMWARE_DIR;
+
+fs::path write(const fs::path& path, const std::string& text) {
+    std::ofstream(path) << text;
+    return path;
+}
+
+std::string uno() { return test::source_path("bench/boards/arduino-uno.yaml"); }
+std::string cnc() { return test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"); }
+
+TEST(CheckBatch, ABrokenScenarioIsOneErrorResultAndTheOthersStillRun) {
+    const auto dir = test::scratch_dir("batch");
+    const fs::path good = write(dir / "good.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 5ms\n"
+                                                   "expect:\n  - findings: 0\n");
+    // Line 6: an axis the board does not have.
+    const fs::path bad = write(dir / "bad.yaml", "board: " + cnc() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 5ms\n"
+                                                 "expect:\n  - steps: {axis: w, count: 3}\n");
+    const fs::path also_good = write(dir / "also_good.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\n");
+    const fs::path junit = dir / "j.xml";
+    const auto r = test::run_command(kCli + " check " + good.string() + " " + bad.string() + " " + also_good.string() +
+                                         kFw + " --junit " + junit.string(), dir);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;  // an input error in the batch
+    EXPECT_NE(r.out.find("PASS good"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("PASS also_good"), std::string::npos) << r.out;
+    const std::string where = bad.string() + ":6: the board has no axis 'w' (axes: x, y, z)";
+    EXPECT_NE(r.out.find("ERROR bad\n  " + where), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find(where), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("2 passed, 1 failed"), std::string::npos) << r.out;
+    const std::string xml = test::slurp(junit);
+    EXPECT_NE(xml.find("tests=\"3\" failures=\"0\" errors=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<error message=\"" + where), std::string::npos) << xml;
+}
+
+// Every reference is checked before anything is simulated: the error comes
+// even though the bad expectation follows a step that would run 1000 s.
+TEST(CheckBatch, ScenarioIsValidatedBeforeAnySimulation) {
+    const auto dir = test::scratch_dir("validate");
+    struct Case {
+        std::string body;
+        std::string message;
+        bool cnc_board = false;
+    };
+    const std::vector<Case> cases = {
+        {"  - delay: 1000s\n  - wait_pin: {pin: uno.PZ9, level: 1}\n", ":5: atmega328p has no pin 'PZ9' (in 'uno.PZ9')"},
+        {"  - delay: 1000s\n  - set_input: {pin: nosuch, level: 1}\n", ":5: 'nosuch' is neither mcu.PIN nor a label"},
+        {"  - delay: 1000s\n  - inject_fault: {part: heater, fault: melt}\n", ":5: the board has no part 'heater'"},
+        {"  - delay: 1000s\n  - delay: 3 parsecs\n", ":5: delay: unknown unit 'parsecs'"},
+        {"  - delay: 1000s\n  - wait_pin: {pin: uno.PB5, level: 2}\n", ":5: level '2' is not 0/low or 1/high"},
+        {"  - delay: 1000s\n  - wait_pin: {pin: uno.PB5}\n", ":5: 'wait_pin' needs 'level'"},
+        {"  - delay: 1000s\nexpect:\n  - findings: 1e300\n", ":6: findings: '1e300' is outside 0..9007199254740992"},
+        {"  - delay: 1000s\nexpect:\n  - findings: [no-such-kind]\n", ":6: unknown finding kind 'no-such-kind'"},
+        {"  - delay: 1000s\nexpect:\n  - steps: {axis: x, count: 3}\n", ":6: the board has no axis 'x' (axes: none)"},
+        {"  - delay: 1000s\nexpect:\n  - steps: {axis: x, count: 2.5}\n", ":6: count: '2.5' is not a whole number", true},
+    };
+    int n = 0;
+    for (const auto& c : cases) {
+        const fs::path path = write(dir / ("s" + std::to_string(n++) + ".yaml"),
+                                    "board: " + (c.cnc_board ? cnc() : uno()) + "\nfirmware: {uno: blink_timer1}\nsteps:\n" + c.body);
+        const auto r = test::run_command(kCli + " check " + path.string() + kFw, dir, 30);
+        EXPECT_EQ(r.exit_code, 2) << c.body << r.out << r.err;
+        EXPECT_NE(r.err.find(path.string() + c.message), std::string::npos) << c.message << "\n" << r.err;
+    }
+}
+
+TEST(BoardSerial, UartInAndOutWorkOnABoardWithAndWithoutGcode) {
+    const auto dir = test::scratch_dir("board-serial");
+    const fs::path in = write(dir / "in.txt", "hello\n");
+    const fs::path out = dir / "out.txt";
+    const auto r = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") + " --for 20ms" +
+                                         " --uart-in " + in.string() + " --uart-out host=" + out.string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    // The firmware's banner, then its echo of what it was sent (firmware/uart_echo).
+    EXPECT_EQ(test::slurp(out), "avrbench uart_echo\r\nhello\n");
+    // The summary shows the port's traffic and last lines without --gcode.
+    EXPECT_NE(r.out.find("serial host 26 bytes from firmware, 6 bytes to firmware; last lines:\n    avrbench uart_echo\n    hello\n"),
+              std::string::npos) << r.out;
+    const auto bad_port = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") +
+                                                " --for 1ms --uart-out debug=" + out.string(), dir);
+    EXPECT_EQ(bad_port.exit_code, 2);
+    EXPECT_NE(bad_port.err.find("no serial port 'debug' (ports: host)"), std::string::npos) << bad_port.err;
+}
+
+TEST(OutputPaths, BadPathsFailBeforeTheRunWithOneLine) {
+    const auto dir = test::scratch_dir("out-paths");
+    write(dir / "a_file", "x");
+    const std::string run = kCli + " run -q --board " + uno() + " " + test::firmware("busy_poll") + " --for 1000s ";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--vcd /nonexistent/x.vcd", "avrbench: error: --vcd: /nonexistent/x.vcd: the folder /nonexistent does not exist\n"},
+        {"--report /nonexistent/r.html", "avrbench: error: --report: /nonexistent/r.html: the folder /nonexistent does not exist\n"},
+        {"--vcd " + (dir / "a_file" / "x.vcd").string(),
+         "avrbench: error: --vcd: " + (dir / "a_file" / "x.vcd").string() + ": " + (dir / "a_file").string() + " is not a folder\n"},
+        {"--vcd " + dir.string(), "avrbench: error: --vcd: " + dir.string() + ": is a folder\n"},
+        {"--uart-out /dev/full", "avrbench: error: --uart-out: /dev/full: is not a regular file (a device, FIFO or socket)\n"},
+    };
+    for (const auto& [option, message] : cases) {
+        // 1000 s of busy simulation would take minutes: the 20 s guard
+        // proves the check comes first.
+        const auto r = test::run_command(run + option, dir, 20);
+        EXPECT_EQ(r.exit_code, 2) << option << r.out << r.err;
+        EXPECT_EQ(r.err, message);
+    }
+}
+
+TEST(OutputPaths, ADeviceOrFifoTargetIsRefusedAndLeftInPlace) {
+    const auto dir = test::scratch_dir("out-device");
+    const fs::path fifo = dir / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    const auto r = test::run_command(kCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + fifo.string(), dir, 20);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_TRUE(fs::is_fifo(fifo)) << "the bench removed a file it did not create";
+    // As root a character device can be made (mknod c 1 7 is /dev/full);
+    // as another user mknod is refused and the FIFO above stands for it.
+    const fs::path device = dir / "fd";
+    if (::mknod(device.c_str(), S_IFCHR | 0644, makedev(1, 7)) == 0) {
+        const auto d = test::run_command(kCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + device.string(), dir, 20);
+        EXPECT_EQ(d.exit_code, 2) << d.err;
+        EXPECT_TRUE(fs::is_character_file(device)) << "the bench removed a device node";
+    }
+}
+
+TEST(OutputPaths, SummaryToAFullDiskIsAnError) {
+    const auto dir = test::scratch_dir("stdout-full");
+    const auto r = test::run_command(kCli + " run " + test::firmware("blink_timer1") + " --for 1ms > /dev/full", dir, 20);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, "avrbench: error: cannot write to standard output\n");
+}
+
+TEST(GoldenUpdate, RefusesAFailingRunUnlessForced) {
+    const auto dir = test::scratch_dir("golden-refuse");
+    // blink_timer1 has no serial output and no findings: expecting one fails.
+    const fs::path scenario = write(dir / "s.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 5ms\n"
+                                                    "expect:\n  - findings: 1\ngolden: s.timeline\n");
+    const auto r = test::run_command(kCli + " golden update " + scenario.string() + kFw, dir);
+    EXPECT_EQ(r.exit_code, 1) << r.out;
+    EXPECT_NE(r.out.find("expect findings (" + scenario.string() + ":6): 0 findings, expected 1"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("golden: not updated"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / "s.timeline"));
+    const auto forced = test::run_command(kCli + " golden update --force " + scenario.string() + kFw, dir);
+    EXPECT_EQ(forced.exit_code, 1) << forced.out;  // still a failing run, but written
+    EXPECT_TRUE(fs::exists(dir / "s.timeline"));
+}
+
+TEST(GoldenUpdate, GoldenIsTheSameWhereverTheCommandRuns) {
+    const auto dir = test::scratch_dir("golden-cwd");
+    fs::create_directories(dir / "project" / "tests");
+    fs::create_directories(dir / "project" / "boards");
+    fs::copy_file(uno(), dir / "project" / "boards" / "uno.yaml");
+    const fs::path scenario = write(dir / "project" / "tests" / "s.yaml",
+                                    "board: ../boards/uno.yaml\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 3ms\n"
+                                    "golden: s.timeline\n");
+    const fs::path golden = dir / "project" / "tests" / "s.timeline";
+    auto update_from = [&](const fs::path& cwd, const std::string& scenario_arg) {
+        const auto r = test::run_command("cd " + cwd.string() + " && " + kCli + " golden update " + scenario_arg + kFw, dir);
+        EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+        return test::slurp(golden);
+    };
+    const std::string from_tests = update_from(dir / "project" / "tests", "s.yaml");
+    const std::string from_project = update_from(dir / "project", "tests/s.yaml");
+    const std::string from_root = update_from("/", scenario.string());
+    EXPECT_EQ(from_tests, from_project);
+    EXPECT_EQ(from_tests, from_root);
+    EXPECT_NE(from_tests.find("../boards/uno.yaml"), std::string::npos) << from_tests;
+}
+
+TEST(Gtkw, SaveFileNamesTheDumpRelativeToItself) {
+    const auto dir = test::scratch_dir("gtkw-path");
+    fs::create_directories(dir / "traces");
+    const auto r = test::run_command("cd " + dir.string() + " && " + kCli + " run -q " + test::firmware("blink_timer1") +
+                                         " --for 2ms --vcd traces/demo.vcd", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string gtkw = test::slurp(dir / "traces" / "demo.gtkw");
+    EXPECT_NE(gtkw.find("[dumpfile] \"demo.vcd\"\n"), std::string::npos) << gtkw;
+}
+
+}  // namespace
+}  // namespace avrbench
