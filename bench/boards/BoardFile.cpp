@@ -198,14 +198,18 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
                 if (key == "mcu") {
                     s.mcu = value;
                 } else if (key == "usart") {
-                    s.usart = static_cast<int>(parse_quantity(value, Dimension::Dimensionless, loc + ": usart"));
+                    // USART0..3: the ATmega2560 has the most (datasheet §22); the board's
+                    // MCU is checked to have it when the board is built.
+                    s.usart = static_cast<int>(parse_integer(value, loc + ": usart", 0, 3));
                 } else if (key == "flow") {
                     if (value != "send_and_wait" && value != "character_counting") {
                         throw BadInput(loc + ": flow '" + value + "' is not send_and_wait or character_counting");
                     }
                     s.flow = value;
                 } else if (key == "rx_buffer") {
-                    s.rx_buffer_bytes = static_cast<unsigned>(parse_quantity(value, Dimension::Dimensionless, loc + ": rx_buffer"));
+                    // The firmware's receive buffer: grbl uses 128 (serial.h); no AVR
+                    // has more than 64 KiB of RAM to hold one.
+                    s.rx_buffer_bytes = static_cast<unsigned>(parse_integer(value, loc + ": rx_buffer", 1, 65536));
                 } else {
                     throw BadInput(loc + ": serial '" + s.name + "': unknown key '" + key + "' (expected mcu, usart, flow, rx_buffer)");
                 }

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 #include <vector>
 
@@ -145,20 +146,19 @@ std::uint64_t parse_duration_ps(std::string_view text, std::string_view what) {
 }
 
 std::int64_t checked_integer(double value, std::string_view what, std::int64_t min_value, std::int64_t max_value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.10g", value);
     if (!std::isfinite(value) || value != std::floor(value)) {
-        throw BadInput(std::string(what) + ": " + std::to_string(value) + " is not a whole number");
+        throw BadInput(std::string(what) + ": " + text + " is not a whole number");
     }
     // Compare as doubles first: the range check must come before any cast.
-    if (value < static_cast<double>(min_value) || value > static_cast<double>(max_value)) {
-        throw BadInput(std::string(what) + ": " + std::to_string(value) + " is outside " + std::to_string(min_value) +
-                       ".." + std::to_string(max_value));
+    // The second check catches max_value near 2^63, which rounds up as a double.
+    if (value < static_cast<double>(min_value) || value > static_cast<double>(max_value) ||
+        static_cast<std::int64_t>(value) < min_value || static_cast<std::int64_t>(value) > max_value) {
+        throw BadInput(std::string(what) + ": " + text + " is outside " + std::to_string(min_value) + ".." +
+                       std::to_string(max_value));
     }
-    const auto n = static_cast<std::int64_t>(value);
-    if (n < min_value || n > max_value) {  // max_value near 2^63 rounds up as a double
-        throw BadInput(std::string(what) + ": " + std::to_string(value) + " is outside " + std::to_string(min_value) +
-                       ".." + std::to_string(max_value));
-    }
-    return n;
+    return static_cast<std::int64_t>(value);
 }
 
 std::int64_t parse_integer(std::string_view text, std::string_view what, std::int64_t min_value, std::int64_t max_value) {

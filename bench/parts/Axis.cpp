@@ -28,13 +28,26 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDrive
     if (rotary_) {
         if (!params.has("steps_per_rev")) throw BadInput("part '" + this->name() + "': a rotary axis needs steps_per_rev");
         const double steps_per_rev = params.quantity("steps_per_rev");
+        // A 1.8 deg motor at 256 microsteps makes 51200 steps/rev; 1e7 covers any gearing.
+        if (!(steps_per_rev > 0 && steps_per_rev <= 1e7)) {
+            throw BadInput("part '" + this->name() + "': steps_per_rev must be above 0 and at most 1e7");
+        }
         // One 1/256 full step is (256 / microsteps)^-1 of a configured step.
         radians_per_256_ = 2.0 * 3.14159265358979323846 / steps_per_rev * microsteps / 256.0;
         metres_per_256_ = 0;
     } else {
         if (!params.has("steps_per_mm")) throw BadInput("part '" + this->name() + "': a linear axis needs steps_per_mm");
         if (!params.has("travel")) throw BadInput("part '" + this->name() + "': a linear axis needs travel");
-        const double steps_per_m = params.quantity("steps_per_mm") * 1e3;
+        // Ranges real machines span with room: lead screws at 256 microsteps
+        // reach a few thousand steps/mm; no bench axis is longer than 100 m.
+        const double steps_per_mm = params.quantity("steps_per_mm");
+        if (!(steps_per_mm >= 1e-3 && steps_per_mm <= 1e6)) {
+            throw BadInput("part '" + this->name() + "': steps_per_mm must be from 0.001 to 1e6");
+        }
+        if (!(params.quantity("travel") > 0 && params.quantity("travel") <= 100)) {
+            throw BadInput("part '" + this->name() + "': travel must be longer than 0 and at most 100 m");
+        }
+        const double steps_per_m = steps_per_mm * 1e3;
         metres_per_256_ = microsteps / 256.0 / steps_per_m;
         radians_per_256_ = 0;
         travel_m_ = params.quantity("travel");

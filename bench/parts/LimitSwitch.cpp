@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/Errors.hpp"
+#include "core/Units.hpp"
 
 namespace avrbench {
 
@@ -40,11 +41,19 @@ LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params
       normally_open_(params.text("contact") == "NO"),
       closed_level_(params.text("switched_to") == "vcc"),
       pull_(params.text("pull")),
-      bounce_s_(params.quantity("bounce")),
-      bounce_edges_(static_cast<unsigned>(params.integer("bounce_edges"))),
-      rng_(static_cast<std::uint64_t>(params.integer("seed"))) {
+      bounce_s_(params.quantity("bounce") >= 0 && params.quantity("bounce") <= 1.0
+                    ? params.quantity("bounce")
+                    : throw BadInput("parameter 'bounce' must be from 0 to 1 s (contacts settle in milliseconds)")),
+      bounce_edges_(static_cast<unsigned>(checked_integer(static_cast<double>(params.integer("bounce_edges")),
+                                                          "parameter 'bounce_edges'", 0, 1000))),
+      rng_(static_cast<std::uint64_t>(checked_integer(static_cast<double>(params.integer("seed")), "parameter 'seed'", 0,
+                                                      std::int64_t{1} << 53))) {
     if (axis.rotary()) throw BadInput("part '" + this->name() + "': limit switches go on linear axes");
     trip_m_ = params.has("position") ? params.quantity("position") : (min_side_ ? 0.0 : axis.travel_mm() * 1e-3);
+    if (trip_m_ < 0 || trip_m_ > axis.travel_mm() * 1e-3) {
+        throw BadInput("part '" + this->name() + "': position must lie within the axis' travel (0.." +
+                       std::to_string(axis.travel_mm()) + " mm)");
+    }
     out_pin_ = add_pin("out", TerminalRole::Output);
     sig_closed_ = add_signal("closed", false);
     axis_.on_move([this](double position_m) { on_axis_move(position_m); });

@@ -1,5 +1,7 @@
 #include "parts/Params.hpp"
 
+#include "core/Units.hpp"
+
 #include <cmath>
 
 #include "core/Errors.hpp"
@@ -43,7 +45,11 @@ double ParamValues::quantity(const std::string& name) const {
     return it->second;
 }
 
-long long ParamValues::integer(const std::string& name) const { return std::llround(quantity(name)); }
+long long ParamValues::integer(const std::string& name) const {
+    // Whole numbers only, within +-2^53 (exact in a double): never a bare cast.
+    constexpr std::int64_t kLimit = std::int64_t{1} << 53;
+    return checked_integer(quantity(name), "parameter '" + name + "'", -kLimit, kLimit);
+}
 
 const std::string& ParamValues::text(const std::string& name) const {
     auto it = texts_.find(name);

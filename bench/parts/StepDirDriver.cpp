@@ -138,7 +138,13 @@ StepDirDriver::StepDirDriver(std::string name, Mcu& clock, const ParamValues& pa
 
 // A minimum time in cycles, rounded up: a pulse of exactly that length passes.
 Cycle StepDirDriver::cycles(double seconds) const {
-    return static_cast<Cycle>(std::ceil(seconds * clock().frequency_hz() - 1e-9));
+    const double cycles = std::ceil(seconds * clock().frequency_hz() - 1e-9);
+    // A driver's timing minimum is nanoseconds to milliseconds; anything
+    // outside 0..1 hour is a typo, and the cast below needs the range.
+    if (!(cycles >= 0 && seconds <= 3600)) {
+        throw BadInput("part '" + name() + "': a timing value of " + std::to_string(seconds) + " s is outside 0..1 h");
+    }
+    return static_cast<Cycle>(cycles);
 }
 
 bool StepDirDriver::enabled() const {

@@ -40,7 +40,13 @@ Bench::~Bench() = default;
 
 void Bench::watch_motion() {
     // Every declared serial port records what the firmware sends from power-on.
-    for (const auto& decl : board_->spec().serial) board_->mcu(decl.mcu).uart(decl.usart);
+    for (const auto& decl : board_->spec().serial) {
+        try {
+            board_->mcu(decl.mcu).uart(decl.usart);
+        } catch (const BadInput& e) {
+            throw BadInput(decl.location + ": serial '" + decl.name + "': " + e.what());
+        }
+    }
     for (StepDirDriver* driver : board_->parts_of_type<StepDirDriver>()) {
         driver->on_step([this, driver](int) { last_step_ps_ = ps_at_cycle(driver->clock(), driver->clock().cycle()); });
     }
