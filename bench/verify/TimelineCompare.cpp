@@ -16,9 +16,21 @@ std::string value_text(const SignalInfo& info, const TimelineEvent& e) {
     char buf[64];
     if (info.kind == SignalKind::Real) {
         std::snprintf(buf, sizeof buf, "%.6g", e.value.real);
-    } else if (info.kind == SignalKind::Bus && info.width == 8 && e.value.bits >= 32 && e.value.bits < 127) {
-        std::snprintf(buf, sizeof buf, "0x%02llx '%c'", static_cast<unsigned long long>(e.value.bits),
-                      static_cast<char>(e.value.bits));
+    } else if (info.kind == SignalKind::Bus && info.width == 8) {
+        // Bytes one way: hex, then the character as a C literal would write it.
+        const auto b = static_cast<unsigned>(e.value.bits & 0xff);
+        char shown[8];
+        switch (b) {
+            case '\n': std::snprintf(shown, sizeof shown, "\\n"); break;
+            case '\r': std::snprintf(shown, sizeof shown, "\\r"); break;
+            case '\t': std::snprintf(shown, sizeof shown, "\\t"); break;
+            case '\'': std::snprintf(shown, sizeof shown, "\\'"); break;
+            case '\\': std::snprintf(shown, sizeof shown, "\\\\"); break;
+            default:
+                if (b >= 0x20 && b < 0x7f) std::snprintf(shown, sizeof shown, "%c", static_cast<char>(b));
+                else std::snprintf(shown, sizeof shown, "\\x%02x", b);
+        }
+        std::snprintf(buf, sizeof buf, "0x%02x '%s'", b, shown);
     } else {
         std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(e.value.bits));
     }
@@ -27,8 +39,8 @@ std::string value_text(const SignalInfo& info, const TimelineEvent& e) {
 
 std::string event_text(const SignalInfo& info, const TimelineEvent& e) {
     char buf[96];
-    std::snprintf(buf, sizeof buf, "%s at cycle %llu (%.6f ms)", value_text(info, e).c_str(),
-                  static_cast<unsigned long long>(e.cycle), static_cast<double>(e.cycle) * 1e3 / info.clock_hz);
+    std::snprintf(buf, sizeof buf, "%s at cycle %llu (%.9f s)", value_text(info, e).c_str(),
+                  static_cast<unsigned long long>(e.cycle), static_cast<double>(e.cycle) / info.clock_hz);
     return buf;
 }
 
@@ -41,7 +53,7 @@ void add_context(ChannelResult& r, const SignalInfo& info, const std::vector<Tim
     const std::size_t from = index > around ? index - around : 0;
     const std::size_t to = std::min(std::max(g.size(), a.size()), index + around + 1);
     for (std::size_t i = from; i < to; ++i) {
-        std::string line = (i == index ? "> " : "  ") + std::string("#") + std::to_string(i) + "  golden ";
+        std::string line = (i == index ? "> " : "  ") + std::string("#") + std::to_string(i + 1) + "  golden ";
         line += i < g.size() ? event_text(info, g[i]) : "(none)";
         line += "  |  actual ";
         line += i < a.size() ? event_text(info, a[i]) : "(none)";
@@ -113,7 +125,7 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
         case RuleKind::Exact: {
             for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
                 if (i < g.size() && i < a.size() && g[i].cycle == a[i].cycle && equal_value(info, g[i], a[i])) continue;
-                std::snprintf(buf, sizeof buf, "change #%zu differs (%zu golden vs %zu actual changes)", i, g.size(), a.size());
+                std::snprintf(buf, sizeof buf, "change #%zu differs (%zu golden vs %zu actual changes)", i + 1, g.size(), a.size());
                 diverge_at(r, info, g, a, i, around, buf);
                 return;
             }
@@ -124,7 +136,7 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
             for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
                 if (i >= g.size() || i >= a.size() || !equal_value(info, g[i], a[i])) {
                     std::snprintf(buf, sizeof buf, "change #%zu: value sequence differs (%zu golden vs %zu actual changes)",
-                                  i, g.size(), a.size());
+                                  i + 1, g.size(), a.size());
                     diverge_at(r, info, g, a, i, around, buf);
                     return;
                 }
@@ -141,7 +153,7 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                     std::snprintf(buf, sizeof buf,
                                   "change #%zu moved by %.0f cycles (tolerance %.0f); its interval changed by %.0f "
                                   "(tolerance %.1f)",
-                                  i, shift, rule.tolerance_cycles, interval_error, interval_allowed);
+                                  i + 1, shift, rule.tolerance_cycles, interval_error, interval_allowed);
                     diverge_at(r, info, g, a, i, around, buf);
                     return;
                 }
@@ -157,7 +169,7 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                 const double shift = std::fabs(static_cast<double>(as[i].cycle) - static_cast<double>(gs[i].cycle));
                 worst = std::max(worst, shift);
                 if (shift > rule.tolerance_cycles) {
-                    std::snprintf(buf, sizeof buf, "step %zu moved by %.0f cycles, tolerance %.0f", i + 1, shift,
+                    std::snprintf(buf, sizeof buf, "step #%zu moved by %.0f cycles, tolerance %.0f", i + 1, shift,
                                   rule.tolerance_cycles);
                     diverge_at(r, info, gs, as, i, around, buf);
                     return;
@@ -189,8 +201,8 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                     const double d = std::fabs(value_at(a, info, t) - value_at(g, info, t));
                     worst = std::max(worst, d);
                     if (d > rule.band) {
-                        std::snprintf(buf, sizeof buf, "at %.6f ms actual %.6g vs golden %.6g (band %.6g)",
-                                      static_cast<double>(t) * 1e3 / info.clock_hz, value_at(a, info, t),
+                        std::snprintf(buf, sizeof buf, "at %.9f s actual %.6g vs golden %.6g (band %.6g)",
+                                      static_cast<double>(t) / info.clock_hz, value_at(a, info, t),
                                       value_at(g, info, t), rule.band);
                         r.passed = false;
                         r.verdict = "differs";
@@ -215,8 +227,8 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                 if (rule.kind == RuleKind::PwmDuty) {
                     const double dg = duty(g, begin, stop), da = duty(a, begin, stop);
                     if (std::fabs(dg - da) > rule.band) {
-                        std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.3f ms (band %.4f)", da,
-                                      dg, static_cast<double>(begin) * 1e3 / info.clock_hz, rule.band);
+                        std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.6f s (band %.4f)", da,
+                                      dg, static_cast<double>(begin) / info.clock_hz, rule.band);
                         r.passed = false;
                         r.verdict = "differs";
                         r.diverges = true;
@@ -234,8 +246,8 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                     };
                     const double cg = count(gs), ca = count(as);
                     if (std::fabs(ca - cg) > rule.tolerance_rel * cg + 1) {
-                        std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.3f ms", ca, cg,
-                                      static_cast<double>(begin) * 1e3 / info.clock_hz);
+                        std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.6f s", ca, cg,
+                                      static_cast<double>(begin) / info.clock_hz);
                         r.passed = false;
                         r.verdict = "differs";
                         r.diverges = true;
@@ -330,6 +342,10 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
                 r.passed = false;
                 r.verdict = "missing";
                 r.detail = "the run did not record this signal";
+                if (!g.empty()) {
+                    r.diverges = true;
+                    r.divergence_cycle = g.front().cycle;
+                }
             }
             result.channels.push_back(r);
             continue;
@@ -355,7 +371,13 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
         r.passed = false;
         r.verdict = "extra";
         r.detail = "recorded now but not in the golden timeline";
-        r.actual_changes = changes_of(actual, id).size();
+        const auto a = changes_of(actual, id);
+        r.actual_changes = a.size();
+        r.clock_hz = actual.signals()[id].clock_hz;
+        if (!a.empty()) {
+            r.diverges = true;
+            r.divergence_cycle = a.front().cycle;
+        }
         result.channels.push_back(r);
     }
     for (const auto& c : result.channels) result.passed = result.passed && c.passed;
@@ -366,33 +388,50 @@ std::string CompareResult::report() const {
     std::string out;
     std::size_t failing = 0;
     for (const auto& c : channels) failing += c.passed ? 0 : 1;
-    char buf[256];
+    char buf[512];
     if (passed) {
         std::snprintf(buf, sizeof buf, "PASS: all %zu channels match the golden timeline\n", channels.size());
-        out += buf;
-    } else {
-        std::snprintf(buf, sizeof buf, "FAIL: %zu of %zu channels differ from the golden timeline\n", failing, channels.size());
-        out += buf;
-        if (const ChannelResult* first = first_divergence()) {
-            std::snprintf(buf, sizeof buf, "first divergence: %s at %.6f ms (cycle %llu): %s\n", first->signal.c_str(),
-                          first->seconds() * 1e3, static_cast<unsigned long long>(first->divergence_cycle),
-                          first->detail.c_str());
-            out += buf;
-            if (!first->expected.empty() || !first->actual.empty()) {
-                out += "  expected " + first->expected + "\n";
-                out += "  actual   " + first->actual + "\n";
-            }
-            for (const auto& line : first->context) out += "  " + line + "\n";
-        }
+        return buf;
     }
-    out += "\n";
-    std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9s %9s  %s\n", "channel", "rule", "verdict", "golden", "actual", "detail");
+    std::snprintf(buf, sizeof buf, "FAIL: %zu of %zu channels differ from the golden timeline\n", failing, channels.size());
     out += buf;
-    for (const auto& c : channels) {
-        std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9zu %9zu  %s\n", c.signal.c_str(), to_string(c.rule),
-                      c.verdict.c_str(), c.golden_changes, c.actual_changes, c.detail.c_str());
+    if (const ChannelResult* first = first_divergence()) {
+        std::snprintf(buf, sizeof buf, "first divergence: %s at %.9f s (cycle %llu): %s\n", first->signal.c_str(),
+                      first->seconds(), static_cast<unsigned long long>(first->divergence_cycle), first->detail.c_str());
         out += buf;
+        if (!first->expected.empty() || !first->actual.empty()) {
+            out += "  expected " + first->expected + "\n";
+            out += "  actual   " + first->actual + "\n";
+        }
+        for (const auto& line : first->context) out += "  " + line + "\n";
     }
+    // Every differing channel with its own first divergence, earliest first;
+    // the channels that match are counted, not listed.
+    std::vector<const ChannelResult*> differing;
+    for (const auto& c : channels) {
+        if (!c.passed) differing.push_back(&c);
+    }
+    std::stable_sort(differing.begin(), differing.end(), [](const ChannelResult* a, const ChannelResult* b) {
+        if (a->diverges != b->diverges) return a->diverges;
+        return a->seconds() < b->seconds();
+    });
+    out += "\n";
+    std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9s %9s  %-32s %s\n", "channel", "rule", "verdict", "golden", "actual",
+                  "diverges at", "detail");
+    out += buf;
+    for (const ChannelResult* c : differing) {
+        char at[64] = "-";
+        if (c->diverges) {
+            std::snprintf(at, sizeof at, "%.9f s (cycle %llu)", c->seconds(), static_cast<unsigned long long>(c->divergence_cycle));
+        }
+        std::snprintf(buf, sizeof buf, "%-28s %-9s %-8s %9zu %9zu  %-32s %s\n", c->signal.c_str(), to_string(c->rule),
+                      c->verdict.c_str(), c->golden_changes, c->actual_changes, at, c->detail.c_str());
+        out += buf;
+        if (!c->expected.empty() || !c->actual.empty()) out += "    expected " + c->expected + "; actual " + c->actual + "\n";
+    }
+    std::snprintf(buf, sizeof buf, "%zu other channel%s match%s\n", channels.size() - failing,
+                  channels.size() - failing == 1 ? "" : "s", channels.size() - failing == 1 ? "es" : "");
+    out += buf;
     return out;
 }
 

@@ -40,19 +40,51 @@ TEST(TimelineCompare, IdenticalTimelinesPassEveryRule) {
 }
 
 TEST(TimelineCompare, ExactNamesTheFirstDivergentEdge) {
-    // Step 40 (0-based) rises 31 cycles late: change #81 (initial 0, then 2 per step).
+    // Step 40 (0-based) rises 31 cycles late: the 82nd change, counted from 1
+    // as the text and the context both count (1: the initial 0, then 2 per step).
     const auto result = compare_timelines(steps(100, 400), steps(100, 400, 40, 31), rule(RuleKind::Exact));
     ASSERT_FALSE(result.passed);
     const ChannelResult* first = result.first_divergence();
     ASSERT_NE(first, nullptr);
     EXPECT_EQ(first->signal, "uno.PD2");
     EXPECT_EQ(first->divergence_cycle, 1000u + 40 * 400);  // the golden edge, the earlier of the two
-    EXPECT_EQ(first->expected, "1 at cycle 17000 (1.062500 ms)");
+    EXPECT_EQ(first->expected, "1 at cycle 17000 (0.001062500 s)");  // 17000 / 16 MHz
     EXPECT_EQ(first->actual.rfind("1 at cycle 17031 ", 0), 0u) << first->actual;
     const std::string report = result.report();
-    EXPECT_NE(report.find("first divergence: uno.PD2 at 1.062500 ms (cycle 17000)"), std::string::npos) << report;
-    EXPECT_NE(report.find("> #81"), std::string::npos) << report;  // context marks the divergent change
+    EXPECT_NE(report.find("first divergence: uno.PD2 at 0.001062500 s (cycle 17000): change #82 differs"), std::string::npos) << report;
+    EXPECT_NE(report.find("> #82"), std::string::npos) << report;  // context marks the same change
     EXPECT_NE(report.find("uno.PD2"), std::string::npos);
+}
+
+TEST(TimelineCompare, EveryDifferingChannelGetsItsTimeAndMatchingOnesAreCounted) {
+    // Golden: PD2 and PD3 step trains and a UART byte stream; actual: PD2 as
+    // before, PD3's 10th step (0-based) 31 cycles late, the UART's 2nd byte
+    // '\n' instead of 'k'.
+    Timeline golden, actual;
+    for (Timeline* t : {&golden, &actual}) {
+        const SignalId pd2 = t->add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+        const SignalId pd3 = t->add_signal({"uno", "PD3", SignalKind::Wire, 1, 16000000});
+        const SignalId tx = t->add_signal({"uno", "uart0_tx", SignalKind::Bus, 8, 16000000});
+        for (int i = 0; i < 20; ++i) {
+            const Cycle at = 1000 + 400 * static_cast<Cycle>(i);
+            t->record(pd2, at, 1);
+            t->record(pd2, at + 100, 0);
+            const Cycle late = (t == &actual && i == 10) ? 31 : 0;
+            t->record(pd3, at + late, 1);
+            t->record(pd3, at + late + 100, 0);
+        }
+        t->record(tx, 50000, 'o');
+        t->record(tx, 51360, t == &actual ? '\n' : 'k');
+    }
+    const auto result = compare_timelines(golden, actual, rule(RuleKind::Exact));
+    const std::string report = result.report();
+    // PD3 diverges at the golden edge 1000 + 400 * 10 = 5000 cycles (312.5 us),
+    // the UART at 51360 cycles (3.21 ms); both are listed with their time.
+    EXPECT_NE(report.find("0.000312500 s (cycle 5000)"), std::string::npos) << report;
+    EXPECT_NE(report.find("0.003210000 s (cycle 51360)"), std::string::npos) << report;
+    EXPECT_NE(report.find("0x0a '\\n' at cycle 51360"), std::string::npos) << report;  // bytes printed one way
+    EXPECT_EQ(report.find("uno.PD2 "), std::string::npos) << report;  // the matching channel is not listed...
+    EXPECT_NE(report.find("1 other channel matches"), std::string::npos) << report;  // ...only counted
 }
 
 TEST(TimelineCompare, TimingToleranceIsAbsolutePlusRelativeToTheInterval) {
