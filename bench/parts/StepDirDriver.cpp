@@ -134,6 +134,8 @@ StepDirDriver::StepDirDriver(std::string name, Mcu& clock, const ParamValues& pa
     sig_step_ = add_signal("step", false);
     sig_dir_ = add_signal("dir", false);
     sig_position_ = add_signal("position_steps", true);
+    // Outputs on (1) or off (0), as the ENABLE input and its pull-down decide.
+    sig_enabled_ = add_signal("enabled", false, 1);
 }
 
 // A minimum time in cycles, rounded up: a pulse of exactly that length passes.
@@ -146,6 +148,8 @@ Cycle StepDirDriver::cycles(double seconds) const {
     }
     return static_cast<Cycle>(cycles);
 }
+
+void StepDirDriver::start() { publish(sig_enabled_, enabled() ? 1 : 0); }
 
 bool StepDirDriver::enabled() const {
     // The A4988/DRV8825/TMC2208 enable inputs have pull-downs: unwired = enabled.
@@ -173,6 +177,7 @@ void StepDirDriver::on_input(std::size_t pin, bool level) {
         publish(sig_dir_, level ? 1 : 0);
         on_dir_change();
     } else if (pin == enable_pin_) {
+        publish(sig_enabled_, enabled() ? 1 : 0);
         for (auto& fn : output_listeners_) fn();
     }
 }

@@ -34,6 +34,7 @@ public:
     unsigned microsteps() const { return current_microsteps_; }       // resolution at the last step
     unsigned configured_microsteps() const { return configured_microsteps_; }
     bool enabled() const;
+    void start() override;
 
     // Called after every step that moved the position (the axis listens).
     void on_step(std::function<void(int delta_256)> fn) { step_listeners_.push_back(std::move(fn)); }
@@ -78,7 +79,7 @@ private:
     double peak_step_rate_hz_ = 0;
     bool have_active_edge_ = false, have_inactive_edge_ = false, have_dir_change_ = false;
     Cycle last_active_edge_ = 0, last_inactive_edge_ = 0, last_dir_change_ = 0;
-    std::size_t sig_step_, sig_dir_, sig_position_;
+    std::size_t sig_step_, sig_dir_, sig_position_, sig_enabled_;
     std::vector<std::function<void(int)>> step_listeners_;
     double current_a_, motor_supply_v_;
     std::vector<std::function<void()>> output_listeners_;

@@ -32,6 +32,19 @@ std::string gtkwave_name(const SignalInfo& info) {
     return name;
 }
 
+// gtkwave's trace flags (its TR_* bits): 0x20 right-justify, 0x02 hex,
+// 0x800 ASCII, 0x8000 analog interpolated, 0x20000 real.
+std::string trace_flags(const SignalInfo& info) {
+    switch (info.kind) {
+    case SignalKind::Wire: return "@28\n";
+    case SignalKind::Bus:
+        if (info.characters && info.width == 8) return "@820\n";
+        return info.width > 1 ? "@22\n" : "@28\n";
+    case SignalKind::Real: return "@8028\n";
+    }
+    return "@28\n";
+}
+
 }  // namespace
 
 std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, const std::string& save_file_name,
@@ -67,16 +80,29 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
         text += group_begin + group.scope + "\n";
         for (const SignalId id : group.signals) {
             const SignalInfo& info = infos[id];
-            switch (info.kind) {
-            case SignalKind::Wire: text += "@28\n"; break;
-            case SignalKind::Bus: text += info.width > 1 ? "@22\n" : "@28\n"; break;
-            case SignalKind::Real: text += "@8028\n"; break;
-            }
+            text += trace_flags(info);
             text += gtkwave_name(info) + "\n";
             if (info.kind == SignalKind::Real)
                 for (unsigned row = 0; row < options.analog_extra_rows; ++row) text += "@20000\n-\n";
         }
         text += "@1000200\n-" + group.scope + "\n";
+    }
+    // Aliases (net and label names) as groups of their own, shown like their targets.
+    std::vector<std::string> alias_scopes;
+    for (const auto& a : timeline.aliases()) {
+        if (std::find(alias_scopes.begin(), alias_scopes.end(), a.scope) == alias_scopes.end()) alias_scopes.push_back(a.scope);
+    }
+    for (const auto& scope : alias_scopes) {
+        if (std::any_of(groups.begin(), groups.end(), [&](const ScopeGroup& g) { return g.scope == scope; })) continue;
+        text += group_begin + scope + "\n";
+        for (const auto& a : timeline.aliases()) {
+            if (a.scope != scope) continue;
+            SignalInfo shown = infos[a.target];
+            shown.scope = a.scope;
+            shown.name = a.name;
+            text += trace_flags(shown) + gtkwave_name(shown) + "\n";
+        }
+        text += "@1000200\n-" + scope + "\n";
     }
     return text;
 }

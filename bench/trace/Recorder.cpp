@@ -51,7 +51,7 @@ SignalId Recorder::trace_pin(Mcu& mcu, Pin& pin) {
 
 SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
     const SignalId id = timeline_.add_signal(
-        {mcu.name(), "uart" + std::to_string(uart.index()) + "_tx", SignalKind::Bus, 8, mcu.frequency_hz()});
+        {mcu.name(), "uart" + std::to_string(uart.index()) + "_tx", SignalKind::Bus, 8, mcu.frequency_hz(), true});
     Timeline* timeline = &timeline_;
     uart.on_transmit([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
     return id;

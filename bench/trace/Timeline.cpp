@@ -47,6 +47,17 @@ SignalId Timeline::add_signal(SignalInfo info) {
     return id;
 }
 
+void Timeline::add_alias(SignalId target, const std::string& scope, const std::string& name) {
+    if (target >= signals_.size()) throw std::invalid_argument("alias " + scope + "." + name + ": no such signal");
+    if (scope.empty() || name.empty() || has_whitespace(scope) || has_whitespace(name)) {
+        throw std::invalid_argument("alias '" + scope + "." + name + "': scope and name must be non-empty, without whitespace");
+    }
+    if (!index_.emplace(std::make_pair(scope, name), target).second) {
+        throw std::invalid_argument("alias " + scope + "." + name + ": the name is already used");
+    }
+    aliases_.push_back({target, scope, name});
+}
+
 long Timeline::find(const std::string& scope, const std::string& name) const {
     const auto it = index_.find(std::make_pair(scope, name));
     return it == index_.end() ? -1 : static_cast<long>(it->second);

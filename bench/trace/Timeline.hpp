@@ -28,9 +28,20 @@ struct SignalInfo {
     SignalKind kind = SignalKind::Wire;
     unsigned width = 1;                 // bits; 1 for Wire, ignored for Real
     std::uint32_t clock_hz = 16000000;  // clock domain whose cycles stamp this signal's events
+    bool characters = false;            // an 8-bit bus of characters (a UART): viewers show it as text
 };
 
 using SignalId = std::uint32_t;
+
+// Another name for a recorded signal: a board's net ("nets.x_step" for
+// uno.PD2) or label ("labels.heater_0"). Writers show it beside the signal
+// with the same values (in VCD, a second $var with the same identifier code),
+// so it costs no events.
+struct SignalAlias {
+    SignalId target;
+    std::string scope;
+    std::string name;
+};
 
 struct TimelineEvent {
     Cycle cycle;
@@ -69,6 +80,11 @@ public:
     // instruction, so writers that need global order sort by time.
     const std::vector<TimelineEvent>& events() const { return events_; }
 
+    // Adds `scope.name` as another name of `target`. Same checks as
+    // add_signal (no empty or whitespace names, no name used twice).
+    void add_alias(SignalId target, const std::string& scope, const std::string& name);
+    const std::vector<SignalAlias>& aliases() const { return aliases_; }
+
     // Returns the signal with that scope and name, or -1.
     long find(const std::string& scope, const std::string& name) const;
 
@@ -78,6 +94,7 @@ public:
 private:
     std::vector<SignalInfo> signals_;
     std::vector<TimelineEvent> events_;
+    std::vector<SignalAlias> aliases_;
     std::map<std::pair<std::string, std::string>, SignalId> index_;  // (scope, name) -> id
 };
 

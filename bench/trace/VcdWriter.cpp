@@ -203,21 +203,33 @@ private:
         out_.text(" $end\n");
 
         const auto& infos = timeline_.signals();
-        for (const ScopeGroup& group : group_by_scope(timeline_)) {
+        auto declare = [&](SignalId id, const std::string& name) {
+            const SignalState& s = signals_[id];
+            out_.text(s.kind == SignalKind::Real ? "$var real 64 " : "$var wire ");
+            if (s.kind != SignalKind::Real) {
+                out_.number(s.width);
+                out_.character(' ');
+            }
+            out_.text(s.code);
+            out_.character(' ');
+            out_.text(name);
+            out_.text(" $end\n");
+        };
+        // Signals by scope, then aliases (same identifier code as their target)
+        // in their scope: a scope is one $scope block whoever declared it.
+        std::vector<ScopeGroup> groups = group_by_scope(timeline_);
+        for (const auto& alias : timeline_.aliases()) {
+            if (std::none_of(groups.begin(), groups.end(), [&](const ScopeGroup& g) { return g.scope == alias.scope; })) {
+                groups.push_back(ScopeGroup{alias.scope, {}});
+            }
+        }
+        for (const ScopeGroup& group : groups) {
             out_.text("$scope module ");
             out_.text(group.scope);
             out_.text(" $end\n");
-            for (const SignalId id : group.signals) {
-                const SignalState& s = signals_[id];
-                out_.text(s.kind == SignalKind::Real ? "$var real 64 " : "$var wire ");
-                if (s.kind != SignalKind::Real) {
-                    out_.number(s.width);
-                    out_.character(' ');
-                }
-                out_.text(s.code);
-                out_.character(' ');
-                out_.text(infos[id].name);
-                out_.text(" $end\n");
+            for (const SignalId id : group.signals) declare(id, infos[id].name);
+            for (const auto& alias : timeline_.aliases()) {
+                if (alias.scope == group.scope) declare(alias.target, alias.name);
             }
             out_.text("$upscope $end\n");
         }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 #include <set>
 
 #include "core/Units.hpp"
@@ -88,15 +90,28 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
 void Bench::trace_board() {
     if (traced_) return;
     traced_ = true;
-    std::set<std::string> traced_pins;
-    auto trace = [&](const Endpoint& e) {
-        if (board_->spec().find_mcu(e.owner) == nullptr || !traced_pins.insert(e.text()).second) return;
-        recorder_.trace_pin(board_->mcu(e.owner), board_->mcu(e.owner).pin(e.pin));
+    std::map<std::string, SignalId> traced_pins;  // "uno.PD2" -> its signal
+    auto trace = [&](const Endpoint& e) -> std::optional<SignalId> {
+        if (board_->spec().find_mcu(e.owner) == nullptr) return std::nullopt;
+        auto it = traced_pins.find(e.text());
+        if (it != traced_pins.end()) return it->second;
+        const SignalId id = recorder_.trace_pin(board_->mcu(e.owner), board_->mcu(e.owner).pin(e.pin));
+        traced_pins.emplace(e.text(), id);
+        return id;
     };
+    // Each net and label is also shown under its board-file name (a VCD
+    // alias of the MCU pin that drives or reads it: no extra events).
     for (const auto& net : board_->spec().nets) {
-        for (const auto& e : net.endpoints) trace(e);
+        std::optional<SignalId> pin;
+        for (const auto& e : net.endpoints) {
+            const auto id = trace(e);
+            if (!pin) pin = id;
+        }
+        if (pin) timeline_.add_alias(*pin, "nets", net.name);
     }
-    for (const auto& label : board_->spec().labels) trace(label.endpoint);
+    for (const auto& label : board_->spec().labels) {
+        if (const auto id = trace(label.endpoint)) timeline_.add_alias(*id, "labels", label.name);
+    }
     for (const auto& s : board_->spec().serial) {
         Mcu& m = board_->mcu(s.mcu);
         recorder_.trace_uart_tx(m, m.uart(s.usart));

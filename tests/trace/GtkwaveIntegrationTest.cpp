@@ -116,7 +116,7 @@ TEST(GtkwaveAcceptsOurFiles, VcdConvertsToFstAndBackUnchanged) {
 // prints "KEY value" lines; returns them. xvfb-run -a can lose a race for a
 // display number with another X server starting, so a failed start is retried.
 std::map<std::string, std::string> run_gtkwave(const ScratchDir& dir, const std::string& gtkw,
-                                                const std::string& tcl_body) {
+                                                const std::string& tcl_body, const std::string& cwd = "/") {
     const std::string xvfb_run = require_tool("xvfb-run");
     const std::string gtkwave = require_tool("gtkwave");
     if (xvfb_run.empty() || gtkwave.empty()) return {};
@@ -128,7 +128,7 @@ std::map<std::string, std::string> run_gtkwave(const ScratchDir& dir, const std:
                                        "gtkwave::/File/Quit\n");
     const std::string log = dir.file("gtkwave.log");
     // Run from another directory: the save file's relative [dumpfile] must still resolve.
-    const std::string command = "cd / && timeout 120 " + quoted(xvfb_run) + " -a " + quoted(gtkwave) +
+    const std::string command = "cd " + quoted(cwd) + " && timeout 120 " + quoted(xvfb_run) + " -a " + quoted(gtkwave) +
                                 " --script=" + quoted(script) + " " + quoted(gtkw);
     std::string output;
     for (int attempt = 0; attempt < 3; ++attempt) {
@@ -212,6 +212,40 @@ TEST(GtkwaveAcceptsOurFiles, ViewerLoadsNineThousandSignals) {
     EXPECT_EQ(values["TRACES"], "9180");  // 9000 signals + 2 group markers x 90 scopes
     EXPECT_EQ(values["BEFORE"], "0");
     EXPECT_EQ(values["AT"], "1/1/1");
+}
+
+// A board run through the CLI, opened the way a user would: from the traces
+// folder (`cd traces && gtkwave u.gtkw`) and from elsewhere. Labels appear
+// under their board-file names, the UART as text.
+TEST(GtkwaveAcceptsOurFiles, CliRunOpensFromAnyFolderWithLabelsAndUartText) {
+    ScratchDir dir;
+    std::filesystem::create_directories(dir.file("traces"));
+    trace_test::write_text(dir.file("in.txt"), "hi\n");
+    trace_test::run_command("cd " + quoted(dir.file("")) + " && " + quoted(AVRBENCH_CLI) + " run -q --board " +
+                                quoted(std::string(AVRBENCH_SOURCE_DIR) + "/bench/boards/arduino-uno.yaml") + " " +
+                                quoted(std::string(AVRBENCH_FIRMWARE_DIR) + "/uart_echo.elf") +
+                                " --for 5ms --uart-in in.txt --vcd traces/u.vcd",
+                            dir.file("run.log"));
+    // uart_echo's banner "avrbench uart_echo\r\n" goes out one frame per
+    // 1360 cycles = 85 us from the first at 27500 x 100 ps = 2.75 us:
+    // at 1 ms the 12th frame (index 11) is on the line, 'r' of "uart_echo"
+    // (2.75 us + 11 * 85 us = 937.75 us <= 1 ms < 1022.75 us).
+    const std::string tcl =
+        "set n [gtkwave::getTotalNumTraces]\n"
+        "for {set i 0} {$i < $n} {incr i} {\n"
+        "  puts \"TRACE$i [gtkwave::getTraceNameFromIndex $i]/[format %x [gtkwave::getTraceFlagsFromIndex $i]]\"\n"
+        "}\n"
+        "gtkwave::setMarker 1000000000\n"
+        "puts \"AT1ms [gtkwave::getTraceValueAtMarkerFromName {uno.uart0_tx[7:0]}]/"
+        "[gtkwave::getTraceValueAtMarkerFromName labels.led]\"\n";
+    for (const std::string& cwd : {dir.file("traces"), std::string("/")}) {
+        const std::string gtkw = cwd == "/" ? dir.file("traces/u.gtkw") : "u.gtkw";
+        auto values = run_gtkwave(dir, gtkw, tcl, cwd);
+        if (values.empty()) return;
+        EXPECT_EQ(values["TRACE3"], "uart0_tx[7:0]/820") << cwd;  // 0x800 ASCII | 0x20 right-justified
+        EXPECT_EQ(values["TRACE6"], "led/28") << cwd;               // the D13 LED label of the board file
+        EXPECT_EQ(values["AT1ms"], "r/0") << cwd;
+    }
 }
 
 }  // namespace
