@@ -61,6 +61,7 @@ void Part::inject_fault(const std::string& fault, Cycle at_cycle) {
     }
     clock_->scheduler().at(at_cycle, [this, fault](Cycle) {
         fault_ = fault;
+        fault_history_.push_back({clock_->cycle(), fault});
         apply_fault(fault);
     });
 }

@@ -81,6 +81,12 @@ public:
     void inject_fault(const std::string& fault, Cycle at_cycle);
     void inject_fault_at_seconds(const std::string& fault, double seconds);
     const std::string& fault() const { return fault_; }
+    // Every fault that took effect, with the cycle it did (for reports).
+    struct FaultEvent {
+        Cycle cycle;
+        std::string fault;
+    };
+    const std::vector<FaultEvent>& fault_history() const { return fault_history_; }
 
     // Signals for the trace recorder, and a subscription to their changes.
     const std::vector<PartSignalInfo>& signals() const { return signal_infos_; }
@@ -118,6 +124,7 @@ private:
     std::vector<double> signal_values_;
     std::vector<SignalListener> signal_listeners_;
     std::string fault_ = "none";
+    std::vector<FaultEvent> fault_history_;
 };
 
 }  // namespace avrbench

@@ -42,6 +42,7 @@ constexpr std::size_t kNoLimit = std::numeric_limits<std::size_t>::max();
 constexpr std::array<const char*, 8> kPalette = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
                                                  "#9467bd", "#8c564b", "#e377c2", "#17becf"};
 const char* palette(std::size_t i) { return kPalette[i % kPalette.size()]; }
+constexpr const char* kFaultColor = "#e66100";
 
 constexpr const char* kToolpathColor = "#1f77b4";
 constexpr const char* kGoldenColor = "#8fbce6";
@@ -327,8 +328,32 @@ DataPoints mean_points(const Series& s, double t0, double t1, int columns) {
     return out;
 }
 
+// Velocity as a step function of time, from the intervals between position
+// changes: over (t[i-1], t[i]] the axis moved v[i] - v[i-1] in t[i] - t[i-1].
+// A constant step rate gives a constant velocity whatever the plot's
+// resolution (no aliasing against pixel columns). An interval over 4x longer
+// than the next one is rest (a pause between moves, or the time from the
+// start of the trace to a move's first step; an AVR446 ramp shortens its
+// intervals by less than 2x per step). After the last change the axis
+// stands still.
+Series step_velocity(const Series& position) {
+    Series out;
+    if (position.size() < 2) return out;
+    out.push_back({0, 0});
+    for (std::size_t i = 1; i < position.size(); ++i) {
+        const double dt = position[i].t - position[i - 1].t;
+        if (dt <= 0) continue;
+        const double next_dt = i + 1 < position.size() ? position[i + 1].t - position[i].t : dt;
+        const bool pause = dt > 4 * next_dt;
+        out.push_back({position[i - 1].t, pause ? 0.0 : (position[i].v - position[i - 1].v) / dt});
+    }
+    out.push_back({position.back().t, 0});
+    normalize(out);
+    return out;
+}
+
 // Average velocity per column of [t0, t1] (units per second); see the header.
-std::vector<double> column_velocity(const Series& s, double t0, double t1, int columns) {
+[[maybe_unused]] std::vector<double> column_velocity(const Series& s, double t0, double t1, int columns) {
     std::vector<double> moved(static_cast<std::size_t>(columns), 0.0);
     if (s.size() < 2 || t1 <= t0) return moved;
     const double w = (t1 - t0) / columns;
@@ -527,6 +552,7 @@ struct TimePlot {
     std::vector<HLine> hlines;
     std::vector<LegendItem> extra_legend;
     std::optional<VMarker> marker;
+    std::vector<VMarker> events;                    // injected faults: dotted orange lines
     std::optional<std::pair<double, double>> shade;  // a time window to highlight
 };
 
@@ -615,6 +641,16 @@ std::string render_time_plot(const TimePlot& plot) {
                kDivergenceColor + "\">" + esc(plot.marker->label) + "</text>";
     }
 
+    for (const VMarker& e : plot.events) {
+        if (e.t < plot.t0 || e.t > plot.t1) continue;
+        const double px = x(e.t);
+        out += "<g class=\"fault-marker\" data-t=\"" + exact(e.t) + "\"><line x1=\"" + fixed(px, 1) + "\" y1=\"" +
+               std::to_string(T) + "\" x2=\"" + fixed(px, 1) + "\" y2=\"" + std::to_string(T + PH) + "\" stroke=\"" +
+               kFaultColor + "\" stroke-width=\"1.5\" stroke-dasharray=\"2 3\"><title>" + esc(e.label) +
+               "</title></line><text x=\"" + fixed(px + 4, 1) + "\" y=\"" + std::to_string(T + 12) + "\" fill=\"" +
+               kFaultColor + "\">" + esc(e.label) + "</text></g>";
+    }
+
     std::vector<LegendItem> legend;
     for (const PlotSeries& s : plot.series) legend.push_back({s.name, s.color, std::max(2.0, s.width), s.dash, ""});
     for (const LegendItem& item : plot.extra_legend) legend.push_back(item);
@@ -629,6 +665,7 @@ std::string render_time_plot(const TimePlot& plot) {
 struct Context {
     const RunReport& report;
     double end_s = 0;  // time axis of the run's plots: [0, end_s]
+    std::vector<VMarker> fault_markers;  // drawn on every time plot
 };
 
 std::string plot_block(const std::string& heading, const std::string& svg) {
@@ -666,9 +703,13 @@ void append_findings(std::string& out, const RunReport& report) {
         out += "</td></tr>\n";
     }
     out += "</tbody></table>\n";
-    if (report.findings.size() > rows)
-        out += "<p class=\"note\">" + std::to_string(report.findings.size() - rows) + " more findings not shown (" +
-               std::to_string(report.findings.size()) + " in all).</p>\n";
+    if (report.findings.size() > rows) {
+        // The same summary line as the CLI prints: a count per kind and source.
+        const auto summary = summarize_findings(report.findings, rows);
+        out += "<p class=\"note\" id=\"findings-more\">";
+        append_escaped(out, summary.back());
+        out += " (" + std::to_string(report.findings.size()) + " in all)</p>\n";
+    }
     out += "</section>\n";
 }
 
@@ -731,10 +772,17 @@ Range value_range(const std::vector<const Series*>& all, double t0, double t1, b
 void append_comparison(std::string& out, const Context& ctx) {
     const ComparisonView& cmp = *ctx.report.comparison;
     out += "<section id=\"comparison-section\"><h2>Comparison with the golden timeline</h2>\n";
-    out += std::string("<p id=\"comparison-summary\"><span class=\"badge ") + (cmp.passed ? "good\">passed" : "bad\">FAILED") +
-           "</span> ";
-    append_escaped(out, cmp.summary);
-    out += "</p>\n";
+    out += std::string("<p><span class=\"badge ") + (cmp.passed ? "good\">passed" : "bad\">FAILED") + "</span></p>\n";
+    // The diff as the CLI prints it: one <pre>, its line breaks kept.
+    out += "<pre id=\"comparison-summary\">";
+    std::size_t at = 0;
+    while (at <= cmp.summary.size()) {
+        const std::size_t nl = std::min(cmp.summary.find('\n', at), cmp.summary.size());
+        append_escaped(out, std::string_view(cmp.summary).substr(at, nl - at));
+        if (nl < cmp.summary.size()) out += '\n';
+        at = nl + 1;
+    }
+    out += "</pre>\n";
     const double div_t = to_seconds(cmp.first_divergence_cycle, cmp.first_divergence_clock_hz);
     if (!cmp.first_divergence_signal.empty())
         out += "<p>First divergence: <b class=\"mono\">" + esc(cmp.first_divergence_signal) + "</b> at " +
@@ -1084,8 +1132,7 @@ void append_motion(std::string& out, const Context& ctx) {
     out += "<section id=\"velocity-section\"><h2>Axis velocity</h2>\n";
     for (std::size_t i = 0; i < report.axes.size(); ++i) {
         const AxisSeries& axis = report.axes[i];
-        const std::vector<double> v = column_velocity(series[i], 0, ctx.end_s, kTimePlotWidth);
-        const double w = ctx.end_s / kTimePlotWidth;
+        const Series velocity = step_velocity(series[i]);
         TimePlot plot;
         plot.id = "velocity-" + id_fragment(axis.name);
         plot.title = "velocity of axis " + axis.name;
@@ -1093,12 +1140,18 @@ void append_motion(std::string& out, const Context& ctx) {
         plot.t0 = 0, plot.t1 = ctx.end_s;
         const std::string unit = axis.rotary ? "deg/s" : "mm/s";
         plot.y_label = axis.name + " [" + unit + "]";
-        const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-        plot.y = nice_range(*lo, *hi, true, 4);
+        double lo = 0, hi = 0;
+        for (const Sample& x : velocity) lo = std::min(lo, x.v), hi = std::max(hi, x.v);
+        plot.y = nice_range(lo, hi, true, 4);
+        // A margin beyond zero, so an axis at rest is drawn inside the frame,
+        // not hidden under its edge.
+        const double margin = 0.05 * (plot.y.hi - plot.y.lo);
+        if (plot.y.lo == 0) plot.y.lo = -margin;
+        if (plot.y.hi == 0) plot.y.hi = margin;
         plot.height = 120;
-        PlotSeries s{axis.name + " velocity [" + unit + "]", palette(i), {}, 1.6, 1, ""};
-        for (std::size_t c = 0; c < v.size(); ++c) s.points.emplace_back((static_cast<double>(c) + 0.5) * w, v[c]);
-        plot.series.push_back(std::move(s));
+        plot.events = ctx.fault_markers;
+        plot.series.push_back({axis.name + " velocity [" + unit + "]", palette(i),
+                               velocity.empty() ? DataPoints{} : step_points(velocity, 0, ctx.end_s, kTimePlotWidth), 1.6, 1, ""});
         out += plot_block("axis " + axis.name + ": " + std::to_string(series[i].size()) + " position changes",
                           render_time_plot(plot));
     }
@@ -1108,10 +1161,6 @@ void append_motion(std::string& out, const Context& ctx) {
 void append_thermal(std::string& out, const Context& ctx) {
     const RunReport& report = ctx.report;
     if (report.timeline == nullptr || report.temperatures.empty()) return;
-    std::vector<SignalId> ids;
-    for (const TemperatureSeries& t : report.temperatures) ids.push_back(t.temperature_degC);
-    const std::vector<Series> temps = extract(*report.timeline, ids);
-
     out += "<section id=\"thermal-section\"><h2>Temperatures and heater duty</h2>\n";
     TimePlot plot;
     plot.id = "temperatures";
@@ -1119,44 +1168,67 @@ void append_thermal(std::string& out, const Context& ctx) {
     plot.t0 = 0, plot.t1 = ctx.end_s;
     plot.y_label = "temperature [\xc2\xb0" "C]";
     plot.height = 200;
+    plot.events = ctx.fault_markers;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Series& s : temps)
+    auto widen = [&](const Series& s) {
         for (const Sample& x : s) lo = std::min(lo, x.v), hi = std::max(hi, x.v);
-    for (const TemperatureSeries& t : report.temperatures)
-        if (t.target_degC && std::isfinite(*t.target_degC)) lo = std::min(lo, *t.target_degC), hi = std::max(hi, *t.target_degC);
-    if (lo > hi) lo = 0, hi = 100;
-    plot.y = nice_range(lo, hi, false);
-    for (std::size_t i = 0; i < temps.size(); ++i) {
+    };
+    for (std::size_t i = 0; i < report.temperatures.size(); ++i) {
         const TemperatureSeries& t = report.temperatures[i];
-        plot.series.push_back({t.name, palette(i), step_points(temps[i], 0, ctx.end_s, kTimePlotWidth), 1.8, 1, ""});
+        const Series block = extract(*report.timeline, {t.temperature_degC}).front();
+        widen(block);
+        plot.series.push_back({t.name + " block", palette(i), step_points(block, 0, ctx.end_s, kTimePlotWidth), 1.8, 1, ""});
+        if (t.sensor_degC) {
+            const Series sensor = extract(*report.timeline, {*t.sensor_degC}).front();
+            widen(sensor);
+            plot.series.push_back({t.name + " sensor", palette(i), step_points(sensor, 0, ctx.end_s, kTimePlotWidth), 1.2,
+                                   0.8, "4 2"});
+        }
+        if (!t.target_steps.empty()) {
+            // The target holds from each command to the next, and to the end.
+            Series target;
+            for (const auto& [at, degC] : t.target_steps) target.push_back({at, degC});
+            normalize(target);
+            widen(target);
+            DataPoints points;
+            for (std::size_t k = 0; k < target.size(); ++k) {
+                const double until = k + 1 < target.size() ? target[k + 1].t : ctx.end_s;
+                points.emplace_back(target[k].t, target[k].v);
+                points.emplace_back(until, target[k].v);
+            }
+            plot.series.push_back({t.name + " target", palette(i), points, 1.2, 1, "8 4"});
+        }
         if (t.target_degC && std::isfinite(*t.target_degC)) {
+            lo = std::min(lo, *t.target_degC), hi = std::max(hi, *t.target_degC);
             plot.hlines.push_back({*t.target_degC, palette(i), t.name + " target " + fixed(*t.target_degC, 1) + " \xc2\xb0" "C"});
             plot.extra_legend.push_back({t.name + " target", palette(i), 1.2, "6 4", ""});
         }
     }
-    out += plot_block("temperature against time", render_time_plot(plot));
+    if (lo > hi) lo = 0, hi = 100;
+    plot.y = nice_range(lo, hi, false);
+    out += plot_block("temperature against time (block, sensor, target)", render_time_plot(plot));
 
-    std::vector<SignalId> duty_ids;
-    std::vector<std::size_t> duty_of;
-    for (std::size_t i = 0; i < report.temperatures.size(); ++i)
-        if (report.temperatures[i].duty) duty_ids.push_back(*report.temperatures[i].duty), duty_of.push_back(i);
-    if (!duty_ids.empty()) {
-        std::vector<Series> duties = extract(*report.timeline, duty_ids);
-        TimePlot dplot;
-        dplot.id = "heater-duty";
-        dplot.title = "heater duty";
-        dplot.t0 = 0, dplot.t1 = ctx.end_s;
-        dplot.y_label = "duty [%]";
-        dplot.y = {0, 100, 25};
-        dplot.height = 110;
-        for (std::size_t k = 0; k < duties.size(); ++k) {
-            for (Sample& x : duties[k]) x.v *= 100;
-            const std::size_t i = duty_of[k];
-            dplot.series.push_back({report.temperatures[i].name + " heater", palette(i),
-                                    mean_points(duties[k], 0, ctx.end_s, kTimePlotWidth), 1.4, 1, ""});
-        }
-        out += plot_block("heater duty against time", render_time_plot(dplot));
+    TimePlot dplot;
+    dplot.id = "heater-duty";
+    dplot.title = "heater duty";
+    dplot.t0 = 0, dplot.t1 = ctx.end_s;
+    dplot.y_label = "duty [%]";
+    // 0..100 % with a margin, so a heater at 100 % is drawn inside the frame.
+    dplot.y = {-5, 105, 25};
+    dplot.height = 110;
+    dplot.events = ctx.fault_markers;
+    for (std::size_t i = 0; i < report.temperatures.size(); ++i) {
+        const TemperatureSeries& t = report.temperatures[i];
+        // The gate itself, averaged per pixel column: the duty where it
+        // changes, not one sample window later.
+        const std::optional<SignalId> source = t.heater_on ? t.heater_on : t.duty;
+        if (!source) continue;
+        Series duty = extract(*report.timeline, {*source}).front();
+        if (duty.empty()) continue;
+        for (Sample& x : duty) x.v *= 100;
+        dplot.series.push_back({t.name + " heater", palette(i), mean_points(duty, 0, ctx.end_s, kTimePlotWidth), 1.4, 1, ""});
     }
+    if (!dplot.series.empty()) out += plot_block("heater duty against time (gate on-time per pixel column)", render_time_plot(dplot));
     out += "</section>\n";
 }
 
@@ -1184,8 +1256,8 @@ void append_servos(std::string& out, const Context& ctx) {
 
 void append_transcript_line(std::string& out, const TranscriptLine& line) {
     out += line.from_host ? "<span class=\"from-host\">" : "<span class=\"from-firmware\">";
-    char t[48];
-    std::snprintf(t, sizeof t, "%10.6f s ", to_seconds(line.cycle, line.clock_hz));
+    char t[64];
+    std::snprintf(t, sizeof t, "%10.6f s %11llu ", to_seconds(line.cycle, line.clock_hz), static_cast<unsigned long long>(line.cycle));
     out += "<span class=\"t\">";
     out += t;
     out += "</span>";
@@ -1272,7 +1344,7 @@ footer { color: #6b7380; font-size: 12px; text-align: center; margin: 12px 0 20p
 }  // namespace
 
 std::string format_html_report(const RunReport& report) {
-    Context ctx{report};
+    Context ctx{report, 0, {}};
     ctx.end_s = to_seconds(report.end_cycle, report.end_clock_hz);
     if (report.timeline != nullptr) {
         // The time axis reaches the last event of any plotted signal.
@@ -1280,6 +1352,8 @@ std::string format_html_report(const RunReport& report) {
         for (const auto& a : report.axes) ids.push_back(a.position);
         for (const auto& t : report.temperatures) {
             ids.push_back(t.temperature_degC);
+            if (t.sensor_degC) ids.push_back(*t.sensor_degC);
+            if (t.heater_on) ids.push_back(*t.heater_on);
             if (t.duty) ids.push_back(*t.duty);
         }
         for (const auto& s : report.servos) ids.push_back(s.angle_deg);
@@ -1295,6 +1369,11 @@ std::string format_html_report(const RunReport& report) {
                 ctx.end_s = std::max(ctx.end_s, to_seconds(e.cycle, signals[e.signal].clock_hz));
     }
     if (!(ctx.end_s > 0)) ctx.end_s = 1e-3;
+    for (const FaultMarker& f : report.faults) {
+        char cycle[40];
+        std::snprintf(cycle, sizeof cycle, " (%s, cycle %llu)", seconds_text(f.t_s).c_str(), static_cast<unsigned long long>(f.cycle));
+        ctx.fault_markers.push_back({f.t_s, "fault " + f.label + cycle});
+    }
 
     std::string out;
     out.reserve(1 << 16);

@@ -21,10 +21,21 @@ struct AxisSeries {
 };
 
 struct TemperatureSeries {
-    std::string name;                  // "hotend"
-    SignalId temperature_degC;         // real
-    std::optional<SignalId> duty;      // real 0..1 (heater duty), if known
-    std::optional<double> target_degC;
+    std::string name;                       // "hotend"
+    SignalId temperature_degC;              // real: the heated block
+    std::optional<SignalId> sensor_degC;    // real: what the thermistor sees (lags the block)
+    std::optional<SignalId> heater_on;      // wire: the heater gate; its time average is the duty
+    std::optional<SignalId> duty;           // real 0..1 per sample window (used when heater_on is absent)
+    std::optional<double> target_degC;      // a fixed target
+    // Targets set during the run (M104/M109/M140/M190 S..): (time [s], degC).
+    std::vector<std::pair<double, double>> target_steps;
+};
+
+// A fault injected into a part, drawn as a marker on the time plots.
+struct FaultMarker {
+    double t_s = 0;
+    Cycle cycle = 0;
+    std::string label;  // "heater: disconnected"
 };
 
 struct ServoSeries {
@@ -67,6 +78,7 @@ struct RunReport {
     std::vector<TemperatureSeries> temperatures;
     std::vector<ServoSeries> servos;
     std::vector<TranscriptLine> transcript;
+    std::vector<FaultMarker> faults;
     std::vector<Finding> findings;
     std::optional<ComparisonView> comparison;
 };

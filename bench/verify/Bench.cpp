@@ -1,7 +1,9 @@
 #include "verify/Bench.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <optional>
 #include <set>
@@ -12,6 +14,23 @@
 #include "parts/ThermalPlant.hpp"
 
 namespace avrbench {
+
+std::map<char, double> gcode_words(const std::string& line) {
+    std::map<char, double> words;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (c == ';' || c == '*' || c == '(') break;  // comment or checksum
+        if (!std::isalpha(static_cast<unsigned char>(c))) continue;
+        const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        const char* begin = line.c_str() + i + 1;
+        char* end = nullptr;
+        const double value = std::strtod(begin, &end);
+        if (end == begin || !std::isfinite(value)) continue;
+        words.emplace(letter, value);
+        i += static_cast<std::size_t>(end - begin);
+    }
+    return words;
+}
 
 const char* to_string(IdleResult result) {
     switch (result) {
@@ -180,17 +199,60 @@ RunReport Bench::make_report(const std::string& title) const {
         const long id = timeline_.find(a->name(), a->rotary() ? "angle_deg" : "position_mm");
         if (id >= 0) r.axes.push_back({a->name(), static_cast<SignalId>(id), a->rotary()});
     }
-    for (ThermalPlant* plant : board_->parts_of_type<ThermalPlant>()) {
+    // Temperature targets from the G-code the hosts sent: M104/M109 S.. set a
+    // tool heater (T<n> picks the n-th plant that is not a bed), M140/M190 S..
+    // the plant whose name contains "bed".
+    std::vector<ThermalPlant*> plants = board_->parts_of_type<ThermalPlant>();
+    std::vector<ThermalPlant*> tools;
+    ThermalPlant* bed = nullptr;
+    for (ThermalPlant* p : plants) {
+        if (p->name().find("bed") != std::string::npos) {
+            if (bed == nullptr) bed = p;
+        } else {
+            tools.push_back(p);
+        }
+    }
+    std::map<const ThermalPlant*, std::vector<std::pair<double, double>>> targets;
+    for (const auto& [name, host] : hosts_) {
+        const std::uint32_t hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
+        for (const auto& e : host->transcript()) {
+            if (e.direction != Direction::Sent) continue;
+            const auto words = gcode_words(e.text);
+            const auto m = words.find('M'), target = words.find('S');
+            if (m == words.end() || target == words.end()) continue;
+            const ThermalPlant* plant = nullptr;
+            if (m->second == 140 || m->second == 190) {
+                plant = bed;
+            } else if (m->second == 104 || m->second == 109) {
+                const auto tool = words.find('T');
+                const std::size_t index = tool == words.end() || tool->second < 0 ? 0 : static_cast<std::size_t>(tool->second);
+                plant = index < tools.size() ? tools[index] : nullptr;
+            }
+            if (plant != nullptr) targets[plant].emplace_back(static_cast<double>(e.cycle) / hz, target->second);
+        }
+    }
+    for (ThermalPlant* plant : plants) {
         const long temperature = timeline_.find(plant->name(), "block_degC");
         if (temperature < 0) continue;
         TemperatureSeries series;
         series.name = plant->name();
         series.temperature_degC = static_cast<SignalId>(temperature);
-        for (Heater* heater : board_->parts_of_type<Heater>()) {
-            const long duty = timeline_.find(heater->name(), "duty");
-            if (&heater->plant() == plant && duty >= 0) series.duty = static_cast<SignalId>(duty);
+        if (const long sensor = timeline_.find(plant->name(), "sensor_degC"); sensor >= 0) {
+            series.sensor_degC = static_cast<SignalId>(sensor);
         }
+        for (Heater* heater : board_->parts_of_type<Heater>()) {
+            if (&heater->plant() != plant) continue;
+            if (const long on = timeline_.find(heater->name(), "on"); on >= 0) series.heater_on = static_cast<SignalId>(on);
+            if (const long duty = timeline_.find(heater->name(), "duty"); duty >= 0) series.duty = static_cast<SignalId>(duty);
+        }
+        series.target_steps = targets[plant];
         r.temperatures.push_back(series);
+    }
+    for (Part* p : board_->parts()) {
+        for (const auto& f : p->fault_history()) {
+            r.faults.push_back({static_cast<double>(f.cycle) / p->clock().frequency_hz(), f.cycle,
+                                p->name() + ": " + (f.fault == "none" ? std::string("repaired") : f.fault)});
+        }
     }
     for (const auto& decl : board_->spec().serial) {
         Mcu& m = board_->mcu(decl.mcu);

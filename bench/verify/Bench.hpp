@@ -35,6 +35,10 @@ enum class IdleResult {
 
 const char* to_string(IdleResult result);
 
+// The words of one G-code line, letter (upper case) -> number, first of each
+// letter; stops at a ';' or '(' comment or a '*' checksum. "M104 S200 T1".
+std::map<char, double> gcode_words(const std::string& line);
+
 class Bench {
 public:
     // The ELF runs on the board's first MCU.

@@ -12,7 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "parts/Part.hpp"
 #include "report/HtmlReportTestSupport.hpp"
+#include "support/Paths.hpp"
+#include "verify/Bench.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/TraceTestSupport.hpp"
 
@@ -120,7 +123,7 @@ TEST(HtmlReport, RendersInHeadlessChromium) {
     const std::vector<std::pair<std::string, std::string>> plots = {
         {"toolpath", "path"},           {"toolpath-xz", "path"},         {"toolpath-yz", "path"},
         {"velocity-x", "x velocity [mm/s]"}, {"velocity-y", "y velocity [mm/s]"}, {"velocity-z", "z velocity [mm/s]"},
-        {"temperatures", "hotend"},     {"heater-duty", "hotend heater"}, {"servos", "servo0"},
+        {"temperatures", "hotend block"},     {"heater-duty", "hotend heater"}, {"servos", "servo0"},
         {"comparison-mcu-PD2", "golden"}, {"comparison-mcu-PD2", "actual"},
         {"comparison-mcu-PD2-detail", "actual"}, {"comparison-mcu-PD2-overview", "golden"}};
     for (const auto& [id, series] : plots) {
@@ -212,6 +215,87 @@ TEST(HtmlReport, RendersInHeadlessChromium) {
         std::filesystem::copy_file(html_path, std::string(keep) + ".html",
                                    std::filesystem::copy_options::overwrite_existing);
     }
+}
+
+// Reports of real bench runs, read back from the DOM chromium built: what
+// a person sees on the page, with numbers checked against hand calculations.
+std::string rendered_dom(const ScratchDir& dir, const RunReport& report, const std::string& name) {
+    const std::string chromium = trace_test::find_program("chromium");
+    if (chromium.empty()) {
+        ADD_FAILURE() << "chromium not found on PATH: run ci/setup";
+        return "";
+    }
+    const std::string html_path = dir.file(name + ".html");
+    write_html_report(report, html_path);
+    const std::string dom_path = dir.file(name + ".dom.html"), log = dir.file(name + ".log");
+    EXPECT_EQ(run_chromium(chromium, dir, name, "--dump-dom", "file://" + html_path, dom_path, log), 0) << read_text(log);
+    return read_text(dom_path);
+}
+
+TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
+    ScratchDir dir;
+    Bench bench(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), test::firmware("stepdir_test"));
+    bench.trace_board();
+    bench.host().add_lines("E1\nX1600\n");
+    ASSERT_EQ(bench.run_until_idle(2.0), IdleResult::Idle);
+    const std::string dom = rendered_dom(dir, bench.make_report("velocity"), "velocity");
+    const std::string svg = element(dom, "svg", "velocity-x");
+    ASSERT_NE(svg, "");
+    const PlotMapping map(svg);
+    const Points v = polyline(svg, "x velocity [mm/s]");
+    ASSERT_GE(v.size(), 4u);
+    // stepdir_test steps every 16 * (5 + 45) = 800 cycles = 50 us (20 kHz);
+    // the board's x axis has 250 steps/mm: 20000 / 250 = 80 mm/s, for
+    // 1600 steps = 80 ms. Every point while moving is that, none between.
+    double top = 0;
+    std::size_t moving = 0;
+    for (const auto& [px, py] : v) {
+        const double mm_s = map.data_y(py);
+        top = std::max(top, mm_s);
+        if (mm_s > 1) {
+            ++moving;
+            EXPECT_NEAR(mm_s, 80.0, 0.8) << "at " << map.data_x(px) << " s";
+        }
+    }
+    EXPECT_NEAR(top, 80.0, 0.8);
+    EXPECT_GE(moving, 2u);
+}
+
+TEST(HtmlReport, ThermalRunShowsSensorTargetDutyInsideTheFrameAndTheFault) {
+    ScratchDir dir;
+    Bench bench(test::source_path("bench/boards/ramps-1.4.yaml"), test::firmware("thermal_pid"));
+    bench.trace_board();
+    // thermal_pid reads no serial input: the line stays unanswered, but what
+    // the host sent sets the target drawn in the report.
+    bench.host().add_line("M104 S200");
+    bench.board().part("hotend_heater").inject_fault("disconnected", 16000000ull * 6);  // at 6 s
+    bench.run_for(10.0);
+    const RunReport report = bench.make_report("thermal");
+    const std::string dom = rendered_dom(dir, report, "thermal");
+    const std::string svg = element(dom, "svg", "temperatures");
+    ASSERT_NE(svg, "");
+    const PlotMapping map(svg);
+    EXPECT_GE(polyline(svg, "hotend block").size(), 2u);
+    EXPECT_GE(polyline(svg, "hotend sensor").size(), 2u);
+    const Points target = polyline(svg, "hotend target");
+    ASSERT_GE(target.size(), 2u);
+    EXPECT_NEAR(map.data_y(target.back().second), 200.0, 0.5);  // M104 S200
+    // The fault marker at 6 s, on the temperature plot and the duty plot.
+    const std::size_t marker = svg.find("<g class=\"fault-marker\"");
+    ASSERT_NE(marker, std::string::npos) << svg.substr(0, 400);
+    EXPECT_NEAR(number_attribute(svg.substr(marker), "data-t"), 6.0, 1e-3);
+    EXPECT_NE(svg.find("fault hotend_heater: disconnected"), std::string::npos);
+    const std::string duty = element(dom, "svg", "heater-duty");
+    ASSERT_NE(duty, "");
+    const PlotMapping dmap(duty);
+    const Points d = polyline(duty, "hotend heater");
+    ASSERT_GE(d.size(), 2u);
+    // The PID firmware starts at full power: 100 % drawn, and inside the frame.
+    double highest_px = 1e9;
+    for (const auto& p : d) highest_px = std::min(highest_px, p.second);
+    EXPECT_NEAR(dmap.data_y(highest_px), 100.0, 0.5);
+    EXPECT_GT(highest_px, dmap.top + 1.0);
+    EXPECT_NE(duty.find("fault-marker"), std::string::npos);
 }
 
 }  // namespace

@@ -186,7 +186,7 @@ TEST(HtmlReport, ThermalPlotDrawsTheTargetLineAndTheDutyInPercent) {
     ASSERT_NE(target, std::string::npos);
     EXPECT_NEAR(number_attribute(svg.substr(target), "y1"), map.pixel_y(210), 0.06);
     EXPECT_NE(svg.find("hotend target 210.0 \xc2\xb0" "C"), std::string::npos);
-    const Points temp = polyline(svg, "hotend");
+    const Points temp = polyline(svg, "hotend block");
     ASSERT_GE(temp.size(), 10u);
     EXPECT_NEAR(map.data_y(temp.front().second), 22 + (230 - 22) * 0.02, 0.2);
     EXPECT_NE(svg.find("temperature [\xc2\xb0" "C]"), std::string::npos);
@@ -194,11 +194,13 @@ TEST(HtmlReport, ThermalPlotDrawsTheTargetLineAndTheDutyInPercent) {
     const std::string duty = element(html, "svg", "heater-duty");
     ASSERT_NE(duty, "");
     const PlotMapping dmap(duty);
-    EXPECT_DOUBLE_EQ(dmap.y_min, 0);
-    EXPECT_DOUBLE_EQ(dmap.y_max, 100);
+    // 0..100 % with 5 % of margin each side: 100 % lies inside the frame.
+    EXPECT_DOUBLE_EQ(dmap.y_min, -5);
+    EXPECT_DOUBLE_EQ(dmap.y_max, 105);
     const Points d = polyline(duty, "hotend heater");
     ASSERT_GE(d.size(), 4u);
     EXPECT_NEAR(dmap.data_y(d.front().second), 100, 0.2);  // heats from the start
+    EXPECT_GT(d.front().second, dmap.top + 1.0);           // below the frame's top edge, visible
     EXPECT_NE(duty.find("duty [%]"), std::string::npos);
     EXPECT_NE(element(html, "svg", "servos").find("angle [deg]"), std::string::npos);
 }
@@ -208,8 +210,11 @@ TEST(HtmlReport, FailedComparisonOverlaysGoldenAndActualAroundTheDivergence) {
     add_everything(run);
     const std::string html = format_html_report(run.report);
     EXPECT_NE(html.find("golden: FAILED"), std::string::npos);
-    const std::string summary = element(html, "p", "comparison-summary");
-    EXPECT_NE(summary.find("FAILED"), std::string::npos);
+    const std::string summary = element(html, "pre", "comparison-summary");
+    EXPECT_NE(summary.find("FAIL: "), std::string::npos);
+    // Real line breaks, not the escaped text of one.
+    EXPECT_NE(summary.find("\nfirst divergence: "), std::string::npos) << summary;
+    EXPECT_EQ(summary.find("\\x0a"), std::string::npos) << summary;
     EXPECT_NE(summary.find("+40 cycles &gt; tolerance 8"), std::string::npos);
     const std::string channels = element(html, "table", "comparison-channels");
     EXPECT_NE(channels.find("<tr class=\"diverged\"><td class=\"mono\">mcu.PD2</td><td class=\"verdict\">timing"),
@@ -365,7 +370,10 @@ TEST(HtmlReport, FindingsTableHasKindSourceTimePcAndDetail) {
     run.report.findings.assign(layout::kMaxFindingRows + 7, run.report.findings[0]);
     const std::string many = format_html_report(run.report);
     EXPECT_EQ(count(element(many, "table", "findings"), "<tr class=\"finding\">"), layout::kMaxFindingRows);
-    EXPECT_NE(many.find("7 more findings not shown"), std::string::npos);
+    // The rest counted per kind and source, as the CLI summarizes them.
+    const std::string more = element(many, "p", "findings-more");
+    EXPECT_NE(more.find("... and 7 more: " + std::string(to_string(run.report.findings[0].kind)) + " (" +
+                        run.report.findings[0].source + ") x7"), std::string::npos) << more;
 }
 
 TEST(HtmlReport, LongTranscriptKeepsHeadAndTailWithANote) {
@@ -385,8 +393,9 @@ TEST(HtmlReport, LongTranscriptKeepsHeadAndTailWithANote) {
     EXPECT_NE(pre.find(" line 999;"), std::string::npos);
     EXPECT_NE(pre.find("601 lines omitted (1001 in all)"), std::string::npos);
     // Direction and time on every line; a long line is cut.
-    EXPECT_NE(pre.find("<span class=\"from-host\"><span class=\"t\">  0.000000 s </span>"), std::string::npos);
-    EXPECT_NE(pre.find("<span class=\"from-firmware\"><span class=\"t\">  0.000100 s </span>"), std::string::npos);
+    // Line 1 at cycle 1600 = 100 us at 16 MHz: both time and cycle shown.
+    EXPECT_NE(pre.find("<span class=\"from-host\"><span class=\"t\">  0.000000 s           0 </span>"), std::string::npos);
+    EXPECT_NE(pre.find("<span class=\"from-firmware\"><span class=\"t\">  0.000100 s        1600 </span>"), std::string::npos);
     EXPECT_NE(pre.find(std::string(layout::kMaxTranscriptChars, 'a') + "\xe2\x80\xa6"), std::string::npos);
     EXPECT_EQ(pre.find(std::string(layout::kMaxTranscriptChars + 1, 'a')), std::string::npos);
 }
@@ -427,7 +436,11 @@ TEST(HtmlReport, AMillionEventsStayWithinTheSizeBound) {
     run.report.timeline = run.timeline.get();
     run.report.end_cycle = cycle;
     run.report.axes = {{"x", run.x, false}, {"y", run.y, false}};
-    run.report.temperatures = {{"hotend", run.hotend, std::nullopt, 200.5}};
+    TemperatureSeries hotend;
+    hotend.name = "hotend";
+    hotend.temperature_degC = run.hotend;
+    hotend.target_degC = 200.5;
+    run.report.temperatures = {hotend};
     const std::string html = format_html_report(run.report);
 
     EXPECT_LT(html.size(), 600'000u);
@@ -441,9 +454,10 @@ TEST(HtmlReport, AMillionEventsStayWithinTheSizeBound) {
     const std::string d = attribute(toolpath.substr(coverage), "d").value_or("");
     EXPECT_GT(count(d, "z"), 100u);
     EXPECT_LE(count(d, "z"), 6000u);
+    // At most entering, min, max and leaving value per pixel column (step_points).
     EXPECT_LE(polyline(element(html, "svg", "velocity-x"), "x velocity [mm/s]").size(),
-              static_cast<std::size_t>(layout::kTimePlotWidth));
-    const Points temp = polyline(element(html, "svg", "temperatures"), "hotend");
+              4u * layout::kTimePlotWidth + 2);
+    const Points temp = polyline(element(html, "svg", "temperatures"), "hotend block");
     EXPECT_GT(temp.size(), static_cast<std::size_t>(layout::kTimePlotWidth));
     EXPECT_LE(temp.size(), 4u * layout::kTimePlotWidth + 2);
     // Min/max per column keeps the noise band: values near 200 and near 201.

@@ -106,11 +106,18 @@ inline void add_everything(DemoRun& run) {
     cmp.golden = std::move(golden);
     cmp.first_divergence_signal = "mcu.PD2";
     cmp.first_divergence_cycle = 1000 + 50 * 2000 + 40;
-    cmp.summary = "mcu.PD2: rising edge 51 at cycle 101040, golden 101000 (+40 cycles > tolerance 8)";
+    // Several lines, as CompareResult::report() writes them.
+    cmp.summary = "FAIL: 1 of 3 channels differ from the golden timeline\n"
+                  "first divergence: mcu.PD2: rising edge 51 at cycle 101040, golden 101000 (+40 cycles > tolerance 8)\n";
     cmp.channels = {{"mcu.PD2", "timing", "150 edges late by 40 cycles"}, {"mcu.PD5", "ok", ""}};
     run.report.comparison = std::move(cmp);
 
-    run.report.temperatures = {{"hotend", run.hotend, run.duty, 210.0}};
+    TemperatureSeries hotend;
+    hotend.name = "hotend";
+    hotend.temperature_degC = run.hotend;
+    hotend.duty = run.duty;
+    hotend.target_degC = 210.0;
+    run.report.temperatures = {hotend};
     run.report.servos = {{"servo0", run.servo}};
     run.report.facts = {"firmware: build/firmware/demo.elf", "board: uno-cnc-shield", "simulated: 15 s"};
     for (int i = 0; i < 12; ++i) {
