@@ -1,5 +1,7 @@
 #include "boards/BoardFile.hpp"
 
+#include <cstdlib>
+
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
@@ -83,9 +85,34 @@ const SerialDecl* BoardSpec::find_serial(const std::string& n) const {
     return nullptr;
 }
 
-BoardSpec load_board_file(const std::string& path) {
+std::vector<std::string> standard_board_dirs() {
+    std::vector<std::string> dirs;
+    if (const char* env = std::getenv("AVRBENCH_BOARDS_DIR")) dirs.emplace_back(env);
+    // Installed: <prefix>/bin/avrbench and <prefix>/share/avrbench/boards.
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": no such board file");
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "avrbench" / "boards").string());
+#ifdef AVRBENCH_SOURCE_BOARDS_DIR
+    dirs.emplace_back(AVRBENCH_SOURCE_BOARDS_DIR);  // running from the build tree
+#endif
+    return dirs;
+}
+
+std::string find_board_file(const std::string& name_or_path) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(name_or_path, ec)) return name_or_path;
+    const bool bare = !name_or_path.empty() && name_or_path.find('/') == std::string::npos &&
+                      std::filesystem::path(name_or_path).extension() != ".yaml";
+    if (!bare) throw BadInput(name_or_path + ": no such board file");
+    for (const auto& dir : standard_board_dirs()) {
+        const std::filesystem::path candidate = std::filesystem::path(dir) / (name_or_path + ".yaml");
+        if (std::filesystem::is_regular_file(candidate, ec)) return candidate.string();
+    }
+    throw BadInput(name_or_path + ": no such board file, and no standard board of that name (see docs/BOARDS.md)");
+}
+
+BoardSpec load_board_file(const std::string& name_or_path) {
+    const std::string path = find_board_file(name_or_path);
     std::ifstream in(path);
     if (!in) throw BadInput(path + ": cannot read");
     std::stringstream ss;

@@ -86,7 +86,12 @@ struct BoardSpec {
 // Reads and checks the file's structure (sections, names, endpoint syntax,
 // MCU types and pins, duplicate names). Part types, parameters and part pins
 // are checked when the board is built (Board), with the same file:line style.
-BoardSpec load_board_file(const std::string& path);
+// `name_or_path` is a file, or the bare name of a standard board
+// ("arduino-uno"), looked up in $AVRBENCH_BOARDS_DIR, then beside the
+// installed avrbench (<prefix>/share/avrbench/boards), then in the source tree.
+BoardSpec load_board_file(const std::string& name_or_path);
+std::string find_board_file(const std::string& name_or_path);
+std::vector<std::string> standard_board_dirs();
 BoardSpec parse_board_text(const std::string& text, const std::string& path);
 
 }  // namespace avrbench
