@@ -31,11 +31,14 @@ std::uint64_t ps_at_cycle(const Mcu& mcu, Cycle cycle) {
 }
 
 std::uint64_t Lockstep::now_ps() const {
-    std::uint64_t now = std::numeric_limits<std::uint64_t>::max();
+    // The running MCU furthest behind; once all have halted, the last to halt.
+    std::uint64_t now = std::numeric_limits<std::uint64_t>::max(), halted_at = 0;
     for (const Mcu* m : mcus_) {
-        if (!m->halted()) now = std::min(now, ps_at_cycle(*m, m->cycle()));
+        const std::uint64_t t = ps_at_cycle(*m, m->cycle());
+        if (m->halted()) halted_at = std::max(halted_at, t);
+        else now = std::min(now, t);
     }
-    return now == std::numeric_limits<std::uint64_t>::max() ? 0 : now;
+    return now == std::numeric_limits<std::uint64_t>::max() ? halted_at : now;
 }
 
 StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {

@@ -49,7 +49,9 @@ Heater::Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalP
     const double v = params.quantity("supply");
     const double r = params.quantity("resistance");
     const double rs = params.quantity("series_resistance");
-    if (!(r > 0) || rs < 0 || v < 0) throw BadInput("part '" + this->name() + "': resistance must be positive");
+    if (!(r > 0)) throw BadInput("part '" + this->name() + "': resistance must be positive");
+    if (!(rs >= 0)) throw BadInput("part '" + this->name() + "': the switch resistance must not be negative");
+    if (!(v >= 0)) throw BadInput("part '" + this->name() + "': the supply voltage must not be negative");
     // P = I^2 R with I = V / (R + R_series).
     power_on_W_ = v * v * r / ((r + rs) * (r + rs));
     gate_active_level_ = params.text("gate_active") == "high";

@@ -91,18 +91,59 @@ std::vector<GcodeLine> parse_gcode(std::string_view text, const std::string& ori
     std::size_t number = first_number;
     std::size_t start = 0;
     while (start <= text.size()) {
-        std::size_t end = text.find('\n', start);
+        // "\n", "\r\n" and a lone "\r" (old Mac files) each end a line.
+        std::size_t end = text.find_first_of("\r\n", start);
         const bool last = end == std::string_view::npos;
         if (last) end = text.size();
-        // A final '\n' ends the last line; it does not start an empty one.
+        // A final line end ends the last line; it does not start an empty one.
         if (last && start == text.size() && start != 0) break;
         std::string stripped = strip_comments(text.substr(start, end - start));
         if (!stripped.empty()) out.push_back(GcodeLine{std::move(stripped), number, origin});
         ++number;
         if (last) break;
-        start = end + 1;
+        start = end + (text[end] == '\r' && end + 1 < text.size() && text[end + 1] == '\n' ? 2 : 1);
     }
     return out;
+}
+
+std::string_view checked_gcode_text(std::string_view text, const std::string& origin) {
+    auto byte_text = [](unsigned char b) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "0x%02x", b);
+        return std::string(buf);
+    };
+    if (text.size() >= 2 && ((static_cast<unsigned char>(text[0]) == 0xff && static_cast<unsigned char>(text[1]) == 0xfe) ||
+                             (static_cast<unsigned char>(text[0]) == 0xfe && static_cast<unsigned char>(text[1]) == 0xff))) {
+        throw BadInput(origin + ":1: UTF-16 text (byte-order mark " + byte_text(static_cast<unsigned char>(text[0])) + " " +
+                       byte_text(static_cast<unsigned char>(text[1])) + "); save the job as ASCII or UTF-8");
+    }
+    // A UTF-8 byte-order mark (Windows editors write one) is not G-code: skip it.
+    if (text.size() >= 3 && text.substr(0, 3) == "\xef\xbb\xbf") text.remove_prefix(3);
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < text.size(); ++i, ++column) {
+        const auto b = static_cast<unsigned char>(text[i]);
+        if (b == '\n' || (b == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) {
+            ++line;
+            column = 0;
+            continue;
+        }
+        if (b == '\r' || b == '\t') continue;
+        if (b < 0x20 || b == 0x7f) {
+            throw BadInput(origin + ":" + std::to_string(line) + ": control byte " + byte_text(b) + " at column " +
+                           std::to_string(column) + " is not G-code text");
+        }
+        if (b < 0x80) continue;
+        // Multi-byte UTF-8 (in comments, say) is text; anything else is not.
+        const std::size_t n = (b >> 5) == 0x6 ? 2 : (b >> 4) == 0xe ? 3 : (b >> 3) == 0x1e ? 4 : 0;
+        bool ok = n != 0 && i + n <= text.size();
+        for (std::size_t k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (!ok) {
+            throw BadInput(origin + ":" + std::to_string(line) + ": byte " + byte_text(b) + " at column " +
+                           std::to_string(column) + " is not UTF-8 text");
+        }
+        i += n - 1;
+    }
+    return text;
 }
 
 UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
@@ -160,7 +201,8 @@ void UartHost::load_file(const std::string& path) {
     if (!in) throw BadInput(path + ": cannot read");
     std::ostringstream text;
     text << in.rdbuf();
-    auto parsed = parse_gcode(text.str(), path);
+    const std::string bytes = text.str();
+    auto parsed = parse_gcode(checked_gcode_text(bytes, path), path);
     lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
     pump();
 }

@@ -85,9 +85,15 @@ struct GcodeLine {
 
 // Strips "; ..." to the end of the line and "( ... )" comments (an unclosed
 // '(' runs to the end of the line), leading and trailing whitespace, and
-// drops the lines left empty. Accepts '\n' and "\r\n" line ends.
+// drops the lines left empty. Accepts "\n", "\r\n" and lone "\r" line ends.
 // `first_number` is the number of the first line of `text`.
 std::vector<GcodeLine> parse_gcode(std::string_view text, const std::string& origin, std::size_t first_number = 1);
+
+// A job file's bytes checked as text before streaming: a UTF-16 file, a NUL
+// or other control byte (tab and line ends aside) and bytes that are not
+// UTF-8 are BadInput "file:line: ..." naming the byte (never echoing it); a
+// UTF-8 byte-order mark is skipped. Returns the text to parse.
+std::string_view checked_gcode_text(std::string_view text, const std::string& origin);
 
 enum class Direction { Sent, Received };
 

@@ -142,6 +142,15 @@ TEST(OutputPaths, SummaryToAFullDiskIsAnError) {
     EXPECT_EQ(r.err, "avrbench: error: cannot write to standard output\n");
 }
 
+// A board whose only MCU halted says when it halted, not "0 s".
+TEST(BoardRun, AHaltedBoardReportsTheTimeItHalted) {
+    const auto dir = test::scratch_dir("halted-board");
+    const auto r = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("crash_bad_opcode") + " --for 10ms", dir);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.out.find("simulated  0.000000 s"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("simulated  0.0000"), std::string::npos) << r.out;  // microseconds after reset
+}
+
 TEST(GoldenUpdate, RefusesAFailingRunUnlessForced) {
     const auto dir = test::scratch_dir("golden-refuse");
     // blink_timer1 has no serial output and no findings: expecting one fails.

@@ -162,6 +162,22 @@ parts:
     EXPECT_TRUE(board->part_as<Heater>("low").on());
 }
 
+TEST(HeaterEnergy, ANegativeSupplyIsNamedAsSuch) {
+    const std::string yaml = R"(
+mcus:
+  mega: {type: atmega2560, clock: 16MHz}
+parts:
+  plant: {type: thermal_plant, preset: heated_bed}
+  h: {type: heater, preset: custom, supply: -12V, resistance: 4.8ohm, plant: plant}
+)";
+    try {
+        test::thermal_board(yaml, "thermal_pwm_off");
+        ADD_FAILURE() << "a negative supply was accepted";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("part 'h': the supply voltage must not be negative"), std::string::npos) << e.what();
+    }
+}
+
 TEST(HeaterEnergy, ActiveLowGateInvertsTheDuty) {
     // A P-MOSFET (or inverting driver) stage: gate low = on. The firmware's
     // 64/256 high time becomes 192/256 = 0.75 on-time, 30 W mean.
