@@ -494,7 +494,7 @@ JunitCase junit_case(const ScenarioResult& r) {
 // failed (or, updating goldens, was refused), else 0.
 int check_command(const CheckArgs& args, bool update_golden) {
     const std::string firmware_dir = args.firmware_dir.empty() ? default_firmware_dir() : args.firmware_dir;
-    if (!args.junit.empty()) check_output_path(args.junit, "--junit");
+    // The report folder first: it is ours to create, and --junit may point into it.
     if (!args.report_dir.empty()) {
         std::error_code ec;
         std::filesystem::create_directories(args.report_dir, ec);
@@ -502,6 +502,7 @@ int check_command(const CheckArgs& args, bool update_golden) {
             throw BadInput("--report-dir: " + args.report_dir + ": cannot create the folder");
         }
     }
+    if (!args.junit.empty()) check_output_path(args.junit, "--junit");
     ScenarioRunOptions options;
     options.report_dir = args.report_dir;
     options.update_golden = update_golden;
