@@ -729,6 +729,14 @@ private:
             }
         }
         mode_ = m;
+        // Only the dual-slope modes count down (ATmega2560 §17.9.1-2: in
+        // Normal and CTC mode "the counting direction is always up"; fast PWM
+        // is single-slope too). A timer switched out of phase-correct PWM while
+        // it counted down counts up from its current value.
+        if (!m.dual_slope()) {
+            dir_ = 1;
+            anchor_dir_ = 1;
+        }
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
             com_[i] = has_comp_[i] ? avr_regbit_get(avr_, t_->comp[i].com) : 0;
         }
