@@ -326,6 +326,14 @@ std::uint16_t Mcu::ram_address_of(const std::string& symbol) const {
 
 std::uint8_t Mcu::read_ram_u8(const std::string& symbol) const { return avr_->data[ram_address_of(symbol)]; }
 
+std::vector<std::uint8_t> Mcu::read_ram(const std::string& symbol, std::size_t count) const {
+    const std::uint16_t a = ram_address_of(symbol);
+    if (a + count > static_cast<std::size_t>(avr_->ramend) + 1) {
+        throw BadInput(elf_.path() + ": " + symbol + " + " + std::to_string(count) + " bytes is past the end of RAM");
+    }
+    return std::vector<std::uint8_t>(avr_->data + a, avr_->data + a + count);
+}
+
 std::uint16_t Mcu::read_ram_u16(const std::string& symbol) const {
     const std::uint16_t a = ram_address_of(symbol);
     return static_cast<std::uint16_t>(avr_->data[a] | (avr_->data[a + 1] << 8));

@@ -89,6 +89,8 @@ public:
     // Value of a RAM variable by its ELF symbol (for tests and reports).
     std::uint8_t read_ram_u8(const std::string& symbol) const;
     std::uint16_t read_ram_u16(const std::string& symbol) const;
+    // `count` bytes from the RAM symbol on (an array); throws BadInput past RAMEND.
+    std::vector<std::uint8_t> read_ram(const std::string& symbol, std::size_t count) const;
 
 private:
     friend struct WatchdogResetHook;

@@ -11,7 +11,8 @@
 //     interrupt is served (the datasheet: one). simavr arms interrupt_state = -2;
 //     RETI is seen through the vector's "running" IRQ, OUT SREG through an I/O
 //     hook on SREG, SEI through a one-cycle cycle timer that runs only while an
-//     interrupt is pending with I = 0;
+//     interrupt is pending with I = 0, and an interrupt raised in the very
+//     step that executed SEI through the "pending" IRQ;
 //  3. a sleep jump lands one cycle after the event that ends it;
 //  4. a wake-up costs nothing (the datasheet: 4/5 cycles more plus the
 //     start-up time of the sleep mode); SLEEP with a pending interrupt is a
@@ -115,7 +116,16 @@ private:
     static void on_pending(avr_irq_t*, std::uint32_t value, void* param) {
         auto* self = static_cast<InterruptTiming*>(param);
         avr_t* avr = self->avr_;
-        if (value == 0 || avr->sreg[S_I]) return;
+        if (value == 0) return;
+        if (avr->sreg[S_I]) {
+            // Raised in the step that executed SEI (simavr's -2 lasts only that
+            // step): served after the one instruction that follows SEI, like an
+            // interrupt already pending when SEI ran. Left at -2, simavr would
+            // serve it one instruction later, after the CLI of `sei; nop; cli`,
+            // and then never again: a vector already pending is not raised anew.
+            if (avr->interrupt_state == -2) avr->interrupt_state = -1;
+            return;
+        }
         if (avr_cycle_timer_status(avr, &sei_watch, self) == 0) avr_cycle_timer_register(avr, 1, &sei_watch, self);
     }
 
