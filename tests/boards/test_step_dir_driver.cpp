@@ -47,11 +47,13 @@ TEST(StepDirDriver, CountsStepsAndIgnoresThemWhileDisabled) {
     std::size_t rising = 0;
     for (const auto& [c, level] : run.step_edges) rising += level ? 1 : 0;
     EXPECT_EQ(rising, 185u);  // the pin saw every pulse: 155 + 30
-    // Net motion +49 steps at 1/16 microstepping (board: microsteps 16).
+    // Net motion: 49 steps with DIR high at 1/16 microstepping (board:
+    // microsteps 16). The CNC shield board counts DIR low as + (grbl drives
+    // DIR high for negative moves), so that is -49 steps.
     auto& x = run.board->part_as<Axis>("x");
-    EXPECT_DOUBLE_EQ(x.position_steps(), 49.0);
-    // 250 steps/mm (grbl default): +49 steps from the 100 mm start = 100.196 mm.
-    EXPECT_NEAR(x.position_mm(), 100.0 + 49.0 / 250.0, 1e-9);
+    EXPECT_DOUBLE_EQ(x.position_steps(), -49.0);
+    // 250 steps/mm (grbl default): -49 steps from the 100 mm start = 99.804 mm.
+    EXPECT_NEAR(x.position_mm(), 100.0 - 49.0 / 250.0, 1e-9);
 }
 
 TEST(StepDirDriver, ReportsTheShortPulseAtItsFallingEdge) {

@@ -145,9 +145,10 @@ TEST(GrblStepper, MoveOfXProducesItsExactStepCountRateAndPulseWidth) {
     expect_pulses(highs_after(g.step(0), start), 10);
     // Every pulse ended inside the step vector, after its sei(): nested.
     EXPECT_EQ(g.mcu().read_ram_u16("nested_ends"), 1600);
-    // DIR X high (positive) before the first step; drivers enabled (PB0 low)
-    // before the first step and disabled after the last.
-    EXPECT_TRUE(g.mcu().pin("PD5").level());
+    // DIR X low before the first step (grbl drives DIR high for negative
+    // moves: planner.c sets the direction bit when the axis' delta < 0);
+    // drivers enabled (PB0 low) before the first step and disabled after the last.
+    EXPECT_FALSE(g.mcu().pin("PD5").level());
     ASSERT_FALSE(x.empty());
     ASSERT_FALSE(g.enable().falls().empty());
     ASSERT_FALSE(g.enable().rises().empty());
@@ -164,9 +165,9 @@ TEST(GrblStepper, ThreeAxesStepInBresenhamProportionsInTheirDirections) {
     EXPECT_EQ(x.size(), 1600u);
     EXPECT_EQ(rises_after(g.step(1), start).size(), 800u);
     EXPECT_EQ(rises_after(g.step(2), start).size(), 400u);
-    EXPECT_TRUE(g.mcu().pin("PD5").level());   // X +
-    EXPECT_FALSE(g.mcu().pin("PD6").level());  // Y -
-    EXPECT_TRUE(g.mcu().pin("PD7").level());   // Z +
+    EXPECT_FALSE(g.mcu().pin("PD5").level());  // X +: DIR low
+    EXPECT_TRUE(g.mcu().pin("PD6").level());   // Y -: DIR high
+    EXPECT_FALSE(g.mcu().pin("PD7").level());  // Z +: DIR low
     // X is the longest axis and sets the rate: 8000 steps/s, 2000 cycles.
     expect_rate(x, kDefaultPeriod);
     EXPECT_EQ(g.command("?"), "<1600,-800,400>\r\nok\r\n");
@@ -183,7 +184,7 @@ TEST(GrblStepper, SecondMoveStartsFromTheFlagSetWhileDisabled) {
     EXPECT_EQ(g.command("X-250"), "ok\r\n");
     EXPECT_EQ(rises_after(g.step(0), start).size(), 250u);
     EXPECT_EQ(g.mcu().read_ram_u16("ocr1a_first"), kDefaultPeriod - 1);
-    EXPECT_FALSE(g.mcu().pin("PD5").level());
+    EXPECT_TRUE(g.mcu().pin("PD5").level());  // X -: DIR high
     EXPECT_EQ(g.command("?"), "<-150,0,0>\r\nok\r\n");
 }
 

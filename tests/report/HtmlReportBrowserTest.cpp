@@ -244,20 +244,21 @@ TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
     const PlotMapping map(svg);
     const Points v = polyline(svg, "x velocity [mm/s]");
     ASSERT_GE(v.size(), 4u);
-    // stepdir_test steps every 16 * (5 + 45) = 800 cycles = 50 us (20 kHz);
-    // the board's x axis has 250 steps/mm: 20000 / 250 = 80 mm/s, for
-    // 1600 steps = 80 ms. Every point while moving is that, none between.
-    double top = 0;
+    // stepdir_test steps every 16 * (5 + 45) = 800 cycles = 50 us (20 kHz)
+    // with DIR high, which this board (grbl's convention) counts as -; the
+    // x axis has 250 steps/mm: 20000 / 250 = 80 mm/s, for 1600 steps = 80 ms.
+    // Every point while moving is -80 mm/s, none between.
+    double fastest = 0;
     std::size_t moving = 0;
     for (const auto& [px, py] : v) {
         const double mm_s = map.data_y(py);
-        top = std::max(top, mm_s);
-        if (mm_s > 1) {
+        fastest = std::min(fastest, mm_s);
+        if (mm_s < -1) {
             ++moving;
-            EXPECT_NEAR(mm_s, 80.0, 0.8) << "at " << map.data_x(px) << " s";
+            EXPECT_NEAR(mm_s, -80.0, 0.8) << "at " << map.data_x(px) << " s";
         }
     }
-    EXPECT_NEAR(top, 80.0, 0.8);
+    EXPECT_NEAR(fastest, -80.0, 0.8);
     EXPECT_GE(moving, 2u);
 }
 

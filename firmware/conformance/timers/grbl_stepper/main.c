@@ -197,7 +197,7 @@ ISR(TIMER1_COMPA_vect)
     }
     const uint8_t stepped = st.next_bits;
     for (uint8_t a = 0; a < 3; ++a) {
-        if (stepped & _BV(PD2 + a)) position[a] += (st.dir_bits & _BV(PD5 + a)) ? 1 : -1;
+        if (stepped & _BV(PD2 + a)) position[a] += (st.dir_bits & _BV(PD5 + a)) ? -1 : 1;
     }
     uint8_t bits = 0;
     if (st.events_left == 0) {
@@ -284,7 +284,7 @@ static void move(const int32_t steps[3])
     for (uint8_t a = 0; a < 3; ++a) st.counter[a] = longest >> 1;
     st.dir_bits = 0;
     for (uint8_t a = 0; a < 3; ++a) {
-        if (steps[a] > 0) st.dir_bits |= _BV(PD5 + a);
+        if (steps[a] < 0) st.dir_bits |= _BV(PD5 + a); /* as grbl: DIR high = negative */
     }
     st.next_bits = 0;
     st.first = 1;
