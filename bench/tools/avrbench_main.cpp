@@ -18,6 +18,7 @@
 #include "core/Errors.hpp"
 #include "core/Mcu.hpp"
 #include "core/Units.hpp"
+#include "core/UserStop.hpp"
 #include "parts/Axis.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
@@ -39,6 +40,7 @@ constexpr int kExitFinding = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitTimeout = 3;
 constexpr int kExitInternal = 4;
+constexpr int kExitInterrupted = 130;  // 128 + SIGINT
 
 struct RunArgs {
     std::string elf;
@@ -258,9 +260,14 @@ int run_board_command(const RunArgs& args) {
     const auto wall_start = std::chrono::steady_clock::now();
     IdleResult outcome = IdleResult::TimeLimit;
     const Picoseconds end_ps = duration_ps;
-    const Picoseconds chunk_ps = std::max<Picoseconds>(duration_ps / 100, 1'000'000);
+    // Slices of at most 10 ms simulated, so Ctrl-C is answered promptly.
+    const Picoseconds chunk_ps = std::clamp<Picoseconds>(duration_ps / 100, 1'000'000, 10 * kPsPerMs);
     // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
     while (bench.now_ps() < end_ps) {
+        if (user_stop_requested()) {
+            outcome = IdleResult::Interrupted;
+            break;
+        }
         const Picoseconds target = std::min(end_ps, add_ps(bench.now_ps(), chunk_ps));
         if (host != nullptr) {
             outcome = bench.run_until_idle_ps(target - bench.now_ps(), settle_ps);
@@ -338,6 +345,10 @@ int run_board_command(const RunArgs& args) {
     for (const auto& f : findings) {
         if (is_mcu_finding(f) || (args.strict && f.kind != FindingKind::HostProtocol)) return kExitFinding;
     }
+    if (outcome == IdleResult::Interrupted) {
+        std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n", bench.now_seconds());
+        return kExitInterrupted;
+    }
     if (host != nullptr && outcome == IdleResult::HostFailed) {
         std::fprintf(stderr, "avrbench: %s\n", host->failure_message().c_str());
         // A host that got no answer is a timeout; error/ALARM/!! are findings.
@@ -404,12 +415,13 @@ int run_command(const RunArgs& args) {
     const auto wall_start = std::chrono::steady_clock::now();
     bool slept = false;
     if (args.until_sleep) {
-        while (mcu.cycle() < end_cycle && !mcu.sleeping() && mcu.step()) {
+        while (mcu.cycle() < end_cycle && !mcu.sleeping() && !user_stop_requested() && mcu.step()) {
         }
         slept = mcu.sleeping();
     } else {
-        const Cycle chunk = std::max<Cycle>(end_cycle / 100, 1);
-        while (mcu.cycle() < end_cycle) {
+        // Slices of at most 10 ms simulated, so Ctrl-C is answered promptly.
+        const Cycle chunk = std::clamp<Cycle>(end_cycle / 100, 1, mcu.frequency_hz() / 100 + 1);
+        while (mcu.cycle() < end_cycle && !user_stop_requested()) {
             if (mcu.run_until(std::min(end_cycle, mcu.cycle() + chunk)) == StopReason::Halted) break;
             progress.show(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
         }
@@ -438,6 +450,10 @@ int run_command(const RunArgs& args) {
     if (!args.vcd.empty()) {
         std::printf("  vcd        %s (%zu signals, %zu events), gtkwave save file %s\n", args.vcd.c_str(),
                     timeline.signals().size(), timeline.events().size(), gtkw_path.c_str());
+    }
+    if (user_stop_requested()) {
+        std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n", simulated_s);
+        return kExitInterrupted;
     }
     if (!mcu.findings().empty()) return kExitFinding;
     if (args.until_sleep && !slept && !mcu.halted()) {
@@ -509,6 +525,7 @@ int check_command(const CheckArgs& args, bool update_golden) {
     options.force = args.force;
     std::vector<ScenarioResult> results;
     for (const auto& path : update_golden ? args.scenarios : shard(args.scenarios)) {
+        if (user_stop_requested()) break;
         try {
             const ScenarioSpec spec = load_scenario(path, firmware_dir);
             results.push_back(run_scenario(spec, options));
@@ -539,6 +556,11 @@ int check_command(const CheckArgs& args, bool update_golden) {
         failed += !r.error && !r.passed ? 1 : 0;
     }
     if (errors > 0) std::printf("%zu scenario(s) could not be loaded or run (ERROR above)\n", errors);
+    if (user_stop_requested()) {
+        std::printf("%zu passed, %zu failed\n", results.size() - failed - errors, failed + errors);
+        std::fprintf(stderr, "avrbench: interrupted after %zu scenario(s); their results are written\n", results.size());
+        return kExitInterrupted;
+    }
     std::printf("%zu passed, %zu failed\n", results.size() - failed - errors, failed + errors);
     return errors > 0 ? kExitBadInput : failed > 0 ? kExitFinding : kExitOk;
 }
@@ -603,6 +625,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "avrbench: usage error: %s (see avrbench --help)\n", e.what());
         return kExitBadInput;
     }
+    install_user_stop_handlers();
     int code = 0;
     try {
         if (run_cmd->parsed()) code = run_command(run);

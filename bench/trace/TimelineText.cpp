@@ -123,6 +123,11 @@ void write_timeline_text(const Timeline& timeline, const TimelineHeader& header,
     write_output_file(path, format_timeline_text(timeline, header), "golden timeline");
 }
 
+// A bound on what one golden file may expand to (events after run-length
+// decoding): 50 million events are about 1.2 GB in memory. A longer run
+// belongs in a golden of selected signals (golden_signals) or a window rule.
+constexpr std::uint64_t kMaxGoldenEvents = 50'000'000;
+
 ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source) {
     ParsedTimeline parsed;
     std::istringstream in(text);
@@ -140,13 +145,25 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
     if (!next_line() || line != "avrbench-timeline 1") fail("not an avrbench timeline (expected 'avrbench-timeline 1')");
     long current = -1;
     Cycle last_cycle = 0;
+    std::uint64_t events = 0;
     auto parse_u64 = [&](const std::string& s) -> std::uint64_t {
         std::uint64_t v = 0;
         auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
         if (ec != std::errc() || end != s.data() + s.size()) fail("'" + s + "' is not a whole number");
         return v;
     };
+    // A cycle count or a cycle delta: bounded so that sums never wrap.
+    auto parse_cycles = [&](const std::string& s) -> Cycle {
+        const std::uint64_t v = parse_u64(s);
+        if (v > (std::uint64_t{1} << 53)) fail("cycle count " + s + " is past any run's end");
+        return v;
+    };
     auto record = [&](Cycle cycle, const std::string& value) {
+        // 10^6 s at 64 MHz is 6.4e13 cycles; 2^53 bounds the sums below too.
+        if (cycle > (std::uint64_t{1} << 53)) fail("cycle " + std::to_string(cycle) + " is past any run's end");
+        if (++events > kMaxGoldenEvents) {
+            fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
+        }
         const SignalInfo& info = parsed.timeline.signals()[static_cast<std::size_t>(current)];
         if (info.kind == SignalKind::Real) {
             double v = 0;
@@ -173,8 +190,11 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
         } else if (word == "end") {
             std::string c, f;
             ls >> c >> f;
-            parsed.header.end_cycle = parse_u64(c);
-            parsed.header.end_clock_hz = static_cast<std::uint32_t>(parse_u64(f));
+            parsed.header.end_cycle = parse_cycles(c);
+            const std::uint64_t hz = parse_u64(f);
+            if (hz == 0 || hz > 64'000'000) fail("end clock " + f + " Hz is not 1 Hz .. 64 MHz");
+            if (parsed.header.end_cycle > hz * 1'000'000ULL) fail("end " + c + " is past 10^6 s at " + f + " Hz");
+            parsed.header.end_clock_hz = static_cast<std::uint32_t>(hz);
         } else if (word == "signal") {
             std::string name, kind, width, clock;
             ls >> name >> kind >> width >> clock;
@@ -187,9 +207,20 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             else if (kind == "bus") info.kind = SignalKind::Bus;
             else if (kind == "real") info.kind = SignalKind::Real;
             else fail("unknown signal kind '" + kind + "'");
-            info.width = info.kind == SignalKind::Real ? 1 : static_cast<unsigned>(parse_u64(width));
-            info.clock_hz = static_cast<std::uint32_t>(parse_u64(clock));
-            parsed.timeline.add_signal(info);
+            const std::uint64_t bits = info.kind == SignalKind::Real ? 1 : parse_u64(width);
+            if (info.kind == SignalKind::Wire && bits != 1) fail("a wire is 1 bit wide, not " + width);
+            if (bits < 1 || bits > 64) fail("bus width " + width + " is not 1..64");
+            info.width = static_cast<unsigned>(bits);
+            const std::uint64_t hz = parse_u64(clock);
+            if (hz == 0 || hz > 64'000'000) fail("clock " + clock + " Hz is not 1 Hz .. 64 MHz");
+            info.clock_hz = static_cast<std::uint32_t>(hz);
+            if (info.scope.empty() || info.name.empty()) fail("signal '" + name + "' has an empty scope or name");
+            if (parsed.timeline.find(info.scope, info.name) >= 0) fail("signal '" + name + "' is declared twice");
+            try {
+                parsed.timeline.add_signal(info);
+            } catch (const std::invalid_argument& e) {
+                fail(e.what());
+            }
         } else if (word[0] == '@') {
             const std::string name = word.substr(1);
             const auto dot = name.find('.');
@@ -200,24 +231,30 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             fail("unexpected '" + line + "'");
         } else if (word[0] == '*') {
             const std::uint64_t repeats = parse_u64(word.substr(1));
+
+            if (repeats > kMaxGoldenEvents) fail("repeat count " + word.substr(1) + " is more than the events a golden may hold");
             std::vector<std::pair<Cycle, std::string>> block;
             std::string delta, value;
             while (ls >> delta >> value) {
                 if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs");
-                block.emplace_back(parse_u64(delta.substr(1)), value);
+                block.emplace_back(parse_cycles(delta.substr(1)), value);
             }
             if (block.empty()) fail("empty repeat block");
+            // Checked before expanding, so an oversized block allocates nothing.
+            if (repeats > (kMaxGoldenEvents - events) / block.size()) {
+                fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
+            }
             for (std::uint64_t r = 0; r < repeats; ++r) {
                 for (const auto& [d, v] : block) record(last_cycle + d, v);
             }
         } else if (word[0] == '+') {
             std::string value;
             ls >> value;
-            record(last_cycle + parse_u64(word.substr(1)), value);
+            record(last_cycle + parse_cycles(word.substr(1)), value);
         } else {
             std::string value;
             ls >> value;
-            record(parse_u64(word), value);
+            record(parse_cycles(word), value);
         }
     }
     return parsed;

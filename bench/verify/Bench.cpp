@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/Units.hpp"
+#include "core/UserStop.hpp"
 #include "parts/Heater.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
@@ -38,6 +39,7 @@ const char* to_string(IdleResult result) {
         case IdleResult::TimeLimit: return "time limit";
         case IdleResult::Halted: return "halted";
         case IdleResult::HostFailed: return "host failed";
+        case IdleResult::Interrupted: return "interrupted";
     }
     return "?";
 }
@@ -156,6 +158,7 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
         const bool motion_settled = last_step_ps_ ? now - std::min(now, *last_step_ps_) >= settle_ps : now >= settle_ps;
         if (all_finished && motion_settled) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
+        if (user_stop_requested()) return IdleResult::Interrupted;
         // now < target, and afterwards now_ps() >= target (core/Time.hpp): progress.
         if (board_->run_until_ps(std::min(end, add_ps(now, slice))) == StopReason::Halted) return IdleResult::Halted;
     }

@@ -31,6 +31,7 @@ enum class IdleResult {
     TimeLimit,   // the simulated-time limit came first
     Halted,      // every MCU halted (crash findings say why)
     HostFailed,  // a host stopped: no answer (timeout), ALARM, !!, ...
+    Interrupted, // SIGINT/SIGTERM (core/UserStop.hpp)
 };
 
 const char* to_string(IdleResult result);

@@ -8,6 +8,7 @@
 
 #include "core/Errors.hpp"
 #include "core/FileHash.hpp"
+#include "core/UserStop.hpp"
 #include "trace/HtmlReport.hpp"
 #include "core/OutputFile.hpp"
 #include "trace/TimelineText.hpp"
@@ -77,8 +78,11 @@ private:
         return "";
     }
     std::string operator()(const DelayStep& s) {
-        bench_.board().run_until_ps(std::min(deadline_, add_ps(bench_.now_ps(), s.duration_ps)));
-        return "";
+        const Picoseconds end = std::min(deadline_, add_ps(bench_.now_ps(), s.duration_ps));
+        while (bench_.now_ps() < end && !user_stop_requested()) {
+            if (bench_.board().run_until_ps(std::min(end, add_ps(bench_.now_ps(), kSlicePs * 100))) == StopReason::Halted) break;
+        }
+        return user_stop_requested() ? "interrupted (SIGINT/SIGTERM)" : "";
     }
     std::string operator()(const WaitIdleStep& s) {
         const Picoseconds now = bench_.now_ps();
@@ -101,7 +105,7 @@ private:
                 }
             }
             const Picoseconds now = bench_.now_ps();
-            if (now >= deadline_ || host.failed()) break;
+            if (now >= deadline_ || host.failed() || user_stop_requested()) break;
             if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kSlicePs))) == StopReason::Halted) break;
         }
         return "the firmware sent no line containing '" + s.text + "' by " + seconds_text(deadline_) +
@@ -111,7 +115,7 @@ private:
         Pin& pin = bench_.board().pin(s.pin);
         while (pin.level() != s.level) {
             const Picoseconds now = bench_.now_ps();
-            if (now >= deadline_) break;
+            if (now >= deadline_ || user_stop_requested()) break;
             if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kPinSlicePs))) == StopReason::Halted) break;
         }
         if (pin.level() == s.level) return "";

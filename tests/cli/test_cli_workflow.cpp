@@ -142,6 +142,24 @@ TEST(OutputPaths, SummaryToAFullDiskIsAnError) {
     EXPECT_EQ(r.err, "avrbench: error: cannot write to standard output\n");
 }
 
+// Ctrl-C (or a CI system's SIGTERM) ends a long run cleanly: what was
+// recorded is written, exit 130.
+TEST(Interrupt, SigintEndsALongRunWritingWhatWasRecorded) {
+    const auto dir = test::scratch_dir("sigint");
+    for (const std::string& board : {std::string(""), " --board " + uno()}) {
+        const std::string vcd = (dir / "long.vcd").string();
+        std::filesystem::remove(vcd);
+        // 1000 s of simulation would take many minutes; SIGINT comes after 2 s.
+        const auto r = test::run_command("timeout --preserve-status -s INT 2 " + kCli + " run -q" + board + " " +
+                                             test::firmware("blink_timer1") + " --for 1000s --vcd " + vcd, dir, 60);
+        EXPECT_EQ(r.exit_code, 130) << board << r.err;
+        EXPECT_NE(r.err.find("avrbench: interrupted at "), std::string::npos) << r.err;
+        const std::string dump = test::slurp(vcd);
+        EXPECT_NE(dump.find("$enddefinitions"), std::string::npos) << board;
+        EXPECT_NE(r.out.find("simulated"), std::string::npos) << board;
+    }
+}
+
 // A board whose only MCU halted says when it halted, not "0 s".
 TEST(BoardRun, AHaltedBoardReportsTheTimeItHalted) {
     const auto dir = test::scratch_dir("halted-board");

@@ -92,5 +92,36 @@ TEST(TimelineText, ParseErrorsNameTheLine) {
     }
 }
 
+// Golden values no run can have: one line naming file and line, never an
+// internal error or an allocation without end.
+TEST(TimelineText, ImpossibleValuesAreFileLineErrors) {
+    const std::string head = "avrbench-timeline 1\n";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"signal uno.tx bus 0 16000000\n", "g.txt:2: bus width 0 is not 1..64"},
+        {"signal uno.tx bus 65 16000000\n", "g.txt:2: bus width 65 is not 1..64"},
+        {"signal uno.PD2 wire 2 16000000\n", "g.txt:2: a wire is 1 bit wide, not 2"},
+        {"signal uno.PD2 wire 1 0\n", "g.txt:2: clock 0 Hz is not 1 Hz .. 64 MHz"},
+        {"signal uno.PD2 wire 1 16000000\nsignal uno.PD2 wire 1 16000000\n", "g.txt:3: signal 'uno.PD2' is declared twice"},
+        {"signal .PD2 wire 1 16000000\n", "g.txt:2: signal '.PD2' has an empty scope or name"},
+        {"end 0 0\n", "g.txt:2: end clock 0 Hz is not 1 Hz .. 64 MHz"},
+        {"end 18446744073709551615 16000000\n", "g.txt:2: cycle count 18446744073709551615 is past any run's end"},
+        // 10^12 repeats would allocate without end (about 6 GB before, for 1e9).
+        {"signal uno.PD2 wire 1 16000000\n@uno.PD2\n*1000000000000 +10 1 +10 0\n",
+         "g.txt:4: repeat count 1000000000000 is more than the events a golden may hold"},
+        {"signal uno.PD2 wire 1 16000000\n@uno.PD2\n*40000000 +10 1 +10 0\n",
+         "g.txt:4: more than 50000000 events (the most a golden timeline may hold)"},
+        {"signal uno.PD2 wire 1 16000000\n@uno.PD2\n0 1\n+18446744073709551615 0\n",
+         "g.txt:5: cycle count 18446744073709551615 is past any run's end"},
+    };
+    for (const auto& [body, message] : cases) {
+        try {
+            parse_timeline_text(head + body, "g.txt");
+            ADD_FAILURE() << "accepted: " << body;
+        } catch (const BadInput& e) {
+            EXPECT_EQ(std::string(e.what()), message) << body;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace avrbench
