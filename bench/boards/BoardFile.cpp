@@ -1,5 +1,7 @@
 #include "boards/BoardFile.hpp"
 
+#include "core/Time.hpp"
+
 #include <cstdlib>
 
 #include <yaml-cpp/yaml.h>
@@ -237,8 +239,17 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
                     // The firmware's receive buffer: grbl uses 128 (serial.h); no AVR
                     // has more than 64 KiB of RAM to hold one.
                     s.rx_buffer_bytes = static_cast<unsigned>(parse_integer(value, loc + ": rx_buffer", 1, 65536));
+                } else if (key == "family") {
+                    if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
+                        throw BadInput(loc + ": family '" + value + "' is not grbl, marlin, teacup or generic");
+                    }
+                    s.family = value;
+                } else if (key == "line_timeout") {
+                    s.line_timeout_s = seconds_from_ps(parse_duration_ps(value, loc + ": line_timeout"));
+                    if (!(s.line_timeout_s > 0)) throw BadInput(loc + ": line_timeout must be longer than 0");
                 } else {
-                    throw BadInput(loc + ": serial '" + s.name + "': unknown key '" + key + "' (expected mcu, usart, flow, rx_buffer)");
+                    throw BadInput(loc + ": serial '" + s.name + "': unknown key '" + key +
+                                   "' (expected mcu, usart, flow, rx_buffer, family, line_timeout)");
                 }
             }
             spec.serial.push_back(std::move(s));

@@ -59,6 +59,8 @@ struct SerialDecl {
     int usart = 0;
     std::string flow = "send_and_wait";  // or character_counting
     unsigned rx_buffer_bytes = 128;
+    std::string family = "generic";  // grbl, marlin, teacup, generic (stimulus/UartHost.hpp)
+    double line_timeout_s = 2.0;     // no answer for this long (keep-alives restart it)
     std::string location;
 };
 

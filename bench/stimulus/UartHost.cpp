@@ -1,5 +1,10 @@
 #include "stimulus/UartHost.hpp"
 
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -82,6 +87,7 @@ const char* to_string(HostEventKind kind) {
         case HostEventKind::Timeout: return "timeout";
         case HostEventKind::BannerTimeout: return "banner-timeout";
         case HostEventKind::LineTooLong: return "line-too-long";
+        case HostEventKind::Restarted: return "restarted";
     }
     return "?";
 }
@@ -146,12 +152,68 @@ std::string_view checked_gcode_text(std::string_view text, const std::string& or
     return text;
 }
 
+const char* to_string(FirmwareFamily family) {
+    switch (family) {
+        case FirmwareFamily::Generic: return "generic";
+        case FirmwareFamily::Grbl: return "grbl";
+        case FirmwareFamily::Marlin: return "marlin";
+        case FirmwareFamily::Teacup: return "teacup";
+    }
+    return "?";
+}
+
+FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what) {
+    for (FirmwareFamily f : {FirmwareFamily::Generic, FirmwareFamily::Grbl, FirmwareFamily::Marlin, FirmwareFamily::Teacup}) {
+        if (text == to_string(f)) return f;
+    }
+    throw BadInput(std::string(what) + ": firmware family '" + std::string(text) + "' is not generic, grbl, marlin or teacup");
+}
+
+namespace {
+
+// The family's welcome line (what a reset prints first).
+bool is_welcome(FirmwareFamily family, const std::string& text) {
+    switch (family) {
+        case FirmwareFamily::Grbl: return text.rfind("Grbl ", 0) == 0;
+        case FirmwareFamily::Marlin:
+        case FirmwareFamily::Teacup: return text == "start";
+        case FirmwareFamily::Generic: return false;
+    }
+    return false;
+}
+
+// Output that answers no line: reports, messages, keep-alives.
+bool is_unsolicited(FirmwareFamily family, const std::string& text) {
+    auto starts = [&text](const char* p) { return text.rfind(p, 0) == 0; };
+    switch (family) {
+        case FirmwareFamily::Grbl:
+            // '>' startup-line results (">G54:ok", ">:error:7"), [MSG:..], [GC:..], <status>.
+            return starts(">") || starts("[") || starts("<") || starts("Grbl ");
+        case FirmwareFamily::Marlin:
+            return starts("echo:") || starts("busy:") || starts("//") || starts("T:") || starts(" T:") ||
+                   starts("B:") || starts("X:") || starts("start");
+        case FirmwareFamily::Teacup:
+            return starts("T:") || starts(" T:") || starts("start");
+        case FirmwareFamily::Generic: return false;
+    }
+    return false;
+}
+
+}  // namespace
+
 UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
     : mcu_(mcu), uart_(mcu.uart(uart_index)), options_(std::move(options)), alive_(std::make_shared<bool>(true)) {
     if (options_.flow == FlowControl::CharacterCounting && options_.rx_buffer_bytes == 0) {
         throw BadInput("UART host: rx_buffer_bytes must be at least 1 for character counting");
     }
     if (!(options_.line_timeout_s > 0.0)) throw BadInput("UART host: line timeout must be positive");
+    if (options_.family != FirmwareFamily::Generic && options_.startup == Startup::Immediately) {
+        // A known family: start after its welcome and the boot chatter that follows.
+        options_.startup = Startup::WaitForBanner;
+        if (options_.banner_timeout_s < 10.0) options_.banner_timeout_s = 10.0;  // SD probes take seconds
+    }
+    // Marlin's "Error:" is followed by "Resend:" and its own "ok".
+    if (options_.family == FirmwareFamily::Marlin) options_.error_acknowledges = false;
 
     std::weak_ptr<bool> alive = alive_;
     uart_.on_transmit([this, alive](Cycle cycle, std::uint8_t byte) {
@@ -172,10 +234,18 @@ UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
         case Startup::WaitForBanner:
             mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.banner_timeout_s), [this, alive](Cycle) {
                 if (alive.expired() || ready_ || failed_) return;
+                if (banner_ && options_.family != FirmwareFamily::Generic) {
+                    become_ready();  // welcomed, but never quiet: start anyway
+                    return;
+                }
                 HostEvent e;
                 e.kind = HostEventKind::BannerTimeout;
                 e.cycle = mcu_.cycle();
-                e.message = options_.banner_contains.empty()
+                const char* welcome = options_.family == FirmwareFamily::Grbl ? "Grbl X.Y" : "start";
+                e.message = options_.family != FirmwareFamily::Generic
+                                ? std::string("no welcome '") + welcome + "' from the " + to_string(options_.family) +
+                                      " firmware within " + seconds_text(options_.banner_timeout_s)
+                            : options_.banner_contains.empty()
                                 ? "no banner from the firmware within " + seconds_text(options_.banner_timeout_s)
                                 : "no banner containing '" + options_.banner_contains + "' from the firmware within " +
                                       seconds_text(options_.banner_timeout_s);
@@ -277,11 +347,38 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     const TranscriptEntry entry{cycle, Direction::Received, text, 0};
     transcript_.push_back(entry);
 
+    // Any output is a sign of life: every timeout starts again.
+    if (!failed_ && !outstanding_.empty()) arm_line_timeout();
+
+    const FirmwareFamily family = options_.family;
     if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) {
-        if (options_.banner_contains.empty() || text.find(options_.banner_contains) != std::string::npos) {
+        if (family != FirmwareFamily::Generic) {
+            // Everything before the welcome is discarded by the firmware's own
+            // init anyway (grbl resets its read buffer); after it, wait for quiet.
+            if (is_welcome(family, text)) banner_ = text;
+            if (banner_) arm_quiet_timer();
+        } else if (options_.banner_contains.empty() || text.find(options_.banner_contains) != std::string::npos) {
             banner_ = text;
             become_ready();
         }
+    } else if (ready_ && is_welcome(family, text)) {
+        HostEvent e;
+        e.kind = HostEventKind::Restarted;
+        e.cycle = cycle;
+        e.response = text;
+        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
+        e.message = "the firmware restarted mid-job (welcome '" + text + "' again" +
+                    (e.line ? ", while line " + std::to_string(e.line->number) + " '" + e.line->text + "' was unanswered)" : ")");
+        fail(std::move(e));
+    } else if (is_unsolicited(family, text)) {
+        // Reports and keep-alives: transcript only.
+    } else if (family == FirmwareFamily::Marlin && starts_with(text, "Resend:")) {
+        resend(cycle, text);
+    } else if (starts_with(text, "ok") && resend_on_next_ok_) {
+        resend_on_next_ok_ = false;
+        const GcodeLine& line = lines_[outstanding_.front().index];
+        transcript_.push_back(TranscriptEntry{cycle, Direction::Sent, line.text, line.number});
+        uart_.send(line.text + "\n");
     } else if (starts_with(text, "ok")) {
         ++oks_;
         acknowledge();
@@ -411,10 +508,60 @@ void UartHost::send_line(std::size_t index) {
 void UartHost::arm_line_timeout() {
     const std::uint64_t generation = ++timeout_generation_;
     std::weak_ptr<bool> alive = alive_;
-    mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.line_timeout_s), [this, alive, generation](Cycle) {
+    mcu_.scheduler().after(mcu_.cycles_from_seconds(timeout_for_oldest_s()), [this, alive, generation](Cycle) {
         if (alive.expired() || generation != timeout_generation_) return;
         on_line_timeout();
     });
+}
+
+// After the welcome, the first line goes out once the firmware has been
+// quiet for quiet_after_welcome_s: each line of boot chatter starts it again.
+void UartHost::arm_quiet_timer() {
+    const std::uint64_t generation = ++quiet_generation_;
+    std::weak_ptr<bool> alive = alive_;
+    mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.quiet_after_welcome_s), [this, alive, generation](Cycle) {
+        if (alive.expired() || generation != quiet_generation_) return;
+        become_ready();
+    });
+}
+
+// Marlin asks for a line again ("Resend: N" after "Error:checksum mismatch"
+// or a line-number mismatch) and then says "ok": that "ok" means "ready",
+// not "done". The host sends its oldest unanswered line again on that ok
+// (as Printrun does); the resent line gets an ok of its own.
+void UartHost::resend(Cycle, const std::string&) {
+    ++resends_;
+    if (!outstanding_.empty()) resend_on_next_ok_ = true;
+}
+
+// The timeout for the oldest unanswered line: longer for commands that take
+// long by design.
+double UartHost::timeout_for_oldest_s() const {
+    if (outstanding_.empty()) return options_.line_timeout_s;
+    const GcodeLine& line = lines_[outstanding_.front().index];
+    std::string upper;
+    for (char c : line.text) upper.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    auto has_word = [&upper](const char* word) {
+        const std::size_t n = std::strlen(word);
+        for (std::size_t at = upper.find(word); at != std::string::npos; at = upper.find(word, at + 1)) {
+            const bool start_ok = at == 0 || !std::isalnum(static_cast<unsigned char>(upper[at - 1]));
+            const bool end_ok = at + n >= upper.size() || !std::isdigit(static_cast<unsigned char>(upper[at + n]));
+            if (start_ok && end_ok) return true;
+        }
+        return false;
+    };
+    if (has_word("G4")) {
+        // Dwell: P in milliseconds (S in seconds on Marlin/Teacup).
+        double dwell_s = 0;
+        const auto p = upper.find('P'), sec = upper.find('S');
+        if (p != std::string::npos) dwell_s = std::strtod(upper.c_str() + p + 1, nullptr) / 1000.0;
+        else if (sec != std::string::npos) dwell_s = std::strtod(upper.c_str() + sec + 1, nullptr);
+        if (std::isfinite(dwell_s) && dwell_s > 0) return std::min(dwell_s, 1e6) + options_.line_timeout_s;
+    }
+    for (const char* long_one : {"M109", "M190", "M116", "G28", "G29", "$H"}) {
+        if (has_word(long_one)) return std::max(options_.long_command_timeout_s, options_.line_timeout_s);
+    }
+    return options_.line_timeout_s;
 }
 
 void UartHost::on_line_timeout() {
@@ -425,7 +572,7 @@ void UartHost::on_line_timeout() {
     e.cycle = mcu_.cycle();
     e.line = line;
     e.message = "line " + std::to_string(line.number) + " '" + line.text + "' got no answer within " +
-                seconds_text(options_.line_timeout_s);
+                seconds_text(timeout_for_oldest_s());
     fail(std::move(e));
 }
 

@@ -53,8 +53,32 @@ enum class Startup {
     FixedDelay,     // wait startup_delay_s of simulated time
 };
 
+// What the firmware on the other end speaks. Each family has its welcome,
+// its unsolicited output and its answers (docs/THIRD_PARTY.md):
+//   grbl    welcome "Grbl X.Y"; '>' startup-line results, '[MSG:', '[GC:',
+//           '<...>' status reports are unsolicited; ok / error:N answer a line
+//   marlin  welcome "start"; "echo:", "busy:", "//" and temperature reports
+//           ("T:...", " T:...") are unsolicited keep-alives; "Error:" is
+//           followed by "Resend: N" and an "ok"
+//   teacup  welcome "start" (and a boot "ok", unsolicited); "T:" reports
+//   generic nothing assumed: sends at once, every line is an answer or text
+enum class FirmwareFamily { Generic, Grbl, Marlin, Teacup };
+const char* to_string(FirmwareFamily family);
+// "generic", "grbl", "marlin", "teacup"; BadInput naming `what` otherwise.
+FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what);
+
 struct UartHostOptions {
     FlowControl flow = FlowControl::SendAndWait;
+    FirmwareFamily family = FirmwareFamily::Generic;
+    // A family's welcome: wait for it, then for this long without output
+    // (boot chatter: settings, SD card probes) before the first line.
+    // Assumed: 200 ms, longer than any boot message burst at 115200 baud.
+    double quiet_after_welcome_s = 0.2;
+    // Commands that take long by design (G4, M109, M190, M116, G28, G29, $H)
+    // get this timeout, or the dwell time plus line_timeout_s for G4. Any
+    // output from the firmware (keep-alives) re-arms every timeout.
+    // Assumed: 10 min, longer than any heat-up or homing cycle.
+    double long_command_timeout_s = 600.0;
     // Character counting: the firmware's receive buffer. 128 = grbl 1.1's
     // RX_BUFFER_SIZE on the ATmega328P (grbl/serial.h).
     std::size_t rx_buffer_bytes = 128;
@@ -112,6 +136,7 @@ enum class HostEventKind {
     Timeout,        // a line got no answer within line_timeout_s
     BannerTimeout,  // WaitForBanner: no banner within banner_timeout_s
     LineTooLong,    // character counting: a line longer than the receive buffer can never be sent
+    Restarted,      // the family's welcome came again mid-job: the firmware reset
 };
 
 const char* to_string(HostEventKind kind);
@@ -177,6 +202,9 @@ public:
     // --- answers -----------------------------------------------------------
     std::size_t oks() const { return oks_; }
     std::size_t errors() const { return errors_; }
+    std::size_t resends() const { return resends_; }
+    // Answers that came with no line outstanding (a boot "ok", say).
+    std::size_t unsolicited_oks() const { return unsolicited_acks_; }
     std::size_t alarms() const { return alarms_; }
     std::size_t fatals() const { return fatals_; }
     // ok/error answers that arrived with no line outstanding.
@@ -198,6 +226,13 @@ public:
     bool run_until_finished(double max_seconds);
 
 private:
+    void arm_quiet_timer();
+    void resend(Cycle cycle, const std::string& text);
+    double timeout_for_oldest_s() const;
+    std::uint64_t quiet_generation_ = 0;
+    std::size_t resends_ = 0;
+    bool resend_on_next_ok_ = false;
+
     struct Outstanding {
         std::size_t index;  // into lines_
         std::size_t bytes;  // text + '\n'

@@ -63,6 +63,8 @@ struct RunArgs {
     bool wait_banner = false;
     std::string settle = "50ms";
     std::string report;
+    std::string family;        // --family: overrides the board's
+    std::string line_timeout;  // --line-timeout: overrides the board's
 };
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
@@ -235,15 +237,13 @@ int run_board_command(const RunArgs& args) {
                 throw BadInput("--uart-in: port " + decl.name + " already streams --gcode; give another port (PORT=FILE)");
             }
         }
-        std::optional<UartHostOptions> options;
-        if (!args.flow.empty() || args.wait_banner) {
-            UartHostOptions o;
-            o.flow = parse_flow_control(decl.flow, decl.location);
-            o.rx_buffer_bytes = decl.rx_buffer_bytes;
-            if (!args.flow.empty()) o.flow = parse_flow_control(args.flow, "--flow");
-            if (args.wait_banner) o.startup = Startup::WaitForBanner;
-            options = o;
-        }
+        UartHostOptions o = default_host_options(decl);
+        if (!args.flow.empty()) o.flow = parse_flow_control(args.flow, "--flow");
+        if (!args.family.empty()) o.family = parse_firmware_family(args.family, "--family");
+        if (!args.line_timeout.empty()) o.line_timeout_s = seconds_from_ps(parse_duration_ps(args.line_timeout, "--line-timeout"));
+        if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
+        if (args.wait_banner) o.startup = Startup::WaitForBanner;
+        const std::optional<UartHostOptions> options = o;
         host = &bench.host(decl.name, options);
         host->load_file(args.gcode);
     }
@@ -590,6 +590,10 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--host", run.host, "the board's serial port for --gcode (default: the first)");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");
     run_cmd->add_flag("--wait-banner", run.wait_banner, "send the job only after the firmware's first output line");
+    run_cmd->add_option("--family", run.family,
+                        "grbl | marlin | teacup | generic: the firmware's protocol on the --host port (default: the board's)");
+    run_cmd->add_option("--line-timeout", run.line_timeout,
+                        "a line unanswered this long with no output at all is a timeout (default: the board's, 2s)");
     run_cmd->add_option("--settle", run.settle, "motion has stopped after no STEP edge for this long (default 50ms)");
     run_cmd->add_option("--report", run.report, "write an HTML report of the run (with --board)");
     run_cmd->add_flag("--until-sleep", run.until_sleep, "stop when the firmware first executes SLEEP (bounded by --for)");

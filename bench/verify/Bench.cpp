@@ -75,6 +75,15 @@ void Bench::watch_motion() {
     }
 }
 
+UartHostOptions default_host_options(const SerialDecl& decl) {
+    UartHostOptions o;
+    o.flow = parse_flow_control(decl.flow, decl.location);
+    o.rx_buffer_bytes = decl.rx_buffer_bytes;
+    o.family = parse_firmware_family(decl.family, decl.location);
+    o.line_timeout_s = decl.line_timeout_s;
+    return o;
+}
+
 const SerialDecl& Bench::serial_decl(const std::string& port) const {
     const auto& serial = board_->spec().serial;
     if (serial.empty()) throw BadInput(board_->spec().path + ": the board declares no serial port");
@@ -100,8 +109,7 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
         if (options) {
             o = *options;
         } else {
-            o.flow = parse_flow_control(decl->flow, decl->location);
-            o.rx_buffer_bytes = decl->rx_buffer_bytes;
+            o = default_host_options(*decl);
         }
         slot = std::make_unique<UartHost>(board_->mcu(decl->mcu), decl->usart, o);
     }

@@ -40,6 +40,9 @@ const char* to_string(IdleResult result);
 // letter; stops at a ';' or '(' comment or a '*' checksum. "M104 S200 T1".
 std::map<char, double> gcode_words(const std::string& line);
 
+// A host's options as the board file's serial port declares them.
+UartHostOptions default_host_options(const SerialDecl& decl);
+
 class Bench {
 public:
     // The ELF runs on the board's first MCU.

@@ -306,12 +306,12 @@ ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_
     }
     if (!root.IsMap()) throw BadInput(path + ":1: a scenario is a map with board, firmware, steps, expect");
     check_unique_keys(root, path);
-    static const std::set<std::string> kKeys = {"name", "description", "board", "firmware", "time_limit",
-                                                "steps", "expect", "golden", "golden_signals", "tolerances"};
+    static const std::set<std::string> kKeys = {"name",   "description", "board",  "firmware",       "time_limit", "host",
+                                                "steps",  "expect",      "golden", "golden_signals", "tolerances"};
     for (const auto& kv : root) {
         if (kKeys.count(kv.first.Scalar()) == 0) {
             throw BadInput(where(path, kv.first) + ": unknown key '" + kv.first.Scalar() +
-                           "' (expected name, description, board, firmware, time_limit, steps, expect, golden, "
+                           "' (expected name, description, board, firmware, time_limit, host, steps, expect, golden, "
                            "golden_signals, tolerances)");
         }
     }
@@ -351,6 +351,25 @@ ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_
     }
     if (root["time_limit"]) {
         spec.time_limit_ps = parse_duration_ps(scalar(root["time_limit"], path, "time_limit"), where(path, root["time_limit"]) + ": time_limit");
+    }
+    if (const YAML::Node host = root["host"]) {
+        if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout}");
+        names.check_serial("host", where(path, host));
+        for (const auto& kv : host) {
+            const std::string key = scalar(kv.first, path, "host key");
+            const std::string value = scalar(kv.second, path, key);
+            if (key == "family") {
+                if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
+                    throw BadInput(where(path, kv.second) + ": family '" + value + "' is not grbl, marlin, teacup or generic");
+                }
+                spec.host_family = value;
+            } else if (key == "line_timeout") {
+                spec.host_line_timeout_ps = parse_duration_ps(value, where(path, kv.second) + ": line_timeout");
+                if (*spec.host_line_timeout_ps == 0) throw BadInput(where(path, kv.second) + ": line_timeout must be longer than 0");
+            } else {
+                throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout)");
+            }
+        }
     }
     auto sequence = [&](const char* key) {
         const YAML::Node node = root[key];

@@ -80,6 +80,10 @@ struct ScenarioSpec {
     // Globs of the signals the golden holds. Empty: every wire and bus.
     std::vector<std::string> golden_signals;
     std::vector<ChannelRule> tolerances;
+    // `host: {family, line_timeout}`: the first serial port's host, instead of
+    // what the board file declares (e.g. our own firmware on a grbl board).
+    std::optional<std::string> host_family;
+    std::optional<Picoseconds> host_line_timeout_ps;
     // Paths of send_file steps, resolved.
     std::vector<std::string> stimulus_files() const;
 };

@@ -235,6 +235,12 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     const auto wall_start = std::chrono::steady_clock::now();
     Bench bench(spec.board_path, spec.firmware);
     bind(spec, bench);
+    if (spec.host_family || spec.host_line_timeout_ps) {
+        UartHostOptions o = default_host_options(bench.serial_decl());
+        if (spec.host_family) o.family = parse_firmware_family(*spec.host_family, spec.path);
+        if (spec.host_line_timeout_ps) o.line_timeout_s = seconds_from_ps(*spec.host_line_timeout_ps);
+        bench.host("", o);
+    }
     bench.trace_board();
     auto fail = [&](const std::string& message) {
         result.failures.push_back(message);

@@ -235,6 +235,9 @@ std::string rendered_dom(const ScratchDir& dir, const RunReport& report, const s
 TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
     ScratchDir dir;
     Bench bench(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), test::firmware("stepdir_test"));
+    UartHostOptions generic = default_host_options(bench.serial_decl());
+    generic.family = FirmwareFamily::Generic;  // our test firmware prints no grbl welcome
+    bench.host("", generic);
     bench.trace_board();
     bench.host().add_lines("E1\nX1600\n");
     ASSERT_EQ(bench.run_until_idle(2.0), IdleResult::Idle);
@@ -265,6 +268,9 @@ TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
 TEST(HtmlReport, ThermalRunShowsSensorTargetDutyInsideTheFrameAndTheFault) {
     ScratchDir dir;
     Bench bench(test::source_path("bench/boards/ramps-1.4.yaml"), test::firmware("thermal_pid"));
+    UartHostOptions generic = default_host_options(bench.serial_decl());
+    generic.family = FirmwareFamily::Generic;  // thermal_pid prints no Marlin welcome
+    bench.host("", generic);
     bench.trace_board();
     // thermal_pid reads no serial input: the line stays unanswered, but what
     // the host sent sets the target drawn in the report.

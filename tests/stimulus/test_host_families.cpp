@@ -1,0 +1,125 @@
+// The UART host against the serial protocols of grbl, Marlin and Teacup as
+// their documentation describes them (firmware/host_peer): boot chatter is
+// not an answer, keep-alives and long commands do not time out, Marlin's
+// Error/Resend/ok triplet resends the line, a welcome mid-job is a restart.
+#include <gtest/gtest.h>
+
+#include "core/Mcu.hpp"
+#include "stimulus/UartHost.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+struct Peer {
+    Mcu mcu;
+    UartHost host;
+    Peer(const std::string& firmware, FirmwareFamily family, FlowControl flow = FlowControl::SendAndWait)
+        : mcu(ElfImage::load(test::firmware(firmware))), host(mcu, 0, options(family, flow)) {}
+    static UartHostOptions options(FirmwareFamily family, FlowControl flow) {
+        UartHostOptions o;
+        o.family = family;
+        o.flow = flow;
+        return o;
+    }
+    Cycle first_sent() const {
+        for (const auto& e : host.transcript()) {
+            if (e.direction == Direction::Sent) return e.cycle;
+        }
+        return 0;
+    }
+    Cycle received(const std::string& text) const {
+        for (const auto& e : host.transcript()) {
+            if (e.direction == Direction::Received && e.text == text) return e.cycle;
+        }
+        return 0;
+    }
+};
+
+TEST(HostFamilies, GrblBootChatterIsNotAnAnswer) {
+    // grbl on a blank EEPROM: error:7 and its settings, the welcome, then
+    // ">:error:7" twice. None of it answers line 1.
+    Peer p("host_peer_grbl", FirmwareFamily::Grbl, FlowControl::CharacterCounting);
+    p.host.add_lines("G21\nG91\nG1 X10 F500\n");
+    ASSERT_TRUE(p.host.run_until_finished(5.0)) << p.host.failure_message() << p.host.tail(12);
+    EXPECT_TRUE(p.host.done());
+    EXPECT_EQ(p.host.lines_acknowledged(), 3u);
+    EXPECT_EQ(p.host.oks(), 3u);
+    EXPECT_EQ(p.host.errors(), 0u);  // error:7 came before the welcome; >:error:7 is a startup-line report
+    EXPECT_TRUE(p.host.events().empty());
+    // Nothing was sent before the welcome (grbl would have discarded it).
+    EXPECT_GT(p.first_sent(), p.received("Grbl 1.1h ['$' for help]"));
+}
+
+TEST(HostFamilies, GrblDwellLongerThanTheLineTimeoutIsNotATimeout) {
+    // G4 P3000: 3 s of silence, then ok; the timeout for it is the dwell plus
+    // the 2 s line timeout.
+    Peer p("host_peer_grbl", FirmwareFamily::Grbl);
+    p.host.add_lines("G4 P3000\nG1 X1\n");
+    ASSERT_TRUE(p.host.run_until_finished(10.0)) << p.host.failure_message();
+    EXPECT_EQ(p.host.lines_acknowledged(), 2u);
+}
+
+TEST(HostFamilies, GrblWelcomeMidJobIsARestart) {
+    Peer p("host_peer_grbl", FirmwareFamily::Grbl);
+    p.host.add_lines("G1 X1\nRESET\nG1 X2\n");
+    p.host.run_until_finished(5.0);
+    ASSERT_TRUE(p.host.failed());
+    ASSERT_FALSE(p.host.events().empty());
+    EXPECT_EQ(p.host.events().back().kind, HostEventKind::Restarted);
+    EXPECT_NE(p.host.failure_message().find("the firmware restarted mid-job (welcome 'Grbl 1.1h"), std::string::npos)
+        << p.host.failure_message();
+    // After the reset the firmware's boot report "error:7" (blank EEPROM)
+    // answered RESET, as it would for any host; line 3 went out and was
+    // unanswered when the welcome came again.
+    EXPECT_NE(p.host.failure_message().find("line 3 'G1 X2' was unanswered"), std::string::npos) << p.host.failure_message();
+}
+
+TEST(HostFamilies, MarlinSlowBootKeepAlivesAndResend) {
+    // A 2.1 s SD probe after "start"; M109 with "echo:busy: processing" every
+    // second for 5 s; a line with a bad checksum answered Error/Resend/ok and
+    // then ok when sent again.
+    Peer p("host_peer_marlin", FirmwareFamily::Marlin);
+    p.host.add_lines("G28 X\nM109 S200\nG1 X1*99\nG1 X2\n");
+    ASSERT_TRUE(p.host.run_until_finished(20.0)) << p.host.failure_message() << p.host.tail(12);
+    EXPECT_TRUE(p.host.done());
+    EXPECT_EQ(p.host.lines_acknowledged(), 4u);
+    EXPECT_EQ(p.host.resends(), 1u);
+    // The bad line went out twice; every other line once.
+    std::size_t sent_bad = 0;
+    for (const auto& e : p.host.transcript()) sent_bad += e.direction == Direction::Sent && e.text == "G1 X1*99" ? 1 : 0;
+    EXPECT_EQ(sent_bad, 2u);
+    EXPECT_GT(p.first_sent(), p.received("start"));
+}
+
+TEST(HostFamilies, TeacupBootOkAndSilentM116) {
+    // Teacup's boot "ok" answers nothing; M116 waits 5 s without output (a
+    // long command: no timeout).
+    Peer p("host_peer_teacup", FirmwareFamily::Teacup);
+    p.host.add_lines("M104 S200\nM116\nG1 X10 F600\n");
+    ASSERT_TRUE(p.host.run_until_finished(15.0)) << p.host.failure_message() << p.host.tail(12);
+    EXPECT_EQ(p.host.lines_acknowledged(), 3u);
+    EXPECT_EQ(p.host.oks(), 3u);  // the boot ok, before any line, answered nothing
+    EXPECT_EQ(p.host.unsolicited_oks(), 0u);
+    Cycle boot_ok = 0;
+    for (const auto& e : p.host.transcript()) {
+        if (e.direction == Direction::Received && e.text == "ok") {
+            boot_ok = e.cycle;
+            break;
+        }
+    }
+    EXPECT_GT(boot_ok, 0u);
+    EXPECT_LT(boot_ok, p.first_sent());
+}
+
+TEST(HostFamilies, GenericHostTakesBootChatterAsAnswers) {
+    // Without a family the host sends at once: grbl's boot error:7 answers
+    // line 1. This is why boards name their firmware's family.
+    Peer p("host_peer_grbl", FirmwareFamily::Generic, FlowControl::CharacterCounting);
+    p.host.add_lines("G21\n");
+    p.host.run_until_finished(2.0);
+    EXPECT_EQ(p.host.errors(), 1u);
+}
+
+}  // namespace
+}  // namespace avrbench
