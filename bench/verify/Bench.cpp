@@ -163,7 +163,16 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
             all_finished = all_finished && host->finished();
         }
         const Picoseconds now = now_ps();
-        const bool motion_settled = last_step_ps_ ? now - std::min(now, *last_step_ps_) >= settle_ps : now >= settle_ps;
+        // Quiet since the later of the last STEP edge and the last line
+        // either way on any port: a firmware that answers "ok" at once and
+        // starts moving a little later (grbl's planner) is not idle yet.
+        Picoseconds last_activity = last_step_ps_.value_or(0);
+        for (auto& [name, host] : hosts_) {
+            if (host->transcript().empty()) continue;
+            const Mcu& m = board_->mcu(board_->spec().find_serial(name)->mcu);
+            last_activity = std::max(last_activity, ps_at_cycle(m, host->transcript().back().cycle));
+        }
+        const bool motion_settled = now - std::min(now, last_activity) >= settle_ps;
         if (all_finished && motion_settled) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
         if (user_stop_requested()) return IdleResult::Interrupted;
