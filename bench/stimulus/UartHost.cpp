@@ -491,6 +491,14 @@ void UartHost::pump() {
 
 void UartHost::send_line(std::size_t index) {
     const GcodeLine& line = lines_[index];
+    if (options_.family == FirmwareFamily::Grbl && (line.text == "?" || line.text == "!" || line.text == "~")) {
+        // grbl's realtime commands are single bytes picked out of the stream:
+        // not counted in its receive buffer, never answered with ok.
+        transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
+        uart_.send(line.text);
+        ++acknowledged_;
+        return;
+    }
     const std::size_t bytes = line.text.size() + 1;
     const bool was_idle = outstanding_.empty();
     outstanding_.push_back(Outstanding{index, bytes});
@@ -500,6 +508,9 @@ void UartHost::send_line(std::size_t index) {
     transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
     if (was_idle) arm_line_timeout();
     uart_.send(line.text + "\n");
+    if (was_idle && options_.family == FirmwareFamily::Grbl && options_.grbl_status_poll_s > 0) {
+        poll_status(++poll_generation_);
+    }
 }
 
 // The oldest unanswered line must be answered within line_timeout_s of the
@@ -551,17 +562,34 @@ double UartHost::timeout_for_oldest_s() const {
         return false;
     };
     if (has_word("G4")) {
-        // Dwell: P in milliseconds (S in seconds on Marlin/Teacup).
+        // Dwell: P in seconds on grbl (its G-code reference follows
+        // LinuxCNC), in milliseconds on Marlin and Teacup (S in seconds).
+        // grbl and Marlin first wait for every queued move to finish, so G4
+        // is a long command whatever its dwell.
         double dwell_s = 0;
         const auto p = upper.find('P'), sec = upper.find('S');
-        if (p != std::string::npos) dwell_s = std::strtod(upper.c_str() + p + 1, nullptr) / 1000.0;
+        const double p_unit_s = options_.family == FirmwareFamily::Grbl ? 1.0 : 1e-3;
+        if (p != std::string::npos) dwell_s = std::strtod(upper.c_str() + p + 1, nullptr) * p_unit_s;
         else if (sec != std::string::npos) dwell_s = std::strtod(upper.c_str() + sec + 1, nullptr);
-        if (std::isfinite(dwell_s) && dwell_s > 0) return std::min(dwell_s, 1e6) + options_.line_timeout_s;
+        if (!std::isfinite(dwell_s) || dwell_s < 0) dwell_s = 0;
+        return std::max(options_.long_command_timeout_s, std::min(dwell_s, 1e6) + options_.line_timeout_s);
     }
     for (const char* long_one : {"M109", "M190", "M116", "G28", "G29", "$H"}) {
         if (has_word(long_one)) return std::max(options_.long_command_timeout_s, options_.line_timeout_s);
     }
     return options_.line_timeout_s;
+}
+
+// While lines are unanswered, a '?' every grbl_status_poll_s: the report it
+// brings back is the keep-alive that restarts the timeouts.
+void UartHost::poll_status(std::uint64_t generation) {
+    std::weak_ptr<bool> alive = alive_;
+    mcu_.scheduler().after(mcu_.cycles_from_seconds(options_.grbl_status_poll_s), [this, alive, generation](Cycle) {
+        if (alive.expired() || generation != poll_generation_ || failed_ || outstanding_.empty()) return;
+        uart_.send("?");
+        ++status_polls_;
+        poll_status(generation);
+    });
 }
 
 void UartHost::on_line_timeout() {

@@ -79,6 +79,11 @@ struct UartHostOptions {
     // output from the firmware (keep-alives) re-arms every timeout.
     // Assumed: 10 min, longer than any heat-up or homing cycle.
     double long_command_timeout_s = 600.0;
+    // grbl: the status query '?' sent this often while lines are unanswered,
+    // as grbl senders do (Universal G-code Sender and bCNC poll about every
+    // 200 ms); grbl answers with a '<...>' report even mid-move, so a silent
+    // grbl is a hung grbl. 0 disables it. Assumed: 250 ms.
+    double grbl_status_poll_s = 0.25;
     // Character counting: the firmware's receive buffer. 128 = grbl 1.1's
     // RX_BUFFER_SIZE on the ATmega328P (grbl/serial.h).
     std::size_t rx_buffer_bytes = 128;
@@ -203,6 +208,7 @@ public:
     std::size_t oks() const { return oks_; }
     std::size_t errors() const { return errors_; }
     std::size_t resends() const { return resends_; }
+    std::size_t status_polls() const { return status_polls_; }  // grbl '?' sent as keep-alive queries
     // Answers that came with no line outstanding (a boot "ok", say).
     std::size_t unsolicited_oks() const { return unsolicited_acks_; }
     std::size_t alarms() const { return alarms_; }
@@ -226,6 +232,10 @@ public:
     bool run_until_finished(double max_seconds);
 
 private:
+    void poll_status(std::uint64_t generation);
+    std::uint64_t poll_generation_ = 0;
+    std::size_t status_polls_ = 0;
+
     void arm_quiet_timer();
     void resend(Cycle cycle, const std::string& text);
     double timeout_for_oldest_s() const;

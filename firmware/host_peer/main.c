@@ -9,7 +9,10 @@
  *   "$0=10", ...), then prints "Grbl 1.1h ['$' for help]", then the results
  *   of its two startup lines (">:error:7" twice: the blank startup blocks).
  *   Input received before the welcome is discarded (serial_reset_read_buffer).
- *   Each line is answered "ok"; "G4 P<ms>" after the dwell; "RESET" makes it
+ *   Each line is answered "ok"; "G4 P<s>" after the dwell (grbl's P is in
+ *   seconds, as in LinuxCNC); "BUSY<s>" works that long before its ok but
+ *   answers the realtime status query '?' meanwhile, as grbl does mid-move;
+ *   "RESET" makes it
  *   reset (watchdog) and print all of the above again.
  * Marlin 1.x: "start", "echo:" lines, then an SD card probe that takes 2.1 s
  *   before "echo:SD init fail"; each line "ok"; "M109 ..." prints
@@ -53,6 +56,32 @@ static void print_P(const char *text)
 
 static char line[96];
 
+#if defined(FAMILY_GRBL)
+/* grbl picks realtime bytes out of the stream at once: '?' is answered with
+ * a status report, whatever the main loop is doing. */
+static uint8_t realtime(char c)
+{
+    if (c != '?') return 0;
+    print_P(PSTR("<Idle|MPos:0.000,0.000,0.000|FS:0,0>\r\n"));
+    return 1;
+}
+
+/* `seconds` of work that still answers realtime queries ("BUSY<s>"). */
+static void busy(long seconds)
+{
+    for (long ms = seconds * 1000L; ms > 0; --ms) {
+        if (bit_is_set(UCSR0A, RXC0)) realtime((char)UDR0);
+        _delay_ms(1);
+    }
+}
+#else
+static uint8_t realtime(char c)
+{
+    (void)c;
+    return 0;
+}
+#endif
+
 /* One line from the host (without its line end), polled. */
 static void read_line(void)
 {
@@ -60,6 +89,7 @@ static void read_line(void)
     for (;;) {
         loop_until_bit_is_set(UCSR0A, RXC0);
         const char c = (char)UDR0;
+        if (realtime(c)) continue;
         if (c == '\n' || c == '\r') {
             if (n == 0) continue;
             line[n] = '\0';
@@ -98,8 +128,9 @@ int main(void)
             }
         }
         if (strncmp_P(line, PSTR("G4 P"), 4) == 0) {
-            for (long ms = atol(line + 4); ms > 0; --ms) _delay_ms(1);
+            for (long ms = atol(line + 4) * 1000L; ms > 0; --ms) _delay_ms(1);
         }
+        if (strncmp_P(line, PSTR("BUSY"), 4) == 0) busy(atol(line + 4));
         SAY("ok");
     }
 #elif defined(FAMILY_MARLIN)

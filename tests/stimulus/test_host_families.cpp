@@ -52,12 +52,45 @@ TEST(HostFamilies, GrblBootChatterIsNotAnAnswer) {
 }
 
 TEST(HostFamilies, GrblDwellLongerThanTheLineTimeoutIsNotATimeout) {
-    // G4 P3000: 3 s of silence, then ok; the timeout for it is the dwell plus
-    // the 2 s line timeout.
+    // G4 P3 (grbl: seconds): 3 s of silence, then ok. G4 waits for queued
+    // motion first, so it gets the long-command timeout, not the 2 s one.
+    UartHostOptions o = Peer::options(FirmwareFamily::Grbl, FlowControl::SendAndWait);
+    o.grbl_status_poll_s = 0;  // host_peer answers no '?': test the timeout alone
+    Mcu mcu(ElfImage::load(test::firmware("host_peer_grbl")));
+    UartHost host(mcu, 0, o);
+    host.add_lines("G4 P3\nG1 X1\n");
+    ASSERT_TRUE(host.run_until_finished(10.0)) << host.failure_message();
+    EXPECT_EQ(host.lines_acknowledged(), 2u);
+}
+
+TEST(HostFamilies, GrblRealtimeQueryIsAByteNotALine) {
+    // '?' in a job is grbl's realtime status query: sent as one byte, never
+    // answered with ok (grbl answers with a '<...>' report).
     Peer p("host_peer_grbl", FirmwareFamily::Grbl);
-    p.host.add_lines("G4 P3000\nG1 X1\n");
-    ASSERT_TRUE(p.host.run_until_finished(10.0)) << p.host.failure_message();
-    EXPECT_EQ(p.host.lines_acknowledged(), 2u);
+    p.host.add_lines("G1 X1\n?\nG1 X2\n");
+    ASSERT_TRUE(p.host.run_until_finished(5.0)) << p.host.failure_message();
+    EXPECT_EQ(p.host.lines_acknowledged(), 3u);
+    EXPECT_EQ(p.host.oks(), 2u);
+}
+
+TEST(HostFamilies, GrblStatusPollsKeepALongMoveAlive) {
+    // 5 s of work before the ok (a long move fills grbl's planner) and
+    // nothing printed unless asked: the host's '?' every 250 ms brings a
+    // report each time, and every report restarts the 2 s line timeout.
+    Peer polled("host_peer_grbl", FirmwareFamily::Grbl);
+    polled.host.add_lines("BUSY5\n");
+    ASSERT_TRUE(polled.host.run_until_finished(10.0)) << polled.host.failure_message();
+    EXPECT_EQ(polled.host.lines_acknowledged(), 1u);
+    EXPECT_GE(polled.host.status_polls(), 19u);  // 5 s / 0.25 s = 20, give or take the first
+    // Without the polls the same firmware is silent for 5 s: a timeout at 2 s.
+    UartHostOptions o = Peer::options(FirmwareFamily::Grbl, FlowControl::SendAndWait);
+    o.grbl_status_poll_s = 0;
+    Mcu mcu(ElfImage::load(test::firmware("host_peer_grbl")));
+    UartHost silent(mcu, 0, o);
+    silent.add_lines("BUSY5\n");
+    silent.run_until_finished(10.0);
+    ASSERT_TRUE(silent.failed());
+    EXPECT_EQ(silent.events().back().kind, HostEventKind::Timeout);
 }
 
 TEST(HostFamilies, GrblWelcomeMidJobIsARestart) {
