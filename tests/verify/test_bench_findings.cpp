@@ -25,3 +25,26 @@ TEST(BenchFindings, AHostTimeoutSaysItsTimeInSecondsAndCycles) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(BenchIdle, QuietIsCountedFromTheLastHostLineNotFromPowerOn) {
+    // grbl answers "ok" when a move is planned and steps after it; no STEP
+    // edge yet must not make the board idle the moment the ok arrives.
+    // host_peer_grbl answers at once and never steps: idle comes exactly one
+    // settle time (300 ms) after its last line.
+    Bench bench(test::source_path("bench/boards/arduino-uno.yaml"), test::firmware("host_peer_grbl"));
+    UartHostOptions o = default_host_options(bench.serial_decl());
+    o.family = FirmwareFamily::Grbl;
+    bench.host("", o).add_line("G1 X1");
+    ASSERT_EQ(bench.run_until_idle(5.0, 0.3), IdleResult::Idle);
+    const auto& transcript = bench.host().transcript();
+    ASSERT_FALSE(transcript.empty());
+    const double last_line_s = static_cast<double>(transcript.back().cycle) / 16e6;
+    EXPECT_GE(bench.now_seconds(), last_line_s + 0.3);
+    EXPECT_LT(bench.now_seconds(), last_line_s + 0.3 + 0.08);  // within one 75 ms slice
+}
+
+}  // namespace
+}  // namespace avrbench
