@@ -13,6 +13,12 @@
 //    the AVR are immediately reset to their initial state when a reset source
 //    goes active": inputs without pull-up, i.e. the level the outside world
 //    drives, or low when nothing drives the pin (the bench's floating level).
+//  - Pull-ups switched off: simavr raises the pull-up level when an input's
+//    PORTxn becomes 1 but lowers nothing when it becomes 0, when DDxn turns an
+//    output driving high into an input without pull-up, or when PUD disables
+//    every pull-up (§14.2.1, Table 14-1: that pin is tri-state). After every
+//    PORTx, DDRx and PUD write, each input nothing drives is set to its
+//    pull-up (1) or to the floating level (0).
 #include <string_view>
 #include <vector>
 
@@ -43,6 +49,14 @@ public:
             io->reset = &on_reset;
             port_registry().add(io, this);
             pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_pin, &on_pin_write, this));
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_port, &on_port_or_ddr_write, this));
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_ddr, &on_port_or_ddr_write, this));
+        }
+        // PUD: MCUCR bit 4 on the 328P/2560 (§14.4.1 / §13.4.1), SFIOR bit 2 on the ATmega32.
+        if (facts_.known) {
+            pud_register_ = facts_.old_mega ? 0x50 : 0x55;
+            pud_mask_ = facts_.old_mega ? 0x04 : 0x10;
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, pud_register_, &on_pud_write, this));
         }
     }
 
@@ -66,6 +80,33 @@ private:
         const std::uint8_t toggles = self->facts_.sbi_single_bit ? single_bit_write_value(avr, addr, value) : value;
         if (toggles == 0) return;
         hook.write_original(avr, addr, toggles);
+        self->settle_inputs(avr);  // a toggled PORTxn of an input switches its pull-up
+    }
+
+    static void on_port_or_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+        hook.write_original(avr, addr, value);
+        static_cast<PortPins*>(hook.context())->settle_inputs(avr);
+    }
+
+    static void on_pud_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+        hook.write_original(avr, addr, value);
+        static_cast<PortPins*>(hook.context())->settle_inputs(avr);
+    }
+
+    // Every input that nothing outside drives: its pull-up level, or floating (0).
+    void settle_inputs(avr_t* avr) {
+        const bool pud = pud_register_ != 0 && (avr->data[pud_register_] & pud_mask_) != 0;
+        for (auto& p : ports_) {
+            avr_ioport_t* port = p.port;
+            const std::uint8_t ddr = avr->data[port->r_ddr], out = avr->data[port->r_port];
+            for (int bit = 0; bit < 8; ++bit) {
+                const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
+                if ((ddr & mask) != 0 || (port->external.pull_mask & mask) != 0) continue;
+                const std::uint32_t level = (out & mask) != 0 && !pud ? 1 : 0;
+                avr_irq_t* irq = port->io.irq + bit;
+                if ((irq->value & 0xFF) != level) avr_raise_irq(irq, level);
+            }
+        }
     }
 
     static void on_reset(avr_io_t* io) {
@@ -84,6 +125,8 @@ private:
     }
 
     PartFacts facts_;
+    avr_io_addr_t pud_register_ = 0;
+    std::uint8_t pud_mask_ = 0;
     std::vector<Port> ports_;
     std::vector<std::unique_ptr<IoWriteHook>> pin_hooks_;
 };
