@@ -1,0 +1,102 @@
+// Arduino sketches built against Debian's arduino-core-avr (firmware/arduino):
+// real third-party code (wiring.c, HardwareSerial, WInterrupts, EEPROM) on the
+// bench, each result checked against the core's documented arithmetic.
+#include <gtest/gtest.h>
+
+#include "core/Mcu.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+Mcu sketch(const std::string& name, const char* mcu_type = "atmega328p") {
+    McuOptions o;
+    o.mcu_type = mcu_type;
+    o.frequency_hz = 16'000'000;  // boards.txt: uno/mega build.f_cpu=16000000L
+    return Mcu(ElfImage::load(test::firmware(name)), o);
+}
+
+TEST(ArduinoCore, MillisReachesOneSecondAndDelayWaitsItsMilliseconds) {
+    Mcu mcu = sketch("ard_millis_delay");
+    Uart& serial = mcu.uart(0);  // records from here on
+    std::vector<std::pair<Cycle, bool>> edges;
+    mcu.pin("PB5").on_change([&edges](Cycle c, bool level) { edges.emplace_back(c, level); });
+    mcu.run_for(16'000'000ull * 16 / 10);  // 1.6 s
+    // wiring.c: Timer0 overflows every 64 * 256 = 16384 cycles (1024 us);
+    // each adds 1 to millis() and 3 to a fraction that carries one more
+    // millisecond at 125. The first overflow count whose millis() >= 1000:
+    unsigned long millis = 0, fract = 0, overflows = 0;
+    while (millis < 1000) {
+        ++overflows;
+        ++millis;
+        fract += 3;
+        if (fract >= 125) {
+            fract -= 125;
+            ++millis;
+        }
+    }
+    ASSERT_GE(edges.size(), 7u);  // high at setup, low at 1 s, five toggles
+    EXPECT_TRUE(edges[0].second);
+    EXPECT_FALSE(edges[1].second);
+    // Timer0 starts in init(), a few hundred cycles after reset; the loop
+    // sees the overflow within a few cycles.
+    const Cycle expected = overflows * 16384;
+    EXPECT_GE(edges[1].first, expected);
+    EXPECT_LT(edges[1].first, expected + 2000) << overflows << " overflows";
+    // delay(100): at least 100 ms (micros() has a 4 us step), plus the
+    // digitalRead/digitalWrite around it (a few microseconds). The first
+    // interval also holds the Serial.println before the first delay.
+    EXPECT_GE(edges[2].first - edges[1].first, 1'600'000u);
+    for (std::size_t i = 3; i < 7; ++i) {
+        const Cycle interval = edges[i].first - edges[i - 1].first;
+        EXPECT_GE(interval, 1'600'000u) << "toggle " << i;
+        EXPECT_LT(interval, 1'600'000u + 800u) << "toggle " << i;  // < 50 us over
+    }
+    const std::string out = serial.transmitted_text();
+    EXPECT_EQ(out.substr(0, out.find('\r')), std::to_string(millis)) << out;
+}
+
+void expect_twenty_matches_at_every_phase(const char* elf, const char* mcu_type) {
+    Mcu mcu = sketch(elf, mcu_type);
+    Uart& serial = mcu.uart(0);
+    mcu.run_for(16'000'000ull / 2);  // 8 x (20 ms + up to 2 ms) plus start-up
+    // Counting up from TCNT1 <= 255 (8-bit PWM) to OCR1A = 1999 at clk/8:
+    // the first match within 1 ms, then one every 1 ms: 20 in 20 ms.
+    EXPECT_EQ(serial.transmitted_text(), "20 20 20 20 20 20 20 20\n") << elf;
+}
+
+TEST(ArduinoCore, Timer1SwitchedFromInitsPwmToCtcMatchesEveryMillisecondUno) {
+    expect_twenty_matches_at_every_phase("ard_timer1_ctc_after_init", "atmega328p");
+}
+
+TEST(ArduinoCore, Timer1SwitchedFromInitsPwmToCtcMatchesEveryMillisecondMega) {
+    expect_twenty_matches_at_every_phase("ard_timer1_ctc_after_init_mega", "atmega2560");
+}
+
+TEST(ArduinoCore, InputPullupReadsHighAndAttachInterruptCountsEveryChange) {
+    Mcu mcu = sketch("ard_input_pullup_interrupt");
+    Uart& serial = mcu.uart(0);
+    mcu.run_for(16'000);  // 1 ms: setup() has printed
+    mcu.run_for(160'000);
+    EXPECT_EQ(serial.transmitted_text(), "pullup 1 0\r\n");  // pull-up on; off (floating: the bench's 0)
+    // Drive D2 low then high: two changes, two interrupts.
+    mcu.pin("PD2").drive(false);
+    mcu.run_for(16'000);
+    mcu.pin("PD2").drive(true);
+    mcu.run_for(16'000);
+    serial.send("?");
+    mcu.run_for(160'000);
+    EXPECT_EQ(serial.transmitted_text(), "pullup 1 0\r\nedges 2\r\n");
+}
+
+TEST(ArduinoCore, EepromLibraryWritesAndReadsBack) {
+    Mcu mcu = sketch("ard_eeprom");
+    Uart& serial = mcu.uart(0);
+    // 16 writes of 3.4 ms each (328P Table 8-2, erase and write): ~55 ms.
+    mcu.run_for(16'000'000ull / 10);
+    // Sum of 3a + 7 for a = 0..15 = 3 * 120 + 16 * 7 = 472.
+    EXPECT_EQ(serial.transmitted_text(), "eeprom 472 472\r\n");
+}
+
+}  // namespace
+}  // namespace avrbench
