@@ -1,4 +1,5 @@
 #include "boards/BoardFile.hpp"
+#include "boards/YamlKeys.hpp"
 
 #include "core/Time.hpp"
 
@@ -130,6 +131,7 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
         throw BadInput(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
     }
     if (!root.IsMap()) throw BadInput(path + ":1: a board file is a map with mcus, parts, nets");
+    check_unique_keys(root, path);
 
     BoardSpec spec;
     spec.path = path;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "boards/BoardFile.hpp"
+#include "boards/YamlKeys.hpp"
 #include "core/Errors.hpp"
 #include "core/Finding.hpp"
 #include "core/McuPins.hpp"
@@ -30,19 +31,6 @@ std::string scalar(const YAML::Node& node, const std::string& path, const std::s
 std::string resolve(const std::string& scenario_path, const std::string& relative) {
     if (relative.empty() || fs::path(relative).is_absolute()) return relative;
     return (fs::path(scenario_path).parent_path() / relative).lexically_normal().string();
-}
-
-// Rejects keys the same map holds twice (yaml-cpp silently keeps one).
-void check_unique_keys(const YAML::Node& map, const std::string& path) {
-    if (!map.IsMap()) return;
-    std::set<std::string> seen;
-    for (const auto& kv : map) {
-        if (!kv.first.IsScalar()) throw BadInput(where(path, kv.first) + ": a key must be a single value");
-        if (!seen.insert(kv.first.Scalar()).second) {
-            throw BadInput(where(path, kv.first) + ": duplicate key '" + kv.first.Scalar() + "'");
-        }
-        check_unique_keys(kv.second, path);
-    }
 }
 
 bool parse_level(const std::string& text, const std::string& location) {

@@ -122,6 +122,11 @@ INSTANTIATE_TEST_SUITE_P(
              "bad.yaml:4: part 'x_driver': microsteps: '1.5' is not a whole number"},
         Case{"step_high_min_huge", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_high_min: 1e30s}",
              "bad.yaml:4: part 'x_driver': a timing value of 1000000000000000019884624838656.000000 s is outside 0..1 h"},
+        // yaml-cpp would keep one of the two silently.
+        Case{"duplicate_parameter", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, steps_per_mm: 8, travel: 200mm}",
+             "bad.yaml:5: duplicate key 'steps_per_mm'"},
+        Case{"duplicate_part", 6, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200mm}",
+             "bad.yaml:6: duplicate key 'x'"},
         Case{"mcu_mismatch", 2, "  uno: {type: atmega2560, clock: 16MHz}",
              "{elf}: built for atmega328p, but bad.yaml:2 declares MCU 'uno' as atmega2560"}),
     [](const auto& param_info) { return std::string(param_info.param.name); });

@@ -2,6 +2,10 @@
 // and back off (firmware/boards/limit_probe/main.c).
 #include <gtest/gtest.h>
 
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "boards/Board.hpp"
 #include "parts/Axis.hpp"
 #include "parts/LimitSwitch.hpp"
@@ -12,15 +16,41 @@ namespace {
 
 // 250 steps/mm (grbl default), carriage at 1 mm, switch at 0.5 mm with
 // 0.05 mm hysteresis.
+// `switch_extra` (", contact: NC, ...") overrides the switch's defaults:
+// a board file may not name a key twice.
 std::string board_text(const std::string& switch_extra) {
+    std::vector<std::pair<std::string, std::string>> params = {
+        {"type", "limit_switch"}, {"axis", "x"}, {"side", "min"}, {"position", "0.5mm"}, {"hysteresis", "0.05mm"},
+        {"contact", "NO"}, {"switched_to", "gnd"}, {"pull", "internal_up"}};
+    std::stringstream extras(switch_extra);
+    std::string item;
+    while (std::getline(extras, item, ',')) {
+        const auto colon = item.find(':');
+        if (colon == std::string::npos) continue;
+        auto trim = [](std::string t) {
+            t.erase(0, t.find_first_not_of(' '));
+            t.erase(t.find_last_not_of(' ') + 1);
+            return t;
+        };
+        const std::string key = trim(item.substr(0, colon)), value = trim(item.substr(colon + 1));
+        bool replaced = false;
+        for (auto& [k, v] : params) {
+            if (k == key) {
+                v = value;
+                replaced = true;
+            }
+        }
+        if (!replaced) params.emplace_back(key, value);
+    }
+    std::string limit;
+    for (const auto& [k, v] : params) limit += (limit.empty() ? "" : ", ") + k + ": " + v;
     return R"(
 mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   x_driver: {type: step_dir_driver, preset: a4988, microsteps: 16}
   x: {type: linear_axis, driver: x_driver, steps_per_mm: 250, travel: 200mm, start_position: 1mm}
-  x_limit: {type: limit_switch, axis: x, side: min, position: 0.5mm, hysteresis: 0.05mm, contact: NO,
-            switched_to: gnd, pull: internal_up)" + switch_extra + R"(}
+  x_limit: {)" + limit + R"(}
 nets:
   x_step: [uno.PD2, x_driver.step]
   x_dir: [uno.PD5, x_driver.dir]
