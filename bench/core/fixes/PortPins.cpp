@@ -48,9 +48,12 @@ public:
             ports_.push_back({port, io->reset});
             io->reset = &on_reset;
             port_registry().add(io, this);
-            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_pin, &on_pin_write, this));
-            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_port, &on_port_or_ddr_write, this));
-            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_ddr, &on_port_or_ddr_write, this));
+            // A write to one port's PIN, PORT or DDR register can change only that port's inputs.
+            hook_contexts_.push_back(std::make_unique<PortHook>(PortHook{this, port}));
+            PortHook* ctx = hook_contexts_.back().get();
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_pin, &on_pin_write, ctx));
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_port, &on_port_or_ddr_write, ctx));
+            pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_ddr, &on_port_or_ddr_write, ctx));
         }
         // PUD: MCUCR bit 4 on the 328P/2560 (§14.4.1 / §13.4.1), SFIOR bit 2 on the ATmega32.
         if (facts_.known) {
@@ -74,38 +77,43 @@ private:
         void (*original_reset)(avr_io_t*);
     };
 
+    struct PortHook {
+        PortPins* self;
+        avr_ioport_t* port;
+    };
+
     static void on_pin_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
-        auto* self = static_cast<PortPins*>(hook.context());
-        if (!self->facts_.pin_write_toggles) return;  // read-only PIN register
-        const std::uint8_t toggles = self->facts_.sbi_single_bit ? single_bit_write_value(avr, addr, value) : value;
+        auto* ctx = static_cast<PortHook*>(hook.context());
+        if (!ctx->self->facts_.pin_write_toggles) return;  // read-only PIN register
+        const std::uint8_t toggles = ctx->self->facts_.sbi_single_bit ? single_bit_write_value(avr, addr, value) : value;
         if (toggles == 0) return;
         hook.write_original(avr, addr, toggles);
-        self->settle_inputs(avr);  // a toggled PORTxn of an input switches its pull-up
+        ctx->self->settle_inputs(avr, ctx->port);  // a toggled PORTxn of an input switches its pull-up
     }
 
     static void on_port_or_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
         hook.write_original(avr, addr, value);
-        static_cast<PortPins*>(hook.context())->settle_inputs(avr);
+        auto* ctx = static_cast<PortHook*>(hook.context());
+        ctx->self->settle_inputs(avr, ctx->port);
     }
 
     static void on_pud_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
         hook.write_original(avr, addr, value);
-        static_cast<PortPins*>(hook.context())->settle_inputs(avr);
+        auto* self = static_cast<PortPins*>(hook.context());
+        for (auto& p : self->ports_) self->settle_inputs(avr, p.port);  // PUD switches every pull-up
     }
 
-    // Every input that nothing outside drives: its pull-up level, or floating (0).
-    void settle_inputs(avr_t* avr) {
+    // Every input of `port` that nothing outside drives: its pull-up level, or floating (0).
+    void settle_inputs(avr_t* avr, avr_ioport_t* port) const {
         const bool pud = pud_register_ != 0 && (avr->data[pud_register_] & pud_mask_) != 0;
-        for (auto& p : ports_) {
-            avr_ioport_t* port = p.port;
-            const std::uint8_t ddr = avr->data[port->r_ddr], out = avr->data[port->r_port];
-            for (int bit = 0; bit < 8; ++bit) {
-                const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
-                if ((ddr & mask) != 0 || (port->external.pull_mask & mask) != 0) continue;
-                const std::uint32_t level = (out & mask) != 0 && !pud ? 1 : 0;
-                avr_irq_t* irq = port->io.irq + bit;
-                if ((irq->value & 0xFF) != level) avr_raise_irq(irq, level);
-            }
+        const std::uint8_t ddr = avr->data[port->r_ddr], out = avr->data[port->r_port];
+        const std::uint8_t undriven = static_cast<std::uint8_t>(~ddr & ~port->external.pull_mask);
+        for (int bit = 0; bit < 8; ++bit) {
+            const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
+            if ((undriven & mask) == 0) continue;
+            const std::uint32_t level = (out & mask) != 0 && !pud ? 1 : 0;
+            avr_irq_t* irq = port->io.irq + bit;
+            if ((irq->value & 0xFF) != level) avr_raise_irq(irq, level);
         }
     }
 
@@ -128,6 +136,7 @@ private:
     avr_io_addr_t pud_register_ = 0;
     std::uint8_t pud_mask_ = 0;
     std::vector<Port> ports_;
+    std::vector<std::unique_ptr<PortHook>> hook_contexts_;
     std::vector<std::unique_ptr<IoWriteHook>> pin_hooks_;
 };
 
