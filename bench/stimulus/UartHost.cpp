@@ -362,11 +362,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
             become_ready();
         }
     } else if (ready_ && is_welcome(family, text)) {
-        HostEvent e;
-        e.kind = HostEventKind::Restarted;
-        e.cycle = cycle;
-        e.response = text;
-        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
+        HostEvent e = event_at_oldest_line(HostEventKind::Restarted, cycle, text);
         e.message = "the firmware restarted mid-job (welcome '" + text + "' again" +
                     (e.line ? ", while line " + std::to_string(e.line->number) + " '" + e.line->text + "' was unanswered)" : ")");
         fail(std::move(e));
@@ -384,56 +380,46 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         acknowledge();
     } else if (starts_with(text, "error") || starts_with(text, "Error")) {
         ++errors_;
-        HostEvent e;
-        e.kind = HostEventKind::Error;
-        e.cycle = cycle;
-        e.response = text;
-        if (!outstanding_.empty()) {
-            const GcodeLine& line = lines_[outstanding_.front().index];
-            e.line = line;
-            e.message = "line " + std::to_string(line.number) + " '" + line.text + "' got '" + text + "'";
-        } else {
-            e.message = "'" + text + "' with no line outstanding";
-        }
-        const bool stop = options_.stop_on_error;
-        if (stop) {
-            fail(e);
-        } else {
-            record(e);
-        }
+        HostEvent e = event_at_oldest_line(HostEventKind::Error, cycle, text);
+        e.message = e.line ? "line " + std::to_string(e.line->number) + " '" + e.line->text + "' got '" + text + "'"
+                           : "'" + text + "' with no line outstanding";
+        stop_or_record(options_.stop_on_error, std::move(e));
         if (options_.error_acknowledges) acknowledge();
     } else if (starts_with(text, "ALARM")) {
         ++alarms_;
-        HostEvent e;
-        e.kind = HostEventKind::Alarm;
-        e.cycle = cycle;
-        e.response = text;
-        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
-        e.message = "firmware alarm '" + text + "'" +
-                    (e.line ? " after line " + std::to_string(e.line->number) + " '" + e.line->text + "'" : "");
-        if (options_.stop_on_alarm) {
-            fail(std::move(e));
-        } else {
-            record(std::move(e));
-        }
+        HostEvent e = event_at_oldest_line(HostEventKind::Alarm, cycle, text);
+        e.message = "firmware alarm '" + text + "'" + after_line(e);
+        stop_or_record(options_.stop_on_alarm, std::move(e));
     } else if (starts_with(text, "!!")) {
         ++fatals_;
-        HostEvent e;
-        e.kind = HostEventKind::Fatal;
-        e.cycle = cycle;
-        e.response = text;
-        if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
-        e.message = "firmware fatal error '" + text + "'" +
-                    (e.line ? " after line " + std::to_string(e.line->number) + " '" + e.line->text + "'" : "");
-        if (options_.stop_on_fatal) {
-            fail(std::move(e));
-        } else {
-            record(std::move(e));
-        }
+        HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
+        e.message = "firmware fatal error '" + text + "'" + after_line(e);
+        stop_or_record(options_.stop_on_fatal, std::move(e));
     }
     // Anything else (echo:, [MSG:...], banners, reports) is transcript only.
 
     for (auto& fn : line_listeners_) fn(entry);
+}
+
+HostEvent UartHost::event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const {
+    HostEvent e;
+    e.kind = kind;
+    e.cycle = cycle;
+    e.response = response;
+    if (!outstanding_.empty()) e.line = lines_[outstanding_.front().index];
+    return e;
+}
+
+std::string UartHost::after_line(const HostEvent& e) {
+    return e.line ? " after line " + std::to_string(e.line->number) + " '" + e.line->text + "'" : "";
+}
+
+void UartHost::stop_or_record(bool stop, HostEvent event) {
+    if (stop) {
+        fail(std::move(event));
+    } else {
+        record(std::move(event));
+    }
 }
 
 void UartHost::acknowledge() {

@@ -232,6 +232,11 @@ public:
     bool run_until_finished(double max_seconds);
 
 private:
+    // An event about the oldest unanswered line (if any), with the firmware's answer.
+    HostEvent event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const;
+    static std::string after_line(const HostEvent& event);  // " after line N 'text'" or ""
+    void stop_or_record(bool stop, HostEvent event);
+
     void poll_status(std::uint64_t generation);
     std::uint64_t poll_generation_ = 0;
     std::size_t status_polls_ = 0;
