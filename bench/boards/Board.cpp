@@ -174,8 +174,7 @@ void Board::build_nets() {
                 } catch (const BadInput& err) {
                     throw BadInput(e.location + ": " + err.what());
                 }
-                mcu_terminals_.push_back(std::make_unique<McuPinTerminal>(m, *pin));
-                net->connect(*mcu_terminals_.back());
+                add_mcu_terminal(m, *pin, *net);
                 continue;
             }
             Part& p = part(e.owner);
@@ -195,8 +194,83 @@ void Board::build_nets() {
         }
         nets_.push_back(std::move(net));
     }
+    for (auto& n : nets_) {
+        // Findings of a net carry the cycle of an MCU on it (else the board's first).
+        Mcu* clock = mcus_.front().get();
+        for (const auto& t : mcu_terminals_) {
+            if (t->net() == n.get()) {
+                clock = &t->mcu();
+                break;
+            }
+        }
+        n->set_clock(*clock);
+    }
     for (auto& p : parts_) p->start();
     for (auto& n : nets_) n->settle();
+}
+
+McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {
+    mcu_terminals_.push_back(std::make_unique<McuPinTerminal>(mcu, pin));
+    McuPinTerminal& terminal = *mcu_terminals_.back();
+    net.connect(terminal);
+    auto& watch = port_watches_[&mcu];
+    if (!watch) watch = std::make_unique<McuPortWatch>(mcu);
+    watch->add(terminal);
+    return terminal;
+}
+
+namespace {
+
+// A scenario's hand on a pin: a push-pull source it switches on and off.
+class StimulusTerminal final : public Terminal {
+public:
+    explicit StimulusTerminal(std::string label) : label_(std::move(label)) {}
+    std::string label() const override { return label_; }
+    TerminalRole role() const override { return TerminalRole::Output; }
+    Drive drive_state() const override { return drive_; }
+    void receive(const Resolution&) override {}
+    void set(const Drive& drive) {
+        drive_ = drive;
+        drive_changed();
+    }
+
+private:
+    std::string label_;
+    Drive drive_;
+};
+
+}  // namespace
+
+Terminal& Board::stimulus_for(const std::string& endpoint_or_label) {
+    Pin& target = pin(endpoint_or_label);
+    auto& slot = stimuli_[&target];
+    if (slot) return *slot;
+    Net* net = nullptr;
+    for (const auto& t : mcu_terminals_) {
+        if (&t->pin() == &target) net = t->net();
+    }
+    if (net == nullptr) {
+        Mcu* owner = nullptr;
+        for (auto& m : mcus_) {
+            if (m->avr() == target.avr()) owner = m.get();
+        }
+        nets_.push_back(std::make_unique<Net>(endpoint_or_label));
+        net = nets_.back().get();
+        net->set_clock(*owner);
+        add_mcu_terminal(*owner, target, *net);
+    }
+    slot = std::make_unique<StimulusTerminal>("stimulus(" + endpoint_or_label + ")");
+    net->connect(*slot);
+    net->settle();
+    return *slot;
+}
+
+void Board::drive_pin(const std::string& endpoint_or_label, bool level) {
+    static_cast<StimulusTerminal&>(stimulus_for(endpoint_or_label)).set(Drive::strong(level));
+}
+
+void Board::release_pin(const std::string& endpoint_or_label) {
+    static_cast<StimulusTerminal&>(stimulus_for(endpoint_or_label)).set(Drive::none());
 }
 
 Mcu& Board::mcu(const std::string& name) {
@@ -248,6 +322,7 @@ std::vector<Finding> Board::findings() const {
     std::vector<Finding> out;
     for (const auto& m : mcus_) out.insert(out.end(), m->findings().begin(), m->findings().end());
     for (const auto& p : parts_) out.insert(out.end(), p->findings().begin(), p->findings().end());
+    for (const auto& n : nets_) out.insert(out.end(), n->findings().begin(), n->findings().end());
     return out;
 }
 

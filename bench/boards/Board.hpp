@@ -12,6 +12,7 @@
 #include "core/Lockstep.hpp"
 #include "core/Mcu.hpp"
 #include "parts/Part.hpp"
+#include "wiring/McuPinTerminal.hpp"
 #include "wiring/Net.hpp"
 
 namespace avrbench {
@@ -51,6 +52,11 @@ public:
     }
     // "uno.PD2", or a label name from the board file.
     Pin& pin(const std::string& endpoint_or_label);
+    // Drives an MCU pin from outside (a scenario's stimulus) as a push-pull
+    // source on the pin's net, or lets go of it; a pin on no net gets one.
+    void drive_pin(const std::string& endpoint_or_label, bool level);
+    void release_pin(const std::string& endpoint_or_label);
+    const std::vector<std::unique_ptr<Net>>& nets() const { return nets_; }
 
     Lockstep& lockstep() { return lockstep_; }
     // Advances every MCU to `end_ps` of simulated time: afterwards now_ps() >=
@@ -70,11 +76,15 @@ private:
     void build_mcus(const std::map<std::string, std::string>& firmware);
     void build_parts();
     void build_nets();
+    McuPinTerminal& add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net);
+    Terminal& stimulus_for(const std::string& endpoint_or_label);
 
     BoardSpec spec_;
     std::vector<std::unique_ptr<Mcu>> mcus_;  // first member: destroyed last
     std::vector<std::unique_ptr<Part>> parts_;
-    std::vector<std::unique_ptr<Terminal>> mcu_terminals_;
+    std::map<const Mcu*, std::unique_ptr<McuPortWatch>> port_watches_;
+    std::vector<std::unique_ptr<McuPinTerminal>> mcu_terminals_;
+    std::map<const Pin*, std::unique_ptr<Terminal>> stimuli_;
     std::vector<std::unique_ptr<Net>> nets_;
     Lockstep lockstep_;
 };

@@ -4,6 +4,7 @@
 #include "parts/Fan.hpp"
 #include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
+#include "parts/PullResistor.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
 #include "parts/Thermistor.hpp"
@@ -47,6 +48,16 @@ PartType limit_switch() {
     return t;
 }
 
+PartType pull_resistor() {
+    PartType t;
+    t.name = "pull_resistor";
+    t.params = PullResistor::param_specs();
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
+        return std::make_unique<PullResistor>(name, clock, params);
+    };
+    return t;
+}
+
 // Thermal parts (docs/THERMAL.md): a plant, and the heaters, thermistors
 // and fans that name it.
 PartType thermal_plant() {
@@ -84,7 +95,7 @@ PartType on_plant(const std::string& type_name) {
 const std::map<std::string, PartType>& part_types() {
     static const std::map<std::string, PartType> types = [] {
         std::map<std::string, PartType> m;
-        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), thermal_plant(),
+        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), pull_resistor(), thermal_plant(),
                            on_plant<Heater>("heater"), on_plant<Thermistor>("thermistor"), on_plant<Fan>("fan")}) {
             m.emplace(t.name, std::move(t));
         }

@@ -24,6 +24,8 @@ const char* to_string(FindingKind kind) {
         case FindingKind::MotorStall: return "motor-stall";
         case FindingKind::Overheat: return "overheat";
         case FindingKind::HostProtocol: return "host-protocol";
+        case FindingKind::NetContention: return "net-contention";
+        case FindingKind::FloatingInputRead: return "floating-input-read";
     }
     return "unknown";
 }

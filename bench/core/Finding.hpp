@@ -31,6 +31,11 @@ enum class FindingKind {
     MotorStall,          // a stepper motor's rotor lost synchronism with its excitation (lost steps)
     Overheat,            // a thermal plant passed its safe maximum temperature
     HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
+
+    // Found by the nets (wiring/).
+    NetContention,       // two outputs drive one net to opposite levels
+    FloatingInputRead,   // the firmware read an input pin whose net nothing drives
+    kLast = FloatingInputRead,
 };
 
 const char* to_string(FindingKind kind);

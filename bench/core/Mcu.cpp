@@ -217,6 +217,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
         ++resets_;
         // avr_reset() drops every cycle timer: put the scheduler's back.
         scheduler_->rearm();
+        for (auto& fn : reset_listeners_) fn();
         if (watchdog_reset_seen_) {
             watchdog_reset_seen_ = false;
             add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);

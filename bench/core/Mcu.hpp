@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -85,6 +86,9 @@ public:
     std::uint64_t steps() const { return steps_; }
     // How many times the core went through a reset after power-on.
     unsigned resets() const { return resets_; }
+    // Called after each reset (watchdog, jump to the reset vector), once the
+    // I/O registers hold their reset values.
+    void on_reset(std::function<void()> fn) { reset_listeners_.push_back(std::move(fn)); }
 
     // Value of a RAM variable by its ELF symbol (for tests and reports).
     std::uint8_t read_ram_u8(const std::string& symbol) const;
@@ -118,6 +122,7 @@ private:
 
     std::uint64_t steps_ = 0;
     unsigned resets_ = 0;
+    std::vector<std::function<void()>> reset_listeners_;
     bool stop_requested_ = false;
     bool halted_ = false;
     std::string halt_reason_;

@@ -1,5 +1,7 @@
 #include "core/Pin.hpp"
 
+#include "core/fixes/Interrupts.hpp"
+
 extern "C" {
 #include <avr_ioport.h>
 #include <sim_avr.h>
@@ -9,7 +11,11 @@ extern "C" {
 namespace avrbench {
 
 Pin::Pin(avr_t* avr, std::string name, avr_irq_t* irq, avr_ioport_t* port, int bit)
-    : avr_(avr), name_(std::move(name)), irq_(irq), port_(port), mask_(static_cast<std::uint8_t>(1u << bit)) {}
+    : avr_(avr), name_(std::move(name)), irq_(irq), port_(port), mask_(static_cast<std::uint8_t>(1u << bit)) {
+    const PartFacts facts = part_facts(avr);
+    pud_register_ = facts.pud_register;
+    pud_mask_ = facts.pud_mask;
+}
 
 Pin::~Pin() {
     if (notify_registered_) avr_irq_unregister_notify(irq_, &Pin::notify, this);
@@ -33,7 +39,8 @@ void Pin::release() {
 bool Pin::driven() const { return (port_->external.pull_mask & mask_) != 0; }
 
 bool Pin::internal_pull_up() const {
-    return !is_output() && (avr_->data[port_->r_port] & mask_) != 0;
+    const bool pull_ups_disabled = pud_register_ != 0 && (avr_->data[pud_register_] & pud_mask_) != 0;
+    return !is_output() && (avr_->data[port_->r_port] & mask_) != 0 && !pull_ups_disabled;
 }
 
 bool Pin::is_output() const { return (avr_->data[port_->r_ddr] & mask_) != 0; }

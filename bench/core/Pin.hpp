@@ -36,7 +36,8 @@ public:
     // input) or, floating, 0.
     void release();
     bool driven() const;
-    // The firmware has the pin as an input with PORTxn = 1.
+    // The firmware has the pin as an input with PORTxn = 1 and pull-ups
+    // enabled (PUD = 0).
     bool internal_pull_up() const;
     // The firmware has the pin as an output (DDxn = 1).
     bool is_output() const;
@@ -46,6 +47,7 @@ public:
     // that register a plain C callback instead of a std::function.
     avr_irq_t* irq() const { return irq_; }
     avr_t* avr() const { return avr_; }
+    avr_ioport_t* port() const { return port_; }
 
 private:
     static void notify(avr_irq_t* irq, std::uint32_t value, void* param);
@@ -55,6 +57,8 @@ private:
     avr_irq_t* irq_;
     avr_ioport_t* port_;
     std::uint8_t mask_;
+    unsigned short pud_register_ = 0;  // 0: the part has no PUD bit the bench knows
+    std::uint8_t pud_mask_ = 0;
     std::vector<Listener> listeners_;
     bool notify_registered_ = false;
     bool notified_level_ = false;

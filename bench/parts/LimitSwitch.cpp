@@ -23,8 +23,12 @@ std::vector<ParamSpec> LimitSwitch::param_specs() {
         {"switched_to", PT::Choice, Dimension::Dimensionless, false, "gnd", {"gnd", "vcc"}, "",
          "what the closed contact connects the signal to"},
         {"pull", PT::Choice, Dimension::Dimensionless, false, "internal_up",
-         {"internal_up", "external_up", "external_down", "none"}, "",
-         "what sets the level while the contact is open"},
+         {"internal_up", "external_up", "external_down", "none", "push_pull"}, "",
+         "what sets the level while the contact is open (push_pull: a sensor whose output stage drives both "
+         "levels, e.g. an optical endstop)"},
+        {"pull_resistance", PT::Quantity, Dimension::Resistance, false, "10kohm", {},
+         "assumed: the 10 kohm pull-up of common endstop boards (RepRap mechanical endstop v1.2)",
+         "the external pull resistor (external_up / external_down)"},
         {"bounce", PT::Quantity, Dimension::Time, false, "0s", {}, "assumed: no bounce unless asked",
          "duration of contact bounce after each transition"},
         {"bounce_edges", PT::Integer, Dimension::Dimensionless, false, "4", {}, "assumed",
@@ -41,6 +45,7 @@ LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params
       normally_open_(params.text("contact") == "NO"),
       closed_level_(params.text("switched_to") == "vcc"),
       pull_(params.text("pull")),
+      pull_ohm_(params.quantity("pull_resistance")),
       bounce_s_(params.quantity("bounce") >= 0 && params.quantity("bounce") <= 1.0
                     ? params.quantity("bounce")
                     : throw BadInput("parameter 'bounce' must be from 0 to 1 s (contacts settle in milliseconds)")),
@@ -124,8 +129,10 @@ void LimitSwitch::apply_contact(bool closed) {
     } else if (pull_ == "internal_up" || pull_ == "none") {
         // The MCU pin decides: its pull-up if the firmware enabled it, else floating (reads 0).
         release_output(out_pin_);
+    } else if (pull_ == "push_pull") {
+        drive_output(out_pin_, !closed_level_);
     } else {
-        drive_output(out_pin_, pull_ == "external_up");
+        pull_output(out_pin_, pull_ == "external_up", pull_ohm_);
     }
 }
 

@@ -40,7 +40,8 @@ private:
     double trip_m_, hysteresis_m_;
     bool normally_open_;
     bool closed_level_;        // the output level with the contact closed
-    std::string pull_;         // internal_up | external_up | external_down | none
+    std::string pull_;         // internal_up | external_up | external_down | none | push_pull
+    double pull_ohm_;          // the external pull resistor
     double bounce_s_;
     unsigned bounce_edges_;
     std::mt19937_64 rng_;

@@ -8,24 +8,23 @@ namespace avrbench {
 
 std::string PartPin::label() const { return part_.name() + "." + name_; }
 
-void PartPin::receive(bool level) {
-    if (level == level_) return;
-    level_ = level;
-    part_.on_input(index_, level);
+void PartPin::receive(const Resolution& resolution) {
+    if (resolution.level == level_) return;
+    level_ = resolution.level;
+    if (role_ == TerminalRole::Input) part_.on_input(index_, level_);
 }
 
-void PartPin::set_level(bool level) {
-    if (level == level_ && !released_) return;
-    level_ = level;
-    released_ = false;
-    drive(level);
+void PartPin::set_drive(const Drive& drive) {
+    if (drive == drive_) return;
+    drive_ = drive;
+    drive_changed();
 }
 
-void PartPin::set_released() {
-    if (released_) return;
-    released_ = true;
-    release_net();
-}
+void PartPin::set_level(bool level) { set_drive(Drive::strong(level)); }
+
+void PartPin::set_weak(bool level, double ohms) { set_drive(Drive::weak(level, ohms)); }
+
+void PartPin::set_released() { set_drive(Drive::none()); }
 
 PartPin* Part::find_pin(std::string_view name) {
     for (auto& p : pins_) {

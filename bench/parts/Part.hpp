@@ -21,30 +21,35 @@ namespace avrbench {
 
 class Part;
 
-// One pin of a part.
+// One pin of a part. An Input only listens; an Output drives its net
+// push-pull (set_level), through a pull resistor (set_weak), or not at all
+// (set_released: an open contact, an open-drain output that is off).
 class PartPin final : public Terminal {
 public:
     PartPin(Part& part, std::size_t index, std::string name, TerminalRole role)
         : part_(part), index_(index), name_(std::move(name)), role_(role) {}
     std::string label() const override;
     TerminalRole role() const override { return role_; }
-    void receive(bool level) override;
-    bool initial_level() const override { return level_; }
-    bool initially_released() const override { return released_; }
+    Drive drive_state() const override { return drive_; }
+    void receive(const Resolution& resolution) override;
 
     const std::string& name() const { return name_; }
+    // The level the net settled to (what an input reads; 0 while floating).
     bool level() const { return level_; }
     bool connected() const { return net() != nullptr; }
-    void set_level(bool level);  // an output driving its net
-    void set_released();         // an output letting go of its net
+    void set_level(bool level);
+    void set_weak(bool level, double ohms);
+    void set_released();
 
 private:
+    void set_drive(const Drive& drive);
+
     Part& part_;
     std::size_t index_;
     std::string name_;
     TerminalRole role_;
+    Drive drive_;
     bool level_ = false;
-    bool released_ = false;
 };
 
 // A value a part exposes for tracing (a position, a temperature, a level).
@@ -108,6 +113,7 @@ protected:
         (void)level;
     }
     void drive_output(std::size_t pin, bool level) { pins_[pin]->set_level(level); }
+    void pull_output(std::size_t pin, bool level, double ohms) { pins_[pin]->set_weak(level, ohms); }
     void release_output(std::size_t pin) { pins_[pin]->set_released(); }
     bool input_level(std::size_t pin) const { return pins_[pin]->level(); }
     bool connected(std::size_t pin) const { return pins_[pin]->connected(); }

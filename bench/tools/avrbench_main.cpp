@@ -191,7 +191,9 @@ void print_text_tail(const std::string& text, std::size_t max_lines) {
     for (std::size_t i = from; i < lines.size(); ++i) std::printf("    %s\n", printable(lines[i]).c_str());
 }
 
-bool is_mcu_finding(const Finding& f) { return f.has_pc; }
+// A crash of the firmware (the MCU's own oracles); part, net and host findings
+// fail a run only with --strict.
+bool is_mcu_finding(const Finding& f) { return f.kind <= FindingKind::JumpToReset; }
 
 int run_board_command(const RunArgs& args) {
     if (!args.mcu.empty() || !args.freq.empty()) {

@@ -234,7 +234,7 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
         if (item.value.IsSequence()) {
             ExpectFindingKinds kinds;
             std::set<std::string> known;
-            for (int i = 0; i <= static_cast<int>(FindingKind::HostProtocol); ++i) known.insert(to_string(static_cast<FindingKind>(i)));
+            for (int i = 0; i <= static_cast<int>(FindingKind::kLast); ++i) known.insert(to_string(static_cast<FindingKind>(i)));
             for (const auto& entry : item.value) {
                 const std::string kind = scalar(entry, item.path, "findings entry");
                 if (known.count(kind) == 0) {

@@ -122,11 +122,11 @@ private:
         return s.pin + " did not become " + (s.level ? "1" : "0") + " by " + seconds_text(deadline_) + " (the time limit)";
     }
     std::string operator()(const SetInputStep& s) {
-        bench_.board().pin(s.pin).drive(s.level);
+        bench_.board().drive_pin(s.pin, s.level);
         return "";
     }
     std::string operator()(const ReleaseInputStep& s) {
-        bench_.board().pin(s.pin).release();
+        bench_.board().release_pin(s.pin);
         return "";
     }
     std::string operator()(const InjectFaultStep& s) {

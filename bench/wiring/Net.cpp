@@ -1,63 +1,100 @@
 #include "wiring/Net.hpp"
 
+#include <cstdio>
+
 namespace avrbench {
 
-void Terminal::drive(bool level) {
-    if (net_ != nullptr) net_->drive_from(this, level);
-}
-
-void Terminal::release_net() {
-    if (net_ != nullptr) net_->release_from(this);
+void Terminal::drive_changed() {
+    if (net_ != nullptr) net_->update();
 }
 
 void Net::connect(Terminal& terminal) {
     terminal.net_ = this;
     terminals_.push_back(&terminal);
+    drives_.resize(terminals_.size());
 }
 
 void Net::settle() {
-    const Terminal* source = nullptr;
-    for (const Terminal* t : terminals_) {
-        if (t->role() == TerminalRole::Output && !t->initially_released()) source = t;
-    }
-    if (source == nullptr) {
-        for (const Terminal* t : terminals_) {
-            if (t->role() == TerminalRole::Bidirectional) {
-                source = t;
-                break;
-            }
-        }
-    }
-    if (source == nullptr) {
-        for (Terminal* t : terminals_) {
-            if (t->role() == TerminalRole::Output) release_from(t);
-        }
+    settled_ = true;
+    for (std::size_t i = 0; i < terminals_.size(); ++i) drives_[i] = terminals_[i]->drive_state();
+    resolution_ = resolve(drives_);
+    deliver();
+}
+
+void Net::update() {
+    if (!settled_) return;
+    if (delivering_) {
+        // A terminal reacted to our own delivery (simavr echoes a driven MCU
+        // pin through its IRQ): resolve again once the delivery is over.
+        update_pending_ = true;
         return;
     }
-    drive_from(const_cast<Terminal*>(source), source->initial_level());
+    // A terminal that changes its drive in answer to the level it received
+    // (a part with feedback) gets a few rounds; a loop that never settles is
+    // an oscillator, which a net without delay cannot represent.
+    for (int round = 0; round < 8; ++round) {
+        for (std::size_t i = 0; i < terminals_.size(); ++i) drives_[i] = terminals_[i]->drive_state();
+        const Resolution next = resolve(drives_);
+        if (next == resolution_) return;
+        const bool contention_starts = next.state == NetState::Contention && resolution_.state != NetState::Contention;
+        if (next.state != NetState::Floating) floating_read_reported_ = false;
+        resolution_ = next;
+        if (contention_starts && clock_ != nullptr) {
+            Finding f;
+            f.kind = FindingKind::NetContention;
+            f.source = name_;
+            f.cycle = clock_->cycle();
+            f.clock_hz = clock_->frequency_hz();
+            f.has_pc = false;
+            f.detail = "net '" + name_ + "': outputs drive opposite levels (" + drivers_text() + ")";
+            findings_.push_back(std::move(f));
+        }
+        update_pending_ = false;
+        deliver();
+        if (!update_pending_) return;
+    }
 }
 
-void Net::release_from(Terminal* source) {
-    if (delivering_) return;
+void Net::deliver() {
     delivering_ = true;
-    for (Terminal* t : terminals_) {
-        if (t != source) t->receive_release();
-    }
+    for (Terminal* t : terminals_) t->receive(resolution_);
     delivering_ = false;
 }
 
-void Net::drive_from(Terminal* source, bool level) {
-    if (delivering_) return;  // the echo of our own delivery through simavr
-    delivering_ = true;
-    level_ = level;
-    for (Terminal* t : terminals_) {
-        if (t != source) t->receive(level);
+std::string Net::drivers_text() const {
+    std::string out;
+    for (std::size_t i = 0; i < terminals_.size(); ++i) {
+        if (drives_[i].strength != Strength::Strong) continue;
+        if (!out.empty()) out += ", ";
+        out += terminals_[i]->label() + (drives_[i].level ? " high" : " low");
     }
-    delivering_ = false;
+    return out;
 }
 
-McuPinTerminal::McuPinTerminal(Mcu& mcu, Pin& pin) : mcu_(mcu), pin_(pin) {
-    pin_.on_change([this](Cycle, bool level) { drive(level); });
+void Net::floating_read(Mcu& reader, const std::string& pin_label) {
+    if (resolution_.state != NetState::Floating || floating_read_reported_) return;
+    bool something_else_drives = false;
+    for (const Terminal* t : terminals_) {
+        if (t->label() != pin_label && t->role() != TerminalRole::Input) something_else_drives = true;
+    }
+    if (!something_else_drives) return;
+    floating_read_reported_ = true;
+    Finding f;
+    f.kind = FindingKind::FloatingInputRead;
+    f.source = name_;
+    f.cycle = reader.cycle();
+    f.clock_hz = reader.frequency_hz();
+    f.pc_bytes = reader.pc_bytes();
+    f.symbol = reader.elf().describe_flash_address(f.pc_bytes);
+    char why[96];
+    if (resolution_.volts_fraction > 0) {
+        std::snprintf(why, sizeof why, "its pull resistors hold it at %.2f VCC, between V_IL and V_IH",
+                      resolution_.volts_fraction);
+    } else {
+        std::snprintf(why, sizeof why, "nothing drives it and no pull-up is on");
+    }
+    f.detail = "the firmware read " + pin_label + " while net '" + name_ + "' floats (" + why + "); the bench reads 0";
+    findings_.push_back(std::move(f));
 }
 
 }  // namespace avrbench

@@ -1,14 +1,18 @@
 // Nets join terminals: MCU pins and part pins (and pins of several MCUs).
-// A terminal that drives the net delivers its level to every other terminal.
-// simavr's pin IRQs call back into the net when a part drives an MCU pin; the
-// net ignores that echo, so a level travels once around.
+// Every terminal says what it puts on the net (wiring/Drive.hpp: nothing, a
+// pull resistor, a push-pull level); the net resolves them the way a logic
+// input reads the wire and delivers the result to every terminal. Two strong
+// drivers that disagree are a finding (net-contention), and so is firmware
+// reading a floating net (floating-input-read, reported by the MCU side).
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/Finding.hpp"
 #include "core/Mcu.hpp"
+#include "wiring/Drive.hpp"
 
 namespace avrbench {
 
@@ -16,7 +20,7 @@ class Net;
 
 enum class TerminalRole {
     Input,          // only listens (a driver's STEP input)
-    Output,         // drives (a switch contact); two on one net is a wiring error
+    Output,         // drives or lets go (a switch contact, a push-pull output, a pull resistor)
     Bidirectional,  // an MCU pin: input or output as its DDR says
 };
 
@@ -25,23 +29,17 @@ public:
     virtual ~Terminal() = default;
     virtual std::string label() const = 0;  // "uno.PD2", "x_driver.step"
     virtual TerminalRole role() const = 0;
-    // A level driven onto the net by another terminal.
-    virtual void receive(bool level) = 0;
-    // The driving terminal let go of the net (an open switch contact).
-    virtual void receive_release() {}
-    // An Output that is currently not driving (open contact) does not set the
-    // net's level when it is formed.
-    virtual bool initially_released() const { return false; }
-    // The terminal's own idea of its level when the net is formed.
-    virtual bool initial_level() const { return false; }
+    // What the terminal puts on the net now.
+    virtual Drive drive_state() const = 0;
+    // The net settled to `resolution` (delivered to every terminal, the
+    // drivers included, whenever the resolution changes).
+    virtual void receive(const Resolution& resolution) = 0;
 
     Net* net() const { return net_; }
 
 protected:
-    // Drives the net (or just remembers the level while unconnected).
-    void drive(bool level);
-    // Stops driving the net.
-    void release_net();
+    // The terminal's drive changed: the net resolves again.
+    void drive_changed();
 
 private:
     friend class Net;
@@ -57,39 +55,37 @@ public:
     const std::string& name() const { return name_; }
     void connect(Terminal& terminal);
     const std::vector<Terminal*>& terminals() const { return terminals_; }
-    bool level() const { return level_; }
+    // The MCU whose cycle counter stamps this net's findings.
+    void set_clock(Mcu& mcu) { clock_ = &mcu; }
 
-    // Sets the net's level from the terminals' initial levels: a driving
-    // Output's, else an MCU pin's. Called once all terminals are connected.
+    // First resolution, delivered to every terminal. Called once all terminals are connected.
     void settle();
+    // Re-resolves after a terminal's drive changed; delivers only a change.
+    void update();
+
+    const Resolution& resolution() const { return resolution_; }
+    bool level() const { return resolution_.level; }
+
+    // `reader`'s firmware read this net's pin `pin_label` while the net floats.
+    // One finding per floating spell, and only when something else on the net
+    // could drive it (a net of the MCU's own outputs is not read as a signal).
+    void floating_read(Mcu& reader, const std::string& pin_label);
+    const std::vector<Finding>& findings() const { return findings_; }
 
 private:
-    friend class Terminal;
-    void drive_from(Terminal* source, bool level);
-    void release_from(Terminal* source);
+    void deliver();
+    std::string drivers_text() const;
 
     std::string name_;
     std::vector<Terminal*> terminals_;
-    bool level_ = false;
+    std::vector<Drive> drives_;  // scratch, one per terminal
+    Resolution resolution_;
+    bool settled_ = false;
     bool delivering_ = false;
-};
-
-// An MCU pin as a terminal.
-class McuPinTerminal final : public Terminal {
-public:
-    McuPinTerminal(Mcu& mcu, Pin& pin);
-    std::string label() const override { return mcu_.name() + "." + pin_.name(); }
-    TerminalRole role() const override { return TerminalRole::Bidirectional; }
-    void receive(bool level) override { pin_.drive(level); }
-    void receive_release() override { pin_.release(); }
-    bool initial_level() const override { return pin_.level(); }
-
-    Mcu& mcu() const { return mcu_; }
-    Pin& pin() const { return pin_; }
-
-private:
-    Mcu& mcu_;
-    Pin& pin_;
+    bool update_pending_ = false;
+    bool floating_read_reported_ = false;
+    Mcu* clock_ = nullptr;
+    std::vector<Finding> findings_;
 };
 
 }  // namespace avrbench

@@ -113,5 +113,15 @@ TEST(LimitSwitch, NormallyClosedSwitchToVccReadsTheSameAfterInversion) {
     EXPECT_EQ(h.steps_to_release(), 13);
 }
 
+TEST(LimitSwitch, PushPullSensorDrivesBothLevelsAgainstThePullUp) {
+    // An optical endstop's output stage drives low while the beam is
+    // interrupted (here wired active low to match the firmware) and high while
+    // it is clear: strong both ways, so the firmware's pull-up changes nothing.
+    Homing h(", contact: NC, switched_to: vcc, pull: push_pull");
+    EXPECT_EQ(h.steps_to_trip(), 125);
+    EXPECT_EQ(h.steps_to_release(), 13);
+    EXPECT_TRUE(h.board.findings().empty());
+}
+
 }  // namespace
 }  // namespace avrbench

@@ -44,13 +44,13 @@ struct PinBench {
     L293D& ic = board.part_as<L293D>("ic");
     PinBench() {
         for (const char* p : {"PD2", "PD3", "PD4", "PD5", "PD6", "PB0", "PB1", "PB2", "PB3", "PB4"}) {
-            uno.pin(p).drive(false);
+            board.drive_pin(std::string("uno.") + p, false);
         }
-        uno.pin("PD6").drive(true);  // SRCLR inactive
+        board.drive_pin("uno.PD6", true);  // SRCLR inactive
         board.run_for_seconds(0.001);
     }
     void set(const char* pin, bool level) {
-        uno.pin(pin).drive(level);
+        board.drive_pin(std::string("uno.") + pin, level);
         board.run_for_seconds(1e-6);
     }
     // latch_tx(): MSB first, then a rising RCLK (seed 003 digest §2.4).

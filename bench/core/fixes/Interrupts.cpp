@@ -25,6 +25,8 @@ PartFacts part_facts(const avr_t* avr) {
             f.synchronous_int_mask = 0x03;
             f.eeprom_write_us[0] = f.eeprom_write_us[1] = f.eeprom_write_us[2] = 8448;
             f.old_mega = true;
+            f.pud_register = 0x50;  // SFIOR
+            f.pud_mask = 0x04;
             f.known = true;
             return f;
         }
@@ -38,6 +40,10 @@ PartFacts part_facts(const avr_t* avr) {
                                       mmcu == "atmega2560" || mmcu == "atmega2561";
         f.synchronous_int_mask = mega_2560_family ? 0xF0 : 0x03;
         f.known = mmcu.starts_with("atmega");
+        if (f.known) {
+            f.pud_register = 0x55;  // MCUCR
+            f.pud_mask = 0x10;
+        }
     }
     return f;
 }

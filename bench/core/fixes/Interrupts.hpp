@@ -45,6 +45,10 @@ struct PartFacts {
     // ATmega8/16/32/64/128/162/8515/8535: the older register set (MCUCR
     // sleep bits, read-only PINx, the 1 MHz watchdog oscillator).
     bool old_mega = false;
+    // PUD, "pull-up disable" (§14.4.1 328P / §13.4.1 2560: MCUCR 0x55 bit 4;
+    // ATmega32: SFIOR 0x50 bit 2). 0 = unknown part.
+    avr_io_addr_t pud_register = 0;
+    std::uint8_t pud_mask = 0;
     bool known = false;
 };
 

@@ -56,9 +56,9 @@ public:
             pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, port->r_ddr, &on_port_or_ddr_write, ctx));
         }
         // PUD: MCUCR bit 4 on the 328P/2560 (§14.4.1 / §13.4.1), SFIOR bit 2 on the ATmega32.
-        if (facts_.known) {
-            pud_register_ = facts_.old_mega ? 0x50 : 0x55;
-            pud_mask_ = facts_.old_mega ? 0x04 : 0x10;
+        if (facts_.pud_register != 0) {
+            pud_register_ = facts_.pud_register;
+            pud_mask_ = facts_.pud_mask;
             pin_hooks_.push_back(std::make_unique<IoWriteHook>(avr, pud_register_, &on_pud_write, this));
         }
     }

@@ -1,0 +1,94 @@
+#include "wiring/McuPinTerminal.hpp"
+
+extern "C" {
+#include <avr_ioport.h>
+#include <sim_avr.h>
+}
+
+#include "core/fixes/Fix.hpp"
+#include "core/fixes/Interrupts.hpp"
+
+namespace avrbench {
+
+McuPinTerminal::McuPinTerminal(Mcu& mcu, Pin& pin) : mcu_(mcu), pin_(pin), level_(pin.level()) {
+    // A level change of an output (PORT write, compare output, reset) re-resolves
+    // the net. simavr stores an IRQ's new value only after its listeners ran,
+    // so the level comes from the notification, not from the pin.
+    pin_.on_change([this](Cycle, bool level) {
+        level_ = level;
+        drive_changed();
+    });
+}
+
+Drive McuPinTerminal::drive_state() const {
+    if (pin_.is_output()) return Drive::strong(level_);
+    if (pin_.internal_pull_up()) return Drive::weak(true, kInternalPullUpOhm);
+    return Drive::none();
+}
+
+void McuPinTerminal::receive(const Resolution& resolution) {
+    if (pin_.is_output()) {
+        // The output buffer sets PINxn; the net's level is not the pin's to read.
+        if (pin_.driven()) pin_.release();
+        return;
+    }
+    pin_.drive(resolution.level);
+}
+
+McuPortWatch::McuPortWatch(Mcu& mcu) : mcu_(mcu) {
+    const PartFacts facts = part_facts(mcu.avr());
+    if (facts.pud_register != 0) {
+        write_hooks_.push_back(std::make_unique<IoWriteHook>(mcu.avr(), facts.pud_register, &on_pud_write, this));
+    }
+    mcu.on_reset([this] { refresh_all(); });
+}
+
+McuPortWatch::~McuPortWatch() {
+    // Hooks chain on simavr's I/O slots: undo them newest first.
+    while (!read_hooks_.empty()) read_hooks_.pop_back();
+    while (!write_hooks_.empty()) write_hooks_.pop_back();
+}
+
+void McuPortWatch::add(McuPinTerminal& terminal) {
+    avr_ioport_t* port = terminal.pin().port();
+    auto& slot = ports_[port];
+    if (!slot) {
+        slot = std::make_unique<PortWatch>();
+        slot->owner = this;
+        slot->port = port;
+        avr_t* avr = mcu_.avr();
+        for (avr_io_addr_t reg : {port->r_port, port->r_ddr, port->r_pin}) {
+            write_hooks_.push_back(std::make_unique<IoWriteHook>(avr, reg, &on_write, slot.get()));
+        }
+        read_hooks_.push_back(std::make_unique<IoReadHook>(avr, port->r_pin, &on_pin_read, slot.get()));
+    }
+    slot->terminals.push_back(&terminal);
+}
+
+void McuPortWatch::on_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    hook.write_original(avr, addr, value);
+    for (McuPinTerminal* t : static_cast<PortWatch*>(hook.context())->terminals) t->refresh();
+}
+
+void McuPortWatch::on_pud_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    hook.write_original(avr, addr, value);
+    static_cast<McuPortWatch*>(hook.context())->refresh_all();
+}
+
+std::uint8_t McuPortWatch::on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr) {
+    auto* watch = static_cast<PortWatch*>(hook.context());
+    for (McuPinTerminal* t : watch->terminals) {
+        if (t->net()->resolution().state == NetState::Floating && !t->pin().is_output()) {
+            t->net()->floating_read(watch->owner->mcu_, t->label());
+        }
+    }
+    return hook.read_original(avr, addr);
+}
+
+void McuPortWatch::refresh_all() {
+    for (auto& [port, watch] : ports_) {
+        for (McuPinTerminal* t : watch->terminals) t->refresh();
+    }
+}
+
+}  // namespace avrbench

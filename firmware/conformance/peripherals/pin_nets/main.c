@@ -1,0 +1,70 @@
+/*
+ * pin_nets - pins read what the board's nets resolve to: the MCU's pull-up
+ * against board resistors, open-drain (wired-AND) sharing, PUD, and an output
+ * fighting a tie. The board around it is in tests/conformance_periph/
+ * test_pin_nets.cpp; the expected levels come from the datasheet's DC
+ * characteristics (R_PU 20-50 kohm, V_IL max 0.3 VCC, V_IH min 0.6 VCC;
+ * ATmega328P §28.2, 2560 §31.2, ATmega32 §28) and Table 14-1 (pin states).
+ *
+ * Board: PB0 - 1 kohm to GND; PB1 - 100 kohm to GND; PB2 - 47 kohm to GND;
+ * PB3 and PB4 on one net with 4.7 kohm to VCC; PB5 tied to GND (0 ohm).
+ *
+ * reads[] (PINx bit):
+ *   0  PB0 pull-up on: 1 kohm down wins                          -> 0
+ *   1  PB1 pull-up on: 100 kohm down, 0.74 VCC > V_IH             -> 1
+ *   2  PB2 pull-up on: 47 kohm down, 0.57 VCC between V_IL, V_IH -> floating, 0
+ *   3  PB1 again with PUD = 1: only the 100 kohm remains          -> 0
+ *   4  PB4, PB3 and PB4 both inputs without pull-up: 4.7k up      -> 1
+ *   5  PB4 while PB3 is an output driving low (open-drain "on")   -> 0
+ *   6  PB3 while PB4 drives low and PB3 is an input               -> 0
+ *   7  PB4 after both let go again                                -> 1
+ * Then PB5 becomes an output driving high into the tie: contention.
+ */
+#include <avr/io.h>
+
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
+#if defined(MCUCR) && defined(PUD) && !defined(SFIOR)
+#define PUD_REG MCUCR
+#else
+#define PUD_REG SFIOR
+#endif
+
+volatile uint8_t reads[8];
+volatile uint8_t done;
+
+/* The synchroniser delay (§14.2.4) before reading PINx: two NOPs. */
+static inline uint8_t pin_b(uint8_t bit)
+{
+    __asm__ __volatile__("nop\n\tnop");
+    return (uint8_t)((PINB >> bit) & 1);
+}
+
+int main(void)
+{
+    DDRB = 0;
+    PORTB = _BV(PB0) | _BV(PB1) | _BV(PB2);
+    reads[0] = pin_b(PB0);
+    reads[1] = pin_b(PB1);
+    reads[2] = pin_b(PB2);
+    PUD_REG |= _BV(PUD);
+    reads[3] = pin_b(PB1);
+    PUD_REG &= (uint8_t)~_BV(PUD);
+    PORTB = 0;
+
+    reads[4] = pin_b(PB4);
+    DDRB = _BV(PB3); /* PORTB3 = 0: the open-drain idiom pulls low through DDR */
+    reads[5] = pin_b(PB4);
+    DDRB = _BV(PB4);
+    reads[6] = pin_b(PB3);
+    DDRB = 0;
+    reads[7] = pin_b(PB4);
+
+    PORTB = _BV(PB5);
+    DDRB = _BV(PB5);
+    done = 1;
+    for (;;) {
+    }
+}
