@@ -10,6 +10,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -123,7 +124,55 @@ BoardSpec load_board_file(const std::string& name_or_path) {
     return parse_board_text(ss.str(), path);
 }
 
-BoardSpec parse_board_text(const std::string& text, const std::string& path) {
+namespace {
+
+// Replaces the declaration named like `item` in `into`, or appends it.
+template <class Decl>
+void overlay(std::vector<Decl>& into, Decl item) {
+    for (auto& existing : into) {
+        if (existing.name == item.name) {
+            existing = std::move(item);
+            return;
+        }
+    }
+    into.push_back(std::move(item));
+}
+
+BoardSpec parse_board(const std::string& text, const std::string& path, int depth);
+
+// `extends: ramps-1.4`: the base board, a standard board's name or a file
+// relative to this one.
+BoardSpec load_base(const YAML::Node& node, const std::string& path, int depth) {
+    const std::string loc = where(path, node);
+    const std::string name = scalar(node, path, "extends");
+    // Four levels are plenty for variants of variants; more is a loop.
+    if (depth >= 4) throw BadInput(loc + ": 'extends' nests more than 4 boards deep (a board that extends itself?)");
+    std::string base_path = name;
+    const std::filesystem::path relative = std::filesystem::path(path).parent_path() / name;
+    std::error_code ec;
+    if (name.find('/') != std::string::npos || std::filesystem::path(name).extension() == ".yaml") {
+        if (std::filesystem::is_regular_file(relative, ec)) base_path = relative.string();
+    }
+    std::string file;
+    try {
+        file = find_board_file(base_path);
+    } catch (const BadInput& e) {
+        throw BadInput(loc + ": extends " + e.what());
+    }
+    std::ifstream in(file);
+    if (!in) throw BadInput(file + ": cannot read");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_board(ss.str(), file, depth + 1);
+}
+
+}  // namespace
+
+BoardSpec parse_board_text(const std::string& text, const std::string& path) { return parse_board(text, path, 0); }
+
+namespace {
+
+BoardSpec parse_board(const std::string& text, const std::string& path, int depth) {
     YAML::Node root;
     try {
         root = YAML::Load(text);
@@ -135,20 +184,26 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
 
     BoardSpec spec;
     spec.path = path;
-    static const std::set<std::string> kSections = {"board", "description", "mcus", "parts", "nets", "serial", "labels"};
+    static const std::set<std::string> kSections = {"board", "description", "extends", "mcus",
+                                                    "parts", "nets",  "serial",      "labels"};
     for (const auto& kv : root) {
         const std::string key = kv.first.Scalar();
         if (kSections.count(key) == 0) {
             throw BadInput(where(path, kv.first) + ": unknown section '" + key +
-                           "' (expected board, description, mcus, parts, nets, serial, labels)");
+                           "' (expected board, description, extends, mcus, parts, nets, serial, labels)");
         }
     }
+    std::optional<BoardSpec> base;
+    if (root["extends"]) base = load_base(root["extends"], path, depth);
     if (root["board"]) spec.name = scalar(root["board"], path, "board");
     if (root["description"]) spec.description = scalar(root["description"], path, "description");
 
     std::set<std::string> names;
     const YAML::Node mcus = root["mcus"];
-    if (!mcus || !mcus.IsMap() || mcus.size() == 0) throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
+    if (!base && (!mcus || !mcus.IsMap() || mcus.size() == 0)) {
+        throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
+    }
+    if (mcus && !mcus.IsMap()) throw BadInput(where(path, mcus) + ": 'mcus' must be a map of MCU name to type and clock");
     for (const auto& kv : mcus) {
         McuDecl m;
         m.name = kv.first.Scalar();
@@ -195,7 +250,6 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
     if (const YAML::Node nets = root["nets"]) {
         if (!nets.IsMap()) throw BadInput(where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
         std::set<std::string> net_names;
-        std::set<std::string> used_endpoints;
         for (const auto& kv : nets) {
             NetDecl n;
             n.name = kv.first.Scalar();
@@ -205,11 +259,7 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
                 throw BadInput(n.location + ": net '" + n.name + "' must list at least two endpoints, e.g. [uno.PD2, x_driver.step]");
             }
             for (const auto& e : kv.second) {
-                Endpoint ep = parse_endpoint(e, path);
-                if (!used_endpoints.insert(ep.text()).second) {
-                    throw BadInput(ep.location + ": '" + ep.text() + "' is already on another net");
-                }
-                n.endpoints.push_back(std::move(ep));
+                n.endpoints.push_back(parse_endpoint(e, path));
             }
             spec.nets.push_back(std::move(n));
         }
@@ -271,7 +321,34 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
         }
     }
 
-    // Cross-references that need only the file itself.
+    if (base) {
+        // A variant: what it names replaces the base's declaration of that
+        // name, whole; what it adds is added (docs/BOARDS.md, "Variants").
+        BoardSpec merged = std::move(*base);
+        merged.path = path;
+        if (!spec.name.empty()) merged.name = spec.name;
+        if (!spec.description.empty()) merged.description = spec.description;
+        for (auto& m : spec.mcus) overlay(merged.mcus, std::move(m));
+        for (auto& p : spec.parts) overlay(merged.parts, std::move(p));
+        for (auto& n : spec.nets) overlay(merged.nets, std::move(n));
+        for (auto& s2 : spec.serial) overlay(merged.serial, std::move(s2));
+        for (auto& l : spec.labels) overlay(merged.labels, std::move(l));
+        spec = std::move(merged);
+        std::set<std::string> all_names;
+        for (const auto& m : spec.mcus) check_name(m.name, m.location, "MCU", all_names);
+        for (const auto& p : spec.parts) check_name(p.name, p.location, "part", all_names);
+        for (const auto& s2 : spec.serial) check_name(s2.name, s2.location, "serial port", all_names);
+    }
+    std::set<std::string> used_endpoints;
+    for (const auto& n : spec.nets) {
+        for (const auto& ep : n.endpoints) {
+            if (!used_endpoints.insert(ep.text()).second) {
+                throw BadInput(ep.location + ": '" + ep.text() + "' is already on another net");
+            }
+        }
+    }
+
+    // Cross-references within the (merged) board.
     auto check_endpoint = [&](const Endpoint& e) {
         if (const McuDecl* m = spec.find_mcu(e.owner)) {
             check_mcu_pin(e, *m);
@@ -288,5 +365,7 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
     }
     return spec;
 }
+
+}  // namespace
 
 }  // namespace avrbench

@@ -102,7 +102,7 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"bad_clock", 2, "  uno: {type: atmega328p, clock: 16MHZ}",
              "bad.yaml:2: MCU 'uno': clock: unknown unit 'MHZ' in '16MHZ' (expected Hz, kHz, MHz, rpm)"},
         Case{"unknown_section", 7, "netz:",
-             "bad.yaml:7: unknown section 'netz' (expected board, description, mcus, parts, nets, serial, labels)"},
+             "bad.yaml:7: unknown section 'netz' (expected board, description, extends, mcus, parts, nets, serial, labels)"},
         // Values no board can have (each range is written beside its check).
         Case{"steps_per_mm_zero", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 0, travel: 200mm}",
              "bad.yaml:5: part 'x': steps_per_mm must be from 0.001 to 1e6"},
