@@ -5,6 +5,7 @@
 #include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
 #include "parts/PullResistor.hpp"
+#include "parts/SerialPeer.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
 #include "parts/Thermistor.hpp"
@@ -58,6 +59,16 @@ PartType pull_resistor() {
     return t;
 }
 
+PartType serial_peer() {
+    PartType t;
+    t.name = "serial_peer";
+    t.params = SerialPeer::param_specs();
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
+        return std::make_unique<SerialPeer>(name, clock, params);
+    };
+    return t;
+}
+
 // Thermal parts (docs/THERMAL.md): a plant, and the heaters, thermistors
 // and fans that name it.
 PartType thermal_plant() {
@@ -95,7 +106,7 @@ PartType on_plant(const std::string& type_name) {
 const std::map<std::string, PartType>& part_types() {
     static const std::map<std::string, PartType> types = [] {
         std::map<std::string, PartType> m;
-        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), pull_resistor(), thermal_plant(),
+        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), pull_resistor(), serial_peer(), thermal_plant(),
                            on_plant<Heater>("heater"), on_plant<Thermistor>("thermistor"), on_plant<Fan>("fan")}) {
             m.emplace(t.name, std::move(t));
         }

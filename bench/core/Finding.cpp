@@ -24,6 +24,7 @@ const char* to_string(FindingKind kind) {
         case FindingKind::MotorStall: return "motor-stall";
         case FindingKind::Overheat: return "overheat";
         case FindingKind::HostProtocol: return "host-protocol";
+        case FindingKind::SerialFraming: return "serial-framing";
         case FindingKind::NetContention: return "net-contention";
         case FindingKind::FloatingInputRead: return "floating-input-read";
     }

@@ -31,6 +31,7 @@ enum class FindingKind {
     MotorStall,          // a stepper motor's rotor lost synchronism with its excitation (lost steps)
     Overheat,            // a thermal plant passed its safe maximum temperature
     HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
+    SerialFraming,       // a pin-level serial frame with a bad stop bit or edges off the bit grid
 
     // Found by the nets (wiring/).
     NetContention,       // two outputs drive one net to opposite levels
