@@ -297,6 +297,16 @@ void UartHost::send_bytes(const std::string& bytes) {
     uart_.send(bytes);
 }
 
+void UartHost::send_bytes_at(const std::string& bytes, Cycle at_cycle) {
+    ++timed_bytes_pending_;
+    std::weak_ptr<bool> alive = alive_;
+    mcu_.scheduler().at(std::max(at_cycle, mcu_.cycle()), [this, alive, bytes](Cycle) {
+        if (alive.expired()) return;
+        --timed_bytes_pending_;
+        send_bytes(bytes);
+    });
+}
+
 std::string UartHost::received_text() const {
     std::string out;
     out.reserve(received_.size());
@@ -307,7 +317,7 @@ std::string UartHost::received_text() const {
 // --- state -------------------------------------------------------------------
 
 bool UartHost::done() const {
-    return ready_ && !failed_ && next_ == lines_.size() && outstanding_.empty();
+    return ready_ && !failed_ && next_ == lines_.size() && outstanding_.empty() && timed_bytes_pending_ == 0;
 }
 
 std::string UartHost::failure_message() const {

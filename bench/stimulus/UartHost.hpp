@@ -182,6 +182,10 @@ public:
     // real-time commands are not), recorded in the transcript as Sent with
     // source_line 0.
     void send_bytes(const std::string& bytes);
+    // Sends `bytes` the same way when the MCU reaches `at_cycle` (grbl's feed
+    // hold '!' and resume '~' at chosen times); the job is not done() while
+    // any are still to go.
+    void send_bytes_at(const std::string& bytes, Cycle at_cycle);
     // Every byte the firmware transmitted since the host attached.
     const std::vector<UartByte>& received() const { return received_; }
     std::string received_text() const;
@@ -273,6 +277,7 @@ private:
 
     std::vector<GcodeLine> lines_;
     std::size_t next_ = 0;           // next line to send
+    std::size_t timed_bytes_pending_ = 0;  // send_bytes_at() calls not yet due
     std::size_t acknowledged_ = 0;
     std::size_t added_raw_lines_ = 0;  // numbering for add_lines
     std::deque<Outstanding> outstanding_;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -65,6 +66,7 @@ struct RunArgs {
     std::string report;
     std::string family;        // --family: overrides the board's
     std::string line_timeout;  // --line-timeout: overrides the board's
+    std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
 };
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
@@ -193,6 +195,31 @@ void print_text_tail(const std::string& text, std::size_t max_lines) {
 
 // A crash of the firmware (the MCU's own oracles); part, net and host findings
 // fail a run only with --strict.
+// --realtime 2.5s='!': a time and the bytes to send then, outside the line
+// stream: printable characters as they are, ^X for a control character
+// (grbl's soft reset Ctrl-X), 0xNN for any byte (grbl 1.1's overrides).
+std::pair<Picoseconds, std::string> parse_realtime(const std::string& item) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq + 1 >= item.size()) {
+        throw BadInput("--realtime '" + item + "': expected TIME=BYTES, e.g. 2s=! or 1.5s=^X or 3s=0x85");
+    }
+    const Picoseconds at = parse_duration_ps(item.substr(0, eq), "--realtime");
+    const std::string text = item.substr(eq + 1);
+    std::string bytes;
+    if (text.size() == 2 && text[0] == '^' && text[1] >= '@' && text[1] <= '_') {
+        bytes.push_back(static_cast<char>(text[1] - '@'));
+    } else if (text.size() == 4 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X') &&
+               std::isxdigit(static_cast<unsigned char>(text[2])) && std::isxdigit(static_cast<unsigned char>(text[3]))) {
+        bytes.push_back(static_cast<char>(std::stoi(text.substr(2), nullptr, 16)));
+    } else {
+        for (char c : text) {
+            if (c < 0x20 || c > 0x7e) throw BadInput("--realtime '" + item + "': write control bytes as ^X or 0xNN");
+        }
+        bytes = text;
+    }
+    return {at, bytes};
+}
+
 bool is_mcu_finding(const Finding& f) { return f.kind <= FindingKind::JumpToReset; }
 
 int run_board_command(const RunArgs& args) {
@@ -231,6 +258,8 @@ int run_board_command(const RunArgs& args) {
     for (const auto& pf : uart_out) bench.serial_decl(pf.port);
     if (!args.host.empty()) bench.serial_decl(args.host);
 
+    std::vector<std::pair<Picoseconds, std::string>> realtime_bytes;
+    for (const auto& item : args.realtime) realtime_bytes.push_back(parse_realtime(item));
     UartHost* host = nullptr;
     if (!args.gcode.empty()) {
         const SerialDecl& decl = bench.serial_decl(args.host);
@@ -248,6 +277,11 @@ int run_board_command(const RunArgs& args) {
         const std::optional<UartHostOptions> options = o;
         host = &bench.host(decl.name, options);
         host->load_file(args.gcode);
+        for (const auto& [at_ps, bytes] : realtime_bytes) {
+            host->send_bytes_at(bytes, board.mcu(decl.mcu).cycles_from_seconds(seconds_from_ps(at_ps)));
+        }
+    } else if (!realtime_bytes.empty()) {
+        throw BadInput("--realtime needs --gcode (the bytes go to its host's port)");
     }
     for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
     if (!args.vcd.empty() || !args.report.empty()) {
@@ -377,6 +411,7 @@ int run_command(const RunArgs& args) {
     if (!args.board.empty()) return run_board_command(args);
     if (!args.gcode.empty()) throw BadInput("--gcode needs --board (the board file names the serial port)");
     if (!args.report.empty()) throw BadInput("--report needs --board");
+    if (!args.realtime.empty()) throw BadInput("--realtime needs --board and --gcode");
     const ElfImage elf = ElfImage::load(args.elf);
     McuOptions options;
     options.name = "mcu";
@@ -596,6 +631,9 @@ int main(int argc, char** argv) {
                         "grbl | marlin | teacup | generic: the firmware's protocol on the --host port (default: the board's)");
     run_cmd->add_option("--line-timeout", run.line_timeout,
                         "a line unanswered this long with no output at all is a timeout (default: the board's, 2s)");
+    run_cmd->add_option("--realtime", run.realtime,
+                        "TIME=BYTES sent at that simulated time outside the line stream, e.g. 2s=! 4s=~ (grbl "
+                        "feed hold/resume), 1s=^X, 3s=0x85 (repeatable; needs --gcode)");
     run_cmd->add_option("--settle", run.settle, "motion has stopped after no STEP edge for this long (default 50ms)");
     run_cmd->add_option("--report", run.report, "write an HTML report of the run (with --board)");
     run_cmd->add_flag("--until-sleep", run.until_sleep, "stop when the firmware first executes SLEEP (bounded by --for)");

@@ -124,7 +124,18 @@ INSTANTIATE_TEST_SUITE_P(
                      "/nonexistent/in.txt"},
         BadInputCase{"unknown_pin", "run " + test::firmware("blink_timer1") + " --trace PZ3", "PZ3"},
         BadInputCase{"unknown_option", "run " + test::firmware("blink_timer1") + " --frobnicate", "usage error"},
-        BadInputCase{"no_subcommand", "", "usage error"}),
+        BadInputCase{"no_subcommand", "", "usage error"},
+        BadInputCase{"realtime_without_board", "run " + test::firmware("blink_timer1") + " --realtime 1s=!",
+                     "--realtime needs --board and --gcode"},
+        BadInputCase{"realtime_without_gcode",
+                     "run " + test::firmware("blink_timer1") + " --board arduino-uno-cnc-shield-v3 --realtime 1s=!",
+                     "--realtime needs --gcode"},
+        BadInputCase{"realtime_malformed",
+                     "run " + test::firmware("blink_timer1") + " --board arduino-uno-cnc-shield-v3 --realtime 1s",
+                     "expected TIME=BYTES"},
+        BadInputCase{"realtime_non_ascii_byte",
+                     "run " + test::firmware("blink_timer1") + " --board arduino-uno-cnc-shield-v3 --realtime 1s=\xc3\xa9",
+                     "write control bytes as ^X or 0xNN"}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
 TEST(CliRun, FirmwareForABiggerMcuCrashesCleanly) {

@@ -73,6 +73,27 @@ TEST(HostFamilies, GrblRealtimeQueryIsAByteNotALine) {
     EXPECT_EQ(p.host.oks(), 2u);
 }
 
+TEST(HostFamilies, TimedRealtimeBytesGoOutAtTheirCycleAndHoldTheJobOpen) {
+    // grbl's feed hold '!' and resume '~' at chosen times (grbl 1.1
+    // "Realtime commands": single bytes outside the streaming protocol).
+    Peer p("host_peer_grbl", FirmwareFamily::Grbl, FlowControl::CharacterCounting);
+    p.host.add_lines("G1 X1\n");
+    const Cycle hold_at = p.mcu.cycles_from_seconds(1.5), resume_at = p.mcu.cycles_from_seconds(2.25);
+    p.host.send_bytes_at("!", hold_at);
+    p.host.send_bytes_at("~", resume_at);
+    // The line is answered within a second; the job is not done before the last byte went.
+    ASSERT_TRUE(p.host.run_until_finished(10.0)) << p.host.failure_message();
+    EXPECT_GE(p.mcu.cycle(), resume_at);
+    std::vector<std::pair<Cycle, std::string>> sent_bytes;
+    for (const auto& e : p.host.transcript()) {
+        if (e.direction == Direction::Sent && e.source_line == 0) sent_bytes.emplace_back(e.cycle, e.text);
+    }
+    ASSERT_EQ(sent_bytes.size(), 2u);
+    EXPECT_EQ(sent_bytes[0], std::make_pair(hold_at, std::string("!")));
+    EXPECT_EQ(sent_bytes[1], std::make_pair(resume_at, std::string("~")));
+    EXPECT_EQ(p.host.lines_acknowledged(), 1u);
+}
+
 TEST(HostFamilies, GrblStatusPollsKeepALongMoveAlive) {
     // 5 s of work before the ok (a long move fills grbl's planner) and
     // nothing printed unless asked: the host's '?' every 250 ms brings a
