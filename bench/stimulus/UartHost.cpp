@@ -62,6 +62,14 @@ std::string printable(const std::string& text) {
     return out;
 }
 
+// A job line as messages quote it: whole up to 80 bytes, else its start and
+// its length (a 100 kB line must not become a 100 kB error message).
+std::string quoted_line(const std::string& text) {
+    constexpr std::size_t kShown = 60;
+    if (text.size() <= 80) return "'" + printable(text) + "'";
+    return "'" + printable(text.substr(0, kShown)) + "...' (" + std::to_string(text.size()) + " bytes)";
+}
+
 }  // namespace
 
 const char* to_string(FlowControl flow) {
@@ -391,7 +399,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     } else if (starts_with(text, "error") || starts_with(text, "Error")) {
         ++errors_;
         HostEvent e = event_at_oldest_line(HostEventKind::Error, cycle, text);
-        e.message = e.line ? "line " + std::to_string(e.line->number) + " '" + e.line->text + "' got '" + text + "'"
+        e.message = e.line ? "line " + std::to_string(e.line->number) + " " + quoted_line(e.line->text) + " got '" + text + "'"
                            : "'" + text + "' with no line outstanding";
         stop_or_record(options_.stop_on_error, std::move(e));
         if (options_.error_acknowledges) acknowledge();
@@ -473,7 +481,7 @@ void UartHost::pump() {
                 e.kind = HostEventKind::LineTooLong;
                 e.cycle = mcu_.cycle();
                 e.line = line;
-                e.message = "line " + std::to_string(line.number) + " '" + line.text + "' is " +
+                e.message = "line " + std::to_string(line.number) + " " + quoted_line(line.text) + " is " +
                             std::to_string(bytes) + " bytes with its newline, more than the " +
                             std::to_string(options_.rx_buffer_bytes) + "-byte receive buffer";
                 fail(std::move(e));
@@ -502,8 +510,8 @@ void UartHost::send_line(std::size_t index) {
     if (outstanding_.size() > max_outstanding_lines_) max_outstanding_lines_ = outstanding_.size();
     if (outstanding_bytes_ > max_outstanding_bytes_) max_outstanding_bytes_ = outstanding_bytes_;
     transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
-    if (was_idle) arm_line_timeout();
     uart_.send(line.text + "\n");
+    if (was_idle) arm_line_timeout();  // after queueing: the timeout counts from the line's last byte
     if (was_idle && options_.family == FirmwareFamily::Grbl && options_.grbl_status_poll_s > 0) {
         poll_status(++poll_generation_);
     }
@@ -515,7 +523,10 @@ void UartHost::send_line(std::size_t index) {
 void UartHost::arm_line_timeout() {
     const std::uint64_t generation = ++timeout_generation_;
     std::weak_ptr<bool> alive = alive_;
-    mcu_.scheduler().after(mcu_.cycles_from_seconds(timeout_for_oldest_s()), [this, alive, generation](Cycle) {
+    // The clock starts once the firmware has the whole line: bytes still
+    // queued for its receiver (a long line at 115200 baud takes seconds).
+    const Cycle still_sending = static_cast<Cycle>(uart_.pending_rx()) * uart_.cycles_per_frame();
+    mcu_.scheduler().after(mcu_.cycles_from_seconds(timeout_for_oldest_s()) + still_sending, [this, alive, generation](Cycle) {
         if (alive.expired() || generation != timeout_generation_) return;
         on_line_timeout();
     });
@@ -595,7 +606,7 @@ void UartHost::on_line_timeout() {
     e.kind = HostEventKind::Timeout;
     e.cycle = mcu_.cycle();
     e.line = line;
-    e.message = "line " + std::to_string(line.number) + " '" + line.text + "' got no answer within " +
+    e.message = "line " + std::to_string(line.number) + " " + quoted_line(line.text) + " got no answer within " +
                 seconds_text(timeout_for_oldest_s());
     fail(std::move(e));
 }
@@ -646,7 +657,7 @@ std::string UartHost::tail(std::size_t n) const {
                       static_cast<double>(e.cycle) / static_cast<double>(mcu_.frequency_hz()),
                       e.direction == Direction::Sent ? '>' : '<');
         out += stamp;
-        out += printable(e.text);
+        out += e.text.size() > 200 ? quoted_line(e.text) : printable(e.text);
         out += '\n';
     }
     return out;

@@ -94,6 +94,24 @@ TEST(HostFamilies, TimedRealtimeBytesGoOutAtTheirCycleAndHoldTheJobOpen) {
     EXPECT_EQ(p.host.lines_acknowledged(), 1u);
 }
 
+TEST(HostFamilies, TheLineTimeoutStartsOnceTheWholeLineIsSent) {
+    // A 3000-byte line at host_peer's 117647 baud (UBRR0 = 16 with U2X0) takes
+    // 3001 frames x 10 bits = 255 ms to send; with a 100 ms line timeout the
+    // firmware must still be given 100 ms after the newline, not after the
+    // first byte (host_peer reads to the newline, then answers ok).
+    UartHostOptions o = Peer::options(FirmwareFamily::Grbl, FlowControl::SendAndWait);
+    o.grbl_status_poll_s = 0;
+    o.line_timeout_s = 0.1;
+    Mcu mcu(ElfImage::load(test::firmware("host_peer_grbl")));
+    UartHost host(mcu, 0, o);
+    host.add_lines("G1 X" + std::string(2996, '1') + "\n");
+    ASSERT_TRUE(host.run_until_finished(5.0)) << host.failure_message();
+    EXPECT_TRUE(host.done());
+    EXPECT_EQ(host.oks(), 1u);
+    // The transcript's tail shows such a line by its start and length.
+    EXPECT_NE(host.tail(2).find("...' (3000 bytes)"), std::string::npos) << host.tail(2);
+}
+
 TEST(HostFamilies, GrblStatusPollsKeepALongMoveAlive) {
     // 5 s of work before the ok (a long move fills grbl's planner) and
     // nothing printed unless asked: the host's '?' every 250 ms brings a

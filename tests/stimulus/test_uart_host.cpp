@@ -306,9 +306,12 @@ TEST(UartHost, DefaultTimeoutIsTwoSimulatedSeconds) {
     ASSERT_TRUE(host.run_until_finished(5.0));
     EXPECT_EQ(host.failure_message(), "line 2 'G1 X10' got no answer within 2 s");
     ASSERT_EQ(host.events().size(), 1u);
-    // Sent at cycle 0 (Startup::Immediately), timed out 2 s = 32,000,000 cycles later.
-    EXPECT_GE(host.events()[0].cycle, 2 * kCyclesPerSecond);
-    EXPECT_LE(host.events()[0].cycle, 2 * kCyclesPerSecond + kBoundarySlack);
+    // Queued at cycle 0 (Startup::Immediately); the clock starts when its 7
+    // bytes ("G1 X10\n") would have reached the firmware at the USART's frame
+    // length, and runs 2 s = 32,000,000 cycles.
+    const Cycle on_the_wire = 7 * mcu.uart(0).cycles_per_frame();
+    EXPECT_GE(host.events()[0].cycle, 2 * kCyclesPerSecond + on_the_wire);
+    EXPECT_LE(host.events()[0].cycle, 2 * kCyclesPerSecond + on_the_wire + kBoundarySlack);
     EXPECT_EQ(mcu.uart(0).bytes_delivered(), 0u);
 }
 
