@@ -143,24 +143,53 @@ std::string with_extension(const std::string& path, const std::string& extension
 
 // Writes the VCD and, beside it, a gtkwave save file zoomed to the whole run
 // (which ends at `clock`'s current cycle). Returns the save file's path.
-std::string write_waveforms(const Timeline& timeline, const std::string& vcd_path, const Mcu& clock) {
-    VcdOptions vcd_options;
-    vcd_options.end_cycle = clock.cycle();
-    vcd_options.end_clock_hz = clock.frequency_hz();
-    const VcdResult vcd = write_vcd(timeline, vcd_path, vcd_options);
-    const std::string gtkw_path = with_extension(vcd_path, ".gtkw");
-    GtkwOptions gtkw_options;
-    gtkw_options.fit_end_time = vcd.end_time;
-    gtkw_options.fit_timescale = vcd.timescale;
-    // The save file names the dump relative to its own folder, which gtkwave
-    // resolves from wherever it is started.
-    std::error_code ec;
-    const auto gtkw_folder = std::filesystem::absolute(gtkw_path, ec).parent_path();
-    std::string dump = std::filesystem::relative(std::filesystem::absolute(vcd_path, ec), gtkw_folder, ec).generic_string();
-    if (ec || dump.empty()) dump = std::filesystem::absolute(vcd_path, ec).string();
-    write_gtkw(timeline, gtkw_path, dump, gtkw_options);
-    return gtkw_path;
-}
+// --vcd: the dump and its gtkwave save file. Written as the run goes
+// (VcdStream: memory does not grow with the run's length) unless the whole
+// timeline is wanted afterwards (--report), then at the end from memory.
+class Waveforms {
+public:
+    // Events may be recorded up to one UART frame after the time they stamp
+    // (a byte is stamped with its start bit): 100 ms covers frames down to
+    // 100 baud. The dump is written up to this far behind the simulation.
+    static constexpr Picoseconds kSettleLagPs = 100 * kPsPerMs;
+
+    Waveforms(Timeline& timeline, std::string vcd_path, bool stream)
+        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()) {}
+
+    // Once every signal is registered.
+    void start() {
+        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_);
+    }
+    void drain(Picoseconds now_ps) {
+        if (stream_) stream_->drain(timeline_, now_ps > kSettleLagPs ? now_ps - kSettleLagPs : 0);
+    }
+    // Writes the rest (or all) and the save file; returns the save file's path.
+    std::string finish(const Mcu& clock) {
+        if (path_.empty()) return "";
+        VcdOptions vcd_options;
+        vcd_options.end_cycle = clock.cycle();
+        vcd_options.end_clock_hz = clock.frequency_hz();
+        const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, path_, vcd_options);
+        const std::string gtkw_path = with_extension(path_, ".gtkw");
+        GtkwOptions gtkw_options;
+        gtkw_options.fit_end_time = vcd.end_time;
+        gtkw_options.fit_timescale = vcd.timescale;
+        // The save file names the dump relative to its own folder, which gtkwave
+        // resolves from wherever it is started.
+        std::error_code ec;
+        const auto gtkw_folder = std::filesystem::absolute(gtkw_path, ec).parent_path();
+        std::string dump = std::filesystem::relative(std::filesystem::absolute(path_, ec), gtkw_folder, ec).generic_string();
+        if (ec || dump.empty()) dump = std::filesystem::absolute(path_, ec).string();
+        write_gtkw(timeline_, gtkw_path, dump, gtkw_options);
+        return gtkw_path;
+    }
+
+private:
+    Timeline& timeline_;
+    std::string path_;
+    bool stream_wanted_;
+    std::unique_ptr<VcdStream> stream_;
+};
 
 void print_findings(const std::vector<Finding>& findings) {
     std::printf("  findings   %zu\n", findings.size());
@@ -292,6 +321,8 @@ int run_board_command(const RunArgs& args) {
         }
     }
 
+    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty());
+    waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
     IdleResult outcome = IdleResult::TimeLimit;
@@ -312,16 +343,15 @@ int run_board_command(const RunArgs& args) {
             outcome = IdleResult::Halted;
             break;
         }
+        waveforms.drain(bench.now_ps());
         progress.show(static_cast<double>(bench.now_ps()) / static_cast<double>(end_ps), bench.now_seconds());
     }
     progress.finish();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
-    std::string gtkw_path;
     const Timeline& timeline = bench.timeline();
-    if (!args.vcd.empty()) {
-        gtkw_path = write_waveforms(timeline, args.vcd, board.mcu());
-    }
+    if (timeline.overflowed()) throw BadInput(timeline.overflow_message());
+    const std::string gtkw_path = waveforms.finish(board.mcu());
     for (const auto& pf : uart_out) write_output_file(pf.path, bench.serial(pf.port).transmitted_text(), "--uart-out");
     const auto findings = bench.findings();
     if (!args.report.empty()) {
@@ -373,8 +403,9 @@ int run_board_command(const RunArgs& args) {
         print_text_tail(u.transmitted_text(), 10);
     }
     if (!args.vcd.empty()) {
-        std::printf("  vcd        %s (%zu signals, %zu events), gtkwave save file %s\n", args.vcd.c_str(),
-                    timeline.signals().size(), timeline.events().size(), gtkw_path.c_str());
+        std::printf("  vcd        %s (%zu signals, %llu events), gtkwave save file %s\n", args.vcd.c_str(),
+                    timeline.signals().size(), static_cast<unsigned long long>(timeline.recorded_count()),
+                    gtkw_path.c_str());
     }
     if (!args.report.empty()) std::printf("  report     %s\n", args.report.c_str());
 
@@ -448,6 +479,8 @@ int run_command(const RunArgs& args) {
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
     const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
+    Waveforms waveforms(timeline, args.vcd, true);
+    waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
     bool slept = false;
@@ -460,6 +493,7 @@ int run_command(const RunArgs& args) {
         const Cycle chunk = std::clamp<Cycle>(end_cycle / 100, 1, mcu.frequency_hz() / 100 + 1);
         while (mcu.cycle() < end_cycle && !user_stop_requested()) {
             if (mcu.run_until(std::min(end_cycle, mcu.cycle() + chunk)) == StopReason::Halted) break;
+            waveforms.drain(ps_at_cycle(mcu, mcu.cycle()));
             progress.show(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
         }
     }
@@ -467,10 +501,8 @@ int run_command(const RunArgs& args) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
     if (!uart_out.empty()) write_output_file(uart_out.front().path, uart0->transmitted_text(), "--uart-out");
-    std::string gtkw_path;
-    if (!args.vcd.empty()) {
-        gtkw_path = write_waveforms(timeline, args.vcd, mcu);
-    }
+    if (timeline.overflowed()) throw BadInput(timeline.overflow_message());
+    const std::string gtkw_path = waveforms.finish(mcu);
 
     const double simulated_s = mcu.seconds();
     std::printf("avrbench run: %s on %s at %.6g MHz\n", args.elf.c_str(), mcu.mcu_type().c_str(),
@@ -485,8 +517,9 @@ int run_command(const RunArgs& args) {
     }
     print_findings(mcu.findings());
     if (!args.vcd.empty()) {
-        std::printf("  vcd        %s (%zu signals, %zu events), gtkwave save file %s\n", args.vcd.c_str(),
-                    timeline.signals().size(), timeline.events().size(), gtkw_path.c_str());
+        std::printf("  vcd        %s (%zu signals, %llu events), gtkwave save file %s\n", args.vcd.c_str(),
+                    timeline.signals().size(), static_cast<unsigned long long>(timeline.recorded_count()),
+                    gtkw_path.c_str());
     }
     if (user_stop_requested()) {
         std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n", simulated_s);

@@ -63,4 +63,10 @@ long Timeline::find(const std::string& scope, const std::string& name) const {
     return it == index_.end() ? -1 : static_cast<long>(it->second);
 }
 
+std::string Timeline::overflow_message() const {
+    return "the run recorded more than " + std::to_string(max_held_) +
+           " signal changes, the most a comparison or report keeps in memory; " + std::to_string(dropped_) +
+           " were dropped (shorten the run, trace fewer signals, or use run --vcd without --report, which streams)";
+}
+
 }  // namespace avrbench

@@ -63,16 +63,36 @@ public:
 
     // Record blindly: writers drop events that repeat a signal's value. For a
     // Wire any nonzero `bits` is 1; for a Bus bits above `width` are ignored.
+    // Events held in memory at most (24 bytes each: 1.2 GB): comparisons and
+    // reports need the whole timeline; a run that records more drops the
+    // rest and says so (overflowed()) instead of exhausting memory. A streamed
+    // VCD (VcdStream) takes the events as the run goes and never gets here.
+    static constexpr std::size_t kMaxHeldEvents = 50'000'000;
+
     void record(SignalId id, Cycle cycle, std::uint64_t bits) {
+        if (events_.size() >= max_held_) {
+            ++dropped_;
+            return;
+        }
         TimelineEvent e{cycle, id, {}};
         e.value.bits = bits;
         events_.push_back(e);
     }
     void record_real(SignalId id, Cycle cycle, double value) {
+        if (events_.size() >= max_held_) {
+            ++dropped_;
+            return;
+        }
         TimelineEvent e{cycle, id, {}};
         e.value.real = value;
         events_.push_back(e);
     }
+    // Events not recorded because kMaxHeldEvents were held.
+    std::uint64_t dropped() const { return dropped_; }
+    bool overflowed() const { return dropped_ != 0; }
+    // "the run recorded more than ... events ..." (one line), for callers to report.
+    std::string overflow_message() const;
+    void set_max_held_events(std::size_t n) { max_held_ = n; }
 
     const std::vector<SignalInfo>& signals() const { return signals_; }
     // Events in the order they were recorded. Within one clock domain this is
@@ -88,6 +108,18 @@ public:
     // Returns the signal with that scope and name, or -1.
     long find(const std::string& scope, const std::string& name) const;
 
+    // Streaming (VcdStream): hands over the events recorded since the last
+    // take and forgets them. events() then holds only what came after.
+    std::vector<TimelineEvent> take_events() {
+        taken_ += events_.size();
+        std::vector<TimelineEvent> out;
+        out.swap(events_);
+        events_.reserve(out.size());
+        return out;
+    }
+    // Every event recorded, taken or not.
+    std::uint64_t recorded_count() const { return taken_ + events_.size(); }
+
     // Avoids reallocation on the hot path when the caller knows the run's size.
     void reserve_events(std::size_t count) { events_.reserve(count); }
 
@@ -95,6 +127,9 @@ private:
     std::vector<SignalInfo> signals_;
     std::vector<TimelineEvent> events_;
     std::vector<SignalAlias> aliases_;
+    std::uint64_t taken_ = 0;
+    std::uint64_t dropped_ = 0;
+    std::size_t max_held_ = kMaxHeldEvents;
     std::map<std::pair<std::string, std::string>, SignalId> index_;  // (scope, name) -> id
 };
 

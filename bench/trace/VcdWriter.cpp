@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <vector>
@@ -103,7 +104,7 @@ public:
     }
 
     VcdResult run() {
-        write_header();
+        begin();
         const auto& events = timeline_.events();
         bool sorted = true;
         std::uint64_t previous = 0;
@@ -114,7 +115,7 @@ public:
         }
         if (sorted) {
             // The common case (one MCU, or domains recorded in order): no copy, no sort.
-            write_changes(events.size(), [&](std::size_t i) { return Keyed{time_of(events[i], i), i}; });
+            for (std::size_t i = 0; i < events.size(); ++i) feed(events[i], time_of(events[i], i));
         } else {
             // Sorting (time, record index) pairs is the stable sort by time.
             std::vector<Keyed> keys(events.size());
@@ -122,10 +123,42 @@ public:
             std::sort(keys.begin(), keys.end(), [](const Keyed& a, const Keyed& b) {
                 return a.time != b.time ? a.time < b.time : a.index < b.index;
             });
-            write_changes(keys.size(), [&](std::size_t i) { return keys[i]; });
+            for (const Keyed& k : keys) feed(events[k.index], k.time);
         }
-        if (options_.end_cycle) {
-            const std::uint64_t end_time = timescale_.units_at(*options_.end_cycle, options_.end_clock_hz);
+        return end();
+    }
+
+    void begin() { write_header(); }
+
+    // The next event in time order (time from time_of). Events at time 0 give
+    // the $dumpvars values; a timestamp is written once all its events are in.
+    void feed(const TimelineEvent& e, std::uint64_t time) {
+        if (!dumped_) {
+            if (time == 0) {
+                stage(e);
+                return;
+            }
+            write_dumpvars();
+        }
+        if (have_current_ && time != current_) {
+            if (time < current_) {
+                throw std::logic_error("VCD: an event at time " + std::to_string(time) + " arrived after time " +
+                                       std::to_string(current_) + " was written");
+            }
+            commit(current_);
+        }
+        current_ = time;
+        have_current_ = true;
+        stage(e);
+    }
+
+    VcdResult end() {
+        if (!dumped_) write_dumpvars();
+        if (have_current_) commit(current_);
+        have_current_ = false;
+        const VcdOptions& end_options = end_options_ ? *end_options_ : options_;
+        if (end_options.end_cycle) {
+            const std::uint64_t end_time = timescale_.units_at(*end_options.end_cycle, end_options.end_clock_hz);
             if (end_time > result_.end_time) {
                 out_.character('#');
                 out_.number(end_time);
@@ -139,6 +172,19 @@ public:
         return result_;
     }
 
+    const VcdTimescale& timescale() const { return timescale_; }
+    void set_end(const VcdOptions& options) { end_options_ = options; }
+    std::uint64_t time_of(const TimelineEvent& e, std::size_t index) const {
+        if (e.signal >= signals_.size())
+            throw std::out_of_range("timeline event " + std::to_string(index) + " refers to signal id " +
+                                    std::to_string(e.signal) + ", but only " + std::to_string(signals_.size()) +
+                                    " signals are registered");
+        const SignalState& s = signals_[e.signal];
+        std::uint64_t units = 0;
+        if (s.units_per_cycle != 0 && !__builtin_mul_overflow(e.cycle, s.units_per_cycle, &units)) return units;
+        return timescale_.units_at(e.cycle, s.clock_hz);  // rounds, or throws on overflow
+    }
+
 private:
     struct Keyed {
         std::uint64_t time;
@@ -150,17 +196,6 @@ private:
         for (const SignalInfo& info : timeline.signals()) clocks.push_back(info.clock_hz);
         if (options.end_cycle) clocks.push_back(options.end_clock_hz);
         return VcdTimescale::for_clocks(clocks);
-    }
-
-    std::uint64_t time_of(const TimelineEvent& e, std::size_t index) const {
-        if (e.signal >= signals_.size())
-            throw std::out_of_range("timeline event " + std::to_string(index) + " refers to signal id " +
-                                    std::to_string(e.signal) + ", but only " + std::to_string(signals_.size()) +
-                                    " signals are registered");
-        const SignalState& s = signals_[e.signal];
-        std::uint64_t units = 0;
-        if (s.units_per_cycle != 0 && !__builtin_mul_overflow(e.cycle, s.units_per_cycle, &units)) return units;
-        return timescale_.units_at(e.cycle, s.clock_hz);  // rounds, or throws on overflow
     }
 
     std::uint64_t normalized(const SignalState& s, const TimelineEvent& e) const {
@@ -293,16 +328,7 @@ private:
         out_.maybe_flush();
     }
 
-    template <class KeyAt>
-    void write_changes(std::size_t count, KeyAt key_at) {
-        const auto& events = timeline_.events();
-        std::size_t i = 0;
-        // Time-0 events give the initial values in $dumpvars.
-        for (; i < count; ++i) {
-            const Keyed k = key_at(i);
-            if (k.time != 0) break;
-            stage(events[k.index]);
-        }
+    void write_dumpvars() {
         out_.text("#0\n$dumpvars\n");
         for (SignalState& s : signals_) {
             if (s.staged_group == group_) {
@@ -317,18 +343,7 @@ private:
         out_.text("$end\n");
         touched_.clear();
         ++group_;
-
-        if (i == count) return;
-        std::uint64_t current = key_at(i).time;
-        for (; i < count; ++i) {
-            const Keyed k = key_at(i);
-            if (k.time != current) {
-                commit(current);
-                current = k.time;
-            }
-            stage(events[k.index]);
-        }
-        commit(current);
+        dumped_ = true;
     }
 
     const Timeline& timeline_;
@@ -338,6 +353,10 @@ private:
     std::vector<SignalState> signals_;
     std::vector<SignalId> touched_;
     std::uint64_t group_ = 0;  // counts timestamps; marks which signals are staged
+    std::optional<VcdOptions> end_options_;  // a stream learns its end only at the end
+    bool dumped_ = false;      // $dumpvars written
+    bool have_current_ = false;
+    std::uint64_t current_ = 0;  // the timestamp being assembled
     VcdResult result_;
 };
 
@@ -366,6 +385,76 @@ std::string format_vcd(const Timeline& timeline, const VcdOptions& options, VcdR
     if (result != nullptr) *result = written;
     return text;
 }
+
+struct VcdStream::Impl {
+    struct Held {
+        std::uint64_t time;
+        std::uint64_t sequence;
+        TimelineEvent event;
+    };
+    Impl(const Timeline& timeline, const std::string& path)
+        : file(path, "VCD"), path_copy(path), out(buffer, file.stream(), path_copy), emitter(timeline, no_options, out) {
+        buffer.reserve(kFlushBytes + 4096);
+        emitter.begin();
+    }
+    void take(Timeline& timeline) {
+        for (const TimelineEvent& e : timeline.take_events()) {
+            held.push_back(Held{emitter.time_of(e, static_cast<std::size_t>(sequence)), sequence, e});
+            ++sequence;
+        }
+    }
+    void write_up_to(std::uint64_t limit) {
+        // Held events in recording order; those due go out sorted by (time,
+        // recording order), the rest stay in recording order.
+        std::vector<Held> due;
+        std::size_t kept = 0;
+        for (const Held& h : held) {
+            if (h.time <= limit) {
+                due.push_back(h);
+            } else {
+                held[kept++] = h;
+            }
+        }
+        held.resize(kept);
+        std::stable_sort(due.begin(), due.end(), [](const Held& a, const Held& b) { return a.time < b.time; });
+        for (const Held& h : due) emitter.feed(h.event, h.time);
+        out.maybe_flush();
+    }
+
+    VcdOptions no_options;
+    OutputFile file;
+    std::string path_copy;
+    std::string buffer;
+    Output out;
+    VcdEmitter emitter;
+    std::vector<Held> held;
+    std::uint64_t sequence = 0;
+};
+
+VcdStream::VcdStream(const Timeline& timeline, const std::string& path)
+    : impl_(std::make_unique<Impl>(timeline, path)) {}
+
+VcdStream::~VcdStream() = default;
+
+void VcdStream::drain(Timeline& timeline, Picoseconds settled_ps) {
+    impl_->take(timeline);
+    __extension__ typedef unsigned __int128 Uint128;
+    const Uint128 units = static_cast<Uint128>(settled_ps) *
+                                    impl_->emitter.timescale().units_per_second() / kPsPerSecond;
+    impl_->write_up_to(units > std::numeric_limits<std::uint64_t>::max() ? std::numeric_limits<std::uint64_t>::max()
+                                                                          : static_cast<std::uint64_t>(units));
+}
+
+VcdResult VcdStream::finish(Timeline& timeline, const VcdOptions& options) {
+    impl_->take(timeline);
+    impl_->write_up_to(std::numeric_limits<std::uint64_t>::max());
+    impl_->emitter.set_end(options);
+    const VcdResult result = impl_->emitter.end();
+    impl_->file.commit();
+    return result;
+}
+
+std::size_t VcdStream::held_events() const { return impl_->held.size(); }
 
 VcdResult write_vcd(const Timeline& timeline, const std::string& path, const VcdOptions& options) {
     // Written beside the target and renamed into place when complete: a

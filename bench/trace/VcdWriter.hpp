@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -50,6 +51,34 @@ VcdResult write_vcd(const Timeline& timeline, const std::string& path, const Vcd
 
 // The same dump as a string (tests, small traces).
 std::string format_vcd(const Timeline& timeline, const VcdOptions& options = {}, VcdResult* result = nullptr);
+
+// A dump written while the run goes, so a long run's memory does not grow
+// with its length: every few milliseconds of simulated time the caller hands
+// over what the timeline recorded (Timeline::take_events) up to a time no
+// later event can precede; the dump is the same bytes write_vcd would write
+// for the whole timeline at the end. Signals and aliases must all be
+// registered before the first drain (the header lists them).
+class VcdStream {
+public:
+    // Checks `path` and opens its temporary file (core/OutputFile).
+    VcdStream(const Timeline& timeline, const std::string& path);
+    ~VcdStream();
+    VcdStream(const VcdStream&) = delete;
+    VcdStream& operator=(const VcdStream&) = delete;
+
+    // Takes the timeline's buffered events and writes those at or before
+    // `settled_ps`; later ones wait for the next drain. Throws std::logic_error
+    // if an event arrives for a time already written.
+    void drain(Timeline& timeline, Picoseconds settled_ps);
+    // Writes everything left, the end marker, and renames the file into place.
+    VcdResult finish(Timeline& timeline, const VcdOptions& options);
+    // Events held back (recorded, not yet written), for tests and benchmarks.
+    std::size_t held_events() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 // The VCD identifier code of the signal with id `index`: bijective base 94 over
 // the printable characters '!'..'~', least significant digit first, so ids

@@ -257,6 +257,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
             break;
         }
     }
+    if (bench.timeline().overflowed()) throw BadInput(spec.path + ": " + bench.timeline().overflow_message());
 
     const std::vector<Finding> findings = bench.findings();
     ExpectationChecker checker(bench, findings);

@@ -160,6 +160,22 @@ TEST(Interrupt, SigintEndsALongRunWritingWhatWasRecorded) {
     }
 }
 
+// --vcd alone streams the dump while the run goes (bounded memory); with
+// --report the whole timeline is kept and the dump written at the end. Both
+// give the same bytes (the demo's job: moves, UART traffic, part signals).
+TEST(BoardRun, StreamedVcdIsTheVcdWrittenFromTheWholeTimeline) {
+    const auto dir = test::scratch_dir("vcd-streamed");
+    const std::string base = kCli + " run -q --board arduino-uno-cnc-shield-v3 " + test::firmware("stepdir_test") + " --gcode " +
+                             test::source_path("tests/scenarios/jobs/demo_square.gcode") + " --family generic --vcd ";
+    const auto streamed = test::run_command(base + (dir / "streamed.vcd").string(), dir, 120);
+    const auto whole = test::run_command(base + (dir / "whole.vcd").string() + " --report " + (dir / "r.html").string(), dir, 120);
+    ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+    ASSERT_EQ(whole.exit_code, 0) << whole.err;
+    const std::string a = test::slurp((dir / "streamed.vcd").string()), b = test::slurp((dir / "whole.vcd").string());
+    EXPECT_GT(a.size(), 10000u);
+    EXPECT_TRUE(a == b) << "streamed " << a.size() << " bytes, whole " << b.size() << " bytes";
+}
+
 // A board whose only MCU halted says when it halted, not "0 s".
 TEST(BoardRun, AHaltedBoardReportsTheTimeItHalted) {
     const auto dir = test::scratch_dir("halted-board");

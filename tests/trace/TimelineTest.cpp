@@ -55,3 +55,27 @@ TEST(Timeline, RecordKeepsRecordOrderAndValues) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(TimelineLimit, EventsBeyondTheHeldLimitAreDroppedAndCounted) {
+    Timeline t;
+    const SignalId a = t.add_signal({"m", "PB0", SignalKind::Wire, 1, 16000000});
+    t.set_max_held_events(3);
+    for (Cycle c = 0; c < 5; ++c) t.record(a, c, c % 2);
+    t.record_real(a, 6, 1.0);
+    EXPECT_EQ(t.events().size(), 3u);
+    EXPECT_TRUE(t.overflowed());
+    EXPECT_EQ(t.dropped(), 3u);
+    EXPECT_NE(t.overflow_message().find("more than 3 signal changes"), std::string::npos) << t.overflow_message();
+    EXPECT_NE(t.overflow_message().find("3 were dropped"), std::string::npos) << t.overflow_message();
+    // Taking the events (a streamed VCD) makes room again.
+    EXPECT_EQ(t.take_events().size(), 3u);
+    t.record(a, 7, 1);
+    EXPECT_EQ(t.events().size(), 1u);
+    EXPECT_EQ(t.recorded_count(), 4u);
+}
+
+}  // namespace
+}  // namespace avrbench
