@@ -1,4 +1,5 @@
 #include "core/Mcu.hpp"
+#include "core/SimavrStep.hpp"
 
 #include <cctype>
 #include <cmath>
@@ -156,7 +157,7 @@ Cycle Mcu::cycles_from_seconds(double seconds) const {
 bool Mcu::step() {
     if (halted_) return false;
     const std::uint32_t pc_before = avr_->pc;
-    const int state = avr_run(avr_);
+    const int state = options_.reference_run_loop ? avr_run(avr_) : SimavrStepper(avr_).step();
     ++steps_;
     check_after_step(state, pc_before);
     return !halted_;
@@ -170,18 +171,25 @@ StopReason Mcu::run_until(Cycle target_cycle) {
     // instruction executes inside avr_run) jumps to its next cycle timer, and
     // without this one that could lie far past the target.
     if (avr->cycle < target_cycle) avr_cycle_timer_register(avr, target_cycle - avr->cycle, &horizon_timer, this);
+    const bool reference = options_.reference_run_loop;
+    SimavrStepper stepper(avr);
+    // One unsigned comparison covers PC = 0 (a reset) and PC past the program.
+    const std::uint32_t code_end_minus_one = code_end_bytes_ - 1;
     while (avr->cycle < target_cycle) {
         const std::uint32_t pc_before = avr->pc;
-        const int state = avr_run(avr);
+        const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
         ++steps_;
         const std::uint32_t pc = avr->pc;
         const std::uint16_t sp = static_cast<std::uint16_t>(avr->data[R_SPL] | (avr->data[R_SPH] << 8));
-        if (__builtin_expect((state != cpu_Running && state != cpu_Sleeping) || pc >= code_end_bytes_ ||
-                                 pc == bad_interrupt_pc_ || pc == 0 || sp < stack_floor_,
+        // cpu_Running = 2 and cpu_Sleeping = 3 (sim_avr.h): one comparison for both.
+        static_assert(cpu_Sleeping == cpu_Running + 1);
+        if (__builtin_expect(static_cast<unsigned>(state - cpu_Running) > 1 || pc - 1 >= code_end_minus_one ||
+                                 pc == bad_interrupt_pc_ || sp < stack_floor_,
                              0)) {
             check_after_step(state, pc_before);
         }
-        if (__builtin_expect(stop_requested_ || halted_, 0)) break;
+        // A finding that halts the core also requests the stop (add_finding, check_after_step).
+        if (__builtin_expect(stop_requested_, 0)) break;
     }
     avr_cycle_timer_cancel(avr, &horizon_timer, this);
     if (halted_) return StopReason::Halted;
@@ -207,6 +215,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     }
     if (state == cpu_Done || state == cpu_Stopped) {
         halted_ = true;
+        stop_requested_ = true;
         halt_reason_ = state == cpu_Done ? "SLEEP with interrupts disabled: nothing can wake the core"
                                          : "simavr stopped the core";
         return false;

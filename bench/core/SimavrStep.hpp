@@ -1,0 +1,80 @@
+// One step of the core, as Debian's simavr 1.6 (1.6+dfsg-3) takes it in
+// avr_callback_run_raw (simavr/sim/sim_avr.c), with one change: the cycle
+// timers are processed only when the first is due. This is the one place in
+// the bench that mirrors simavr's run loop; it must follow that function
+// line by line (re-check it when the simavr version changes).
+//
+// Why it is exact: avr_cycle_timer_process (sim_cycle_timers.c), when no
+// timer is due, only returns `when - cycle` of the first timer and sets
+// run_cycle_count = min(run_cycle_limit, that) = 1, because run_cycle_limit
+// is 1 (set at reset; nothing in the bench changes it) and avr_run_one then
+// never batches instructions. With any other limit, or while simavr has
+// swapped its run callback (the watchdog does, from inside a cycle timer, for
+// one step, to reset the core: avr_watchdog.c; gdb does too), the step is
+// simavr's own avr_run. Both are re-checked after every due timer and every
+// avr_run; a stepper is made per run and must not outlive it. Tests: RunLoop.* run every workload both ways and
+// compare cycle, PC, SREG, registers, RAM and the recorded timeline.
+//
+// Why it is faster: avr_run calls the run loop through a function pointer
+// and the timer pool through a call on every instruction; here both are
+// inline or skipped (docs/PERFORMANCE.md).
+#pragma once
+
+extern "C" {
+#include <sim_avr.h>
+#include <sim_core.h>
+#include <sim_cycle_timers.h>
+#include <sim_interrupts.h>
+}
+
+namespace avrbench {
+
+class SimavrStepper {
+public:
+    explicit SimavrStepper(avr_t* avr) : avr_(avr) { recheck(); }
+
+    __attribute__((always_inline)) int step() {
+        avr_t* const avr = avr_;
+        if (__builtin_expect(!raw_, 0)) {
+            const int state = avr_run(avr);
+            recheck();
+            return state;
+        }
+        avr_flashaddr_t new_pc = avr->pc;
+        if (avr->state == cpu_Running) new_pc = avr_run_one(avr);
+
+        // avr_cycle_timer_process, or (nothing due) what it would return.
+        const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
+        const bool due = first == nullptr || first->when <= avr->cycle;
+        avr_cycle_count_t sleep = 0;
+        if (due) {
+            sleep = avr_cycle_timer_process(avr);
+            recheck();  // a timer may have swapped the run callback (the watchdog)
+        }
+
+        avr->pc = new_pc;
+        const int state = avr->state;
+        if (state == cpu_Sleeping) {
+            if (!avr->sreg[S_I]) {
+                if (avr->log) AVR_LOG(avr, LOG_TRACE, "simavr: sleeping with interrupts off, quitting gracefully\n");
+                avr->state = cpu_Done;
+                return cpu_Done;
+            }
+            if (!due) sleep = first->when - avr->cycle;
+            avr->sleep(avr, sleep);
+            avr->cycle += 1 + sleep;
+        }
+        if (state == cpu_Running || state == cpu_Sleeping) {
+            if (avr->interrupt_state) avr_service_interrupts(avr);
+        }
+        return avr->state;
+    }
+
+private:
+    void recheck() { raw_ = avr_->run == &avr_callback_run_raw && avr_->run_cycle_limit == 1; }
+
+    avr_t* avr_;
+    bool raw_ = false;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,97 @@
+// core/SimavrStep against simavr's own avr_run: every firmware the build
+// makes runs 20 ms both ways, with every pin and USART0 traced, and must end
+// in the same state (cycle, PC, registers, I/O and all of RAM, step count)
+// with the same recorded timeline and the same findings. Firmware with a
+// serial protocol also gets a few lines of input, so interrupts from the
+// receiver are in the mix.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include <sim_avr.h>
+}
+
+#include "core/Errors.hpp"
+#include "core/Mcu.hpp"
+#include "support/Paths.hpp"
+#include "trace/Recorder.hpp"
+#include "trace/Timeline.hpp"
+
+namespace avrbench {
+namespace {
+
+struct EndState {
+    Cycle cycle = 0;
+    std::uint32_t pc = 0;
+    std::vector<std::uint8_t> data;  // registers, I/O, RAM
+    std::vector<std::uint8_t> eeprom;
+    std::vector<TimelineEvent> events;
+    std::vector<std::string> findings;
+    std::uint64_t steps = 0;
+};
+
+EndState run(const std::string& name, bool reference) {
+    McuOptions options;
+    options.reference_run_loop = reference;
+    const ElfImage elf = ElfImage::load(test::firmware(name));
+    if (elf.embedded_mcu().empty()) {
+        // Arduino sketches and other ELFs without .mmcu: the board they were built for.
+        options.mcu_type = name.find("mega") != std::string::npos ? "atmega2560" : "atmega328p";
+        options.frequency_hz = 16'000'000;
+    }
+    Mcu mcu(elf, options);
+    Timeline timeline;
+    Recorder recorder(timeline);
+    recorder.trace_pins(mcu, "all");
+    try {
+        recorder.trace_uart_tx(mcu, mcu.uart(0));
+        mcu.uart(0).send("G1 X1\n?\nM105\nhello\n");
+    } catch (const BadInput&) {
+        // an MCU without USART0
+    }
+    mcu.run_until(mcu.frequency_hz() / 50);  // 20 ms
+    EndState s;
+    s.cycle = mcu.cycle();
+    s.pc = mcu.pc_bytes();
+    const avr_t* avr = mcu.avr();
+    s.data.assign(avr->data, avr->data + avr->ramend + 1);
+    s.events = timeline.events();
+    for (const auto& f : mcu.findings()) s.findings.push_back(f.describe());
+    s.steps = mcu.steps();
+    return s;
+}
+
+std::vector<std::string> all_firmware() {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(AVRBENCH_FIRMWARE_DIR)) {
+        if (entry.path().extension() == ".elf") names.push_back(entry.path().stem().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+TEST(RunLoop, SimavrStepEndsWhereAvrRunEndsOnEveryFirmware) {
+    const auto names = all_firmware();
+    ASSERT_GT(names.size(), 100u);  // the build's whole firmware set, not an empty folder
+    for (const auto& name : names) {
+        const EndState a = run(name, true), b = run(name, false);
+        EXPECT_EQ(a.cycle, b.cycle) << name;
+        EXPECT_EQ(a.pc, b.pc) << name;
+        EXPECT_TRUE(a.data == b.data) << name << ": registers, I/O or RAM differ";
+        EXPECT_EQ(a.steps, b.steps) << name;
+        EXPECT_EQ(a.findings, b.findings) << name;
+        ASSERT_EQ(a.events.size(), b.events.size()) << name;
+        for (std::size_t i = 0; i < a.events.size(); ++i) {
+            const bool same = a.events[i].cycle == b.events[i].cycle && a.events[i].signal == b.events[i].signal &&
+                              a.events[i].value.bits == b.events[i].value.bits;
+            ASSERT_TRUE(same) << name << ": event " << i << " differs";
+        }
+    }
+}
+
+}  // namespace
+}  // namespace avrbench
