@@ -127,8 +127,17 @@ Eigen::MatrixXd ThermalNetwork::a_matrix() const {
 }
 
 Eigen::VectorXd ThermalNetwork::b_vector() const {
+    Eigen::VectorXd b;
+    fill_b_vector(b);
+    return b;
+}
+
+// In place: a heater edge changes b, and allocating per edge (125 k edges/s on
+// a bed's PWM) would cost more than the update itself.
+void ThermalNetwork::fill_b_vector(Eigen::VectorXd& b) const {
     const int n = node_count();
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    if (b.size() != n) b.resize(n);
+    b.setZero();
     for (int i = 0; i < n; ++i) {
         const Node& node = nodes_[i];
         if (node.capacity > 0) {
@@ -137,7 +146,6 @@ Eigen::VectorXd ThermalNetwork::b_vector() const {
             b(i) = ambient_ / node.tau;
         }
     }
-    return b;
 }
 
 bool ThermalNetwork::modal() const {
@@ -183,8 +191,11 @@ void ThermalNetwork::rebuild() const {
 }
 
 void ThermalNetwork::rebuild_input() const {
-    b_ = b_vector();
-    if (modal_) w_ = v_inv_ * b_;
+    fill_b_vector(b_);
+    if (modal_) {
+        if (w_.size() != b_.size()) w_.resize(b_.size());
+        w_.noalias() = v_inv_ * b_;
+    }
     loss_offset_ = 0;
     for (const auto& node : nodes_) loss_offset_ += node.ambient_g * ambient_;
     input_dirty_ = false;

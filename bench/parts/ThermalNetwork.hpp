@@ -67,6 +67,7 @@ public:
     // independent solution.
     Eigen::MatrixXd a_matrix() const;
     Eigen::VectorXd b_vector() const;
+    void fill_b_vector(Eigen::VectorXd& b) const;
     // True when advance() uses the eigen-decomposition (else the Van Loan path).
     bool modal() const;
     // How many times the model matrix was decomposed (changes of A).

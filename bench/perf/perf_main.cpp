@@ -1,15 +1,20 @@
 // avrbench_perf: measures what the bench costs on top of simavr.
 //
 // For each workload it runs the same ELF for the same simulated time
-//   (a) through bare simavr: avr_make_mcu_by_name, avr_init,
-//       avr_load_firmware and a plain `while (state ok) avr_run()` loop, as
-//       simavr's own run_avr does, with simavr's sleep callback replaced by a
-//       no-op (the raw one would usleep and measure the wall clock, not simavr);
-//   (b) through avrbench: Mcu + Recorder tracing 8 pins + VCD written at the end;
-// each timed from creating the core to tearing it down (the ELF is parsed once
-// beforehand for both);
-// alternating (a) and (b) several times and keeping each side's best wall
-// time, then prints the ratio (b)/(a) and each side's real-time factor.
+//   (a) through bare simavr configured as a careful user would:
+//       avr_make_mcu_by_name, avr_init, avr_load_firmware, the external
+//       interrupts' strict level polling off (avr_extint_set_strict_lvl_trig,
+//       which otherwise re-raises a held low level on every instruction), a
+//       no-op sleep callback (the raw one usleep()s to keep wall-clock pace),
+//       and a plain `while (state ok) avr_run()` loop, as run_avr does;
+//   (b) through avrbench as `avrbench run --vcd` runs it: Mcu with its
+//       fixes and oracles, every pin and USART0 traced, the VCD streamed to a
+//       file every 10 ms of simulated time;
+// each timed in thread CPU time from creating the core to tearing it down
+// (the ELF is parsed once beforehand for both), alternating (a) and (b)
+// --repeats times; the medians are printed with their ratio (b)/(a).
+// `--workload NAME --side bare|bench` runs one side once, for
+// instruction counts under callgrind (bench/perf/instructions).
 //
 // Then the thermal plant's cost (docs/THERMAL.md): the RAMPS PID firmware
 // (thermal_pid) on a board with the hot end and bed plants, heaters,
@@ -17,6 +22,10 @@
 // MCU whose ADC replays the recorded thermistor voltages (so the firmware runs
 // the very same instructions), same simulated time, best of --repeats each.
 #include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -25,6 +34,7 @@
 #include <string>
 
 extern "C" {
+#include <avr_extint.h>
 #include <sim_avr.h>
 #include <sim_elf.h>
 }
@@ -33,9 +43,11 @@ extern "C" {
 #include "boards/BoardFile.hpp"
 #include "core/Adc.hpp"
 #include "core/ElfImage.hpp"
+#include "core/Lockstep.hpp"
 #include "core/Mcu.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/VcdWriter.hpp"
+#include "verify/TimelineCompare.hpp"
 
 namespace {
 
@@ -47,37 +59,57 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// (a) bare simavr, as run_avr drives it.
-double run_bare_simavr(const avrbench::ElfImage& elf, avr_cycle_count_t cycles) {
-    const auto start = Clock::now();
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// (a) bare simavr, as run_avr drives it, strict level polling off. Returns CPU seconds.
+__attribute__((noinline)) double run_bare_simavr(const avrbench::ElfImage& elf, avr_cycle_count_t cycles) {
+    const double start = thread_cpu_seconds();
     elf_firmware_t firmware = elf.simavr_firmware();
     firmware.tracecount = 0;
     avr_t* avr = avr_make_mcu_by_name(firmware.mmcu);
     avr_init(avr);
     avr_load_firmware(avr, &firmware);
     avr->sleep = &no_wall_clock_sleep;
+    for (std::uint8_t line = 0; line < 8; ++line) avr_extint_set_strict_lvl_trig(avr, line, 0);
     int state = cpu_Running;
     while ((state == cpu_Running || state == cpu_Sleeping) && avr->cycle < cycles) state = avr_run(avr);
     avr_terminate(avr);
     std::free(avr);
-    return seconds_since(start);
+    return thread_cpu_seconds() - start;
 }
 
-// (b) the bench with 8 traced pins and a VCD.
-double run_avrbench(const avrbench::ElfImage& elf, avr_cycle_count_t cycles, const std::string& pins,
-                    const std::string& vcd_path, std::size_t* events) {
-    const auto start = Clock::now();
-    avrbench::Mcu mcu(elf);
-    avrbench::Timeline timeline;
-    avrbench::Recorder recorder(timeline);
-    recorder.trace_pins(mcu, pins);
-    mcu.run_until(cycles);
-    avrbench::VcdOptions options;
-    options.end_cycle = mcu.cycle();
-    options.end_clock_hz = mcu.frequency_hz();
-    avrbench::write_vcd(timeline, vcd_path, options);
-    *events = timeline.events().size();
-    return seconds_since(start);
+// (b) the bench as `avrbench run --vcd` runs it. Returns CPU seconds.
+__attribute__((noinline)) double run_avrbench(const avrbench::ElfImage& elf, avr_cycle_count_t cycles,
+                                              const std::string& vcd_path, std::uint64_t* events) {
+    const double start = thread_cpu_seconds();
+    {
+        avrbench::Mcu mcu(elf);
+        avrbench::Timeline timeline;
+        avrbench::Recorder recorder(timeline);
+        recorder.trace_pins(mcu, "all");
+        recorder.trace_uart_tx(mcu, mcu.uart(0));
+        avrbench::VcdStream vcd(timeline, vcd_path);
+        const avr_cycle_count_t slice = mcu.frequency_hz() / 100;  // 10 ms, as the CLI
+        while (mcu.cycle() < cycles) {
+            if (mcu.run_until(std::min(cycles, mcu.cycle() + slice)) == avrbench::StopReason::Halted) break;
+            vcd.drain(timeline, avrbench::ps_at_cycle(mcu, mcu.cycle()));
+        }
+        avrbench::VcdOptions options;
+        options.end_cycle = mcu.cycle();
+        options.end_clock_hz = mcu.frequency_hz();
+        vcd.finish(timeline, options);
+        *events = timeline.recorded_count();
+    }
+    return thread_cpu_seconds() - start;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 == 1 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 // The thermal plant's overhead: one board run, from building the board to
@@ -92,11 +124,6 @@ struct AdcTape {
     std::size_t next[16] = {};
 };
 
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
 
 double run_board(const std::string& yaml, const std::string& elf_path, double simulated_s, AdcTape* record,
                  AdcTape* replay, std::uint64_t* steps, double* cpu_s) {
@@ -151,12 +178,73 @@ nets:
   bed_heater_gate: [mega.PH5, bed_heater.gate]
 )";
 
+// Every comparison rule on `edges` edges: a golden and an actual timeline,
+// each a wire toggling every 100 cycles (a 80 kHz step train at 16 MHz) and
+// a real signal changing as often; the actual's wire moved by 1 cycle so the
+// tolerant rules have something to tolerate. Prints edges per CPU second.
+void run_compare_rows(std::size_t edges) {
+    using namespace avrbench;
+    auto make = [edges](Cycle shift) {
+        Timeline t;
+        const SignalId wire = t.add_signal({"m", "step", SignalKind::Wire, 1, 16000000});
+        const SignalId real = t.add_signal({"plant", "degC", SignalKind::Real, 1, 16000000});
+        t.reserve_events(2 * edges);
+        for (std::size_t i = 0; i < edges; ++i) {
+            t.record(wire, 100 * i + (i > 0 ? shift : 0), i % 2);
+            t.record_real(real, 100 * i, 25.0 + static_cast<double>(i % 1000) * 0.01);
+        }
+        return t;
+    };
+    const Timeline golden = make(0), actual = make(1);
+    struct Row {
+        const char* name;
+        ChannelRule rule;
+    };
+    const Row rows[] = {
+        {"exact", {"*", RuleKind::Exact}},
+        {"timing (2 cycles)", {"*", RuleKind::Timing, 2}},
+        {"steps (2 cycles)", {"*", RuleKind::Steps, 2}},
+        {"step_rate (1 ms windows)", {"*", RuleKind::StepRate, 0, 0.05, 0.001}},
+        {"pwm_duty (1 ms windows)", {"*", RuleKind::PwmDuty, 0, 0, 0.001, 0.05}},
+        {"band (0.1)", {"*", RuleKind::Band, 0, 0, 0.01, 0.1}},
+    };
+    std::printf("\n%-44s %12s %12s %14s\n", "comparison rule (2 signals x edges each side)", "edges", "CPU s",
+                "edges/s");
+    for (const Row& row : rows) {
+        CompareOptions options;
+        options.rules = {row.rule};
+        const double start = thread_cpu_seconds();
+        const CompareResult result = compare_timelines(golden, actual, options);
+        const double cpu = thread_cpu_seconds() - start;
+        const double total = 2.0 * 2.0 * static_cast<double>(edges);  // both timelines, both signals
+        std::printf("%-44s %12zu %12.3f %13.1fM  (%s)\n", row.name, edges, cpu, total / cpu / 1e6,
+                    result.passed ? "passed" : "differs");
+    }
+}
+
 struct Workload {
     const char* name;
     const char* elf;
-    const char* pins;  // 8 traced pins
     double simulated_s;
 };
+
+// Peak resident memory of `avrbench run <elf> --for <seconds>s --trace PB0
+// --vcd <tmp>` in a child process (getrusage of the child), in MiB.
+double cli_peak_rss_mib(const std::string& elf, double seconds, const std::string& vcd_path) {
+    const std::string for_arg = std::to_string(seconds) + "s";
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int null_fd = open("/dev/null", O_WRONLY);
+        dup2(null_fd, STDOUT_FILENO);
+        execl(AVRBENCH_CLI, AVRBENCH_CLI, "run", "-q", elf.c_str(), "--for", for_arg.c_str(), "--trace", "PB0", "--vcd",
+              vcd_path.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    int status = 0;
+    rusage usage{};
+    if (wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
 
 }  // namespace
 
@@ -168,36 +256,76 @@ int main(int argc, char** argv) {
     int repeats = 3;
     double scale = 1.0;
     std::string firmware_dir = AVRBENCH_FIRMWARE_DIR;
-    app.add_option("--repeats", repeats, "runs per side (best is kept)");
+    app.add_option("--repeats", repeats, "alternating runs per side (the median is kept)");
     app.add_option("--scale", scale, "multiply every workload's simulated time");
     app.add_option("--firmware-dir", firmware_dir, "where the firmware ELFs are");
     bool only_thermal = false;
     app.add_flag("--only-thermal", only_thermal, "only the thermal plant's overhead");
+    std::string only_workload, side = "bench";
+    app.add_option("--workload", only_workload, "run only this workload (its ELF name), one side, once");
+    app.add_option("--side", side, "bare | bench, with --workload")->check(CLI::IsMember({"bare", "bench"}));
+    std::size_t compare_edges = 0;
+    app.add_option("--compare-edges", compare_edges, "only the comparison rules, on this many edges per signal");
+    std::vector<double> rss_seconds;
+    app.add_option("--rss", rss_seconds, "peak RSS of the CLI streaming a 1 M events/s VCD for these simulated seconds");
     CLI11_PARSE(app, argc, argv);
 
     const Workload workloads[] = {
-        {"busy_poll (CPU-bound, PORTD counter)", "busy_poll", "PORTD", 5.0},
-        {"busy_poll_step (step pins PD2/PD3 held low)", "busy_poll_step", "PORTD", 5.0},
-        {"blink_timer1 (timer ISR, idle loop)", "blink_timer1", "PORTB", 5.0},
-        {"sleep_idle (SLEEP between 10 ms wake-ups)", "sleep_idle", "PORTB", 600.0},
+        {"busy_poll (CPU-bound, PORTD counter)", "busy_poll", 5.0},
+        {"busy_poll_step (step pins PD2/PD3 held low)", "busy_poll_step", 5.0},
+        {"blink_timer1 (timer ISR, idle loop)", "blink_timer1", 5.0},
+        {"toggle_1mhz (PB0 edge every us: 1 M events/s)", "toggle_1mhz", 2.0},
+        {"grbl_stepper (grbl-style step ISR, idle)", "grbl_stepper", 5.0},
+        {"ramps_teacup (Teacup-style RAMPS, 2560)", "ramps_teacup", 5.0},
+        {"sleep_idle (SLEEP between 10 ms wake-ups)", "sleep_idle", 600.0},
     };
     const auto vcd_path = (std::filesystem::temp_directory_path() / "avrbench_perf.vcd").string();
-    std::printf("%-44s %9s %12s %12s %9s %9s %7s\n", "workload", "sim s", "bare RTF", "bench RTF", "bare s",
+    if (!only_workload.empty()) {
+        // One side once (for callgrind's instruction counts).
+        for (const auto& w : workloads) {
+            if (only_workload != w.elf) continue;
+            const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
+            const auto cycles = static_cast<avr_cycle_count_t>(w.simulated_s * scale * elf.embedded_frequency_hz());
+            std::uint64_t events = 0;
+            const double cpu = side == "bare" ? run_bare_simavr(elf, cycles) : run_avrbench(elf, cycles, vcd_path, &events);
+            std::printf("%s %s %.3f s CPU\n", w.elf, side.c_str(), cpu);
+            std::filesystem::remove(vcd_path);
+            return 0;
+        }
+        std::fprintf(stderr, "avrbench_perf: no workload '%s'\n", only_workload.c_str());
+        return 2;
+    }
+    if (compare_edges > 0) {
+        run_compare_rows(compare_edges);
+        return 0;
+    }
+    if (!rss_seconds.empty()) {
+        std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace PB0 --vcd", "sim s", "peak RSS MiB");
+        for (const double seconds : rss_seconds) {
+            const double mib = cli_peak_rss_mib(firmware_dir + "/toggle_1mhz.elf", seconds, vcd_path);
+            std::printf("%-44s %9.0f %14.1f\n", "", seconds, mib);
+            std::filesystem::remove(vcd_path);
+            std::filesystem::remove(vcd_path.substr(0, vcd_path.size() - 4) + ".gtkw");
+        }
+        return 0;
+    }
+    std::printf("CPU seconds, median of %d alternating runs per side\n", repeats);
+    std::printf("%-48s %7s %11s %11s %9s %9s %7s\n", "workload", "sim s", "bare RTF", "bench RTF", "bare s",
                 "bench s", "ratio");
     for (const auto& w : workloads) {
         if (only_thermal) break;
         const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
         const double simulated_s = w.simulated_s * scale;
         const auto cycles = static_cast<avr_cycle_count_t>(simulated_s * elf.embedded_frequency_hz());
-        double best_bare = 1e300, best_bench = 1e300;
-        std::size_t events = 0;
+        std::vector<double> bare, bench;
+        std::uint64_t events = 0;
         for (int i = 0; i < repeats; ++i) {
-            best_bare = std::min(best_bare, run_bare_simavr(elf, cycles));
-            best_bench = std::min(best_bench, run_avrbench(elf, cycles, w.pins, vcd_path, &events));
+            bare.push_back(run_bare_simavr(elf, cycles));
+            bench.push_back(run_avrbench(elf, cycles, vcd_path, &events));
         }
-        std::printf("%-44s %9.1f %11.1fx %11.1fx %9.3f %9.3f %7.3f  (%zu trace events)\n", w.name, simulated_s,
-                    simulated_s / best_bare, simulated_s / best_bench, best_bare, best_bench, best_bench / best_bare,
-                    events);
+        const double b = median(bare), a = median(bench);
+        std::printf("%-48s %7.1f %10.1fx %10.1fx %9.3f %9.3f %7.3f  (%llu trace events)\n", w.name, simulated_s,
+                    simulated_s / b, simulated_s / a, b, a, a / b, static_cast<unsigned long long>(events));
     }
     std::filesystem::remove(vcd_path);
 

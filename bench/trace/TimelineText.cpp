@@ -46,26 +46,56 @@ std::string full_name(const SignalInfo& s) { return s.scope + "." + s.name; }
 
 }  // namespace
 
+namespace {
+
+// Sorted by cycle (stable: at one cycle the last recorded value wins, as in
+// the VCD writer), repeats of the previous value dropped.
+std::vector<TimelineEvent> dedupe(std::vector<TimelineEvent> events, const SignalInfo& info) {
+    if (!std::is_sorted(events.begin(), events.end(),
+                        [](const TimelineEvent& a, const TimelineEvent& b) { return a.cycle < b.cycle; })) {
+        std::stable_sort(events.begin(), events.end(),
+                         [](const TimelineEvent& a, const TimelineEvent& b) { return a.cycle < b.cycle; });
+    }
+    // In place: `kept` events are the result so far.
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        const TimelineEvent e = events[i];
+        if (kept > 0 && events[kept - 1].cycle == e.cycle) {
+            events[kept - 1] = e;
+            if (kept >= 2 && same_value(info, events[kept - 2], events[kept - 1])) --kept;
+            continue;
+        }
+        if (kept > 0 && same_value(info, events[kept - 1], e)) continue;
+        events[kept++] = e;
+    }
+    events.resize(kept);
+    return events;
+}
+
+}  // namespace
+
 std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id) {
     std::vector<TimelineEvent> events;
     for (const auto& e : timeline.events()) {
         if (e.signal == id) events.push_back(e);
     }
-    std::stable_sort(events.begin(), events.end(),
-                     [](const TimelineEvent& a, const TimelineEvent& b) { return a.cycle < b.cycle; });
-    const SignalInfo& info = timeline.signals()[id];
-    std::vector<TimelineEvent> out;
-    for (const auto& e : events) {
-        // At one cycle the last value recorded wins (as in the VCD writer).
-        if (!out.empty() && out.back().cycle == e.cycle) {
-            out.back() = e;
-            if (out.size() >= 2 && same_value(info, out[out.size() - 2], out.back())) out.pop_back();
-            continue;
-        }
-        if (!out.empty() && same_value(info, out.back(), e)) continue;
-        out.push_back(e);
+    return dedupe(std::move(events), timeline.signals()[id]);
+}
+
+std::vector<std::vector<TimelineEvent>> changes_by_signal(const Timeline& timeline) {
+    std::vector<std::vector<TimelineEvent>> per_signal(timeline.signals().size());
+    std::vector<std::size_t> counts(per_signal.size(), 0);
+    for (const auto& e : timeline.events()) {
+        if (e.signal < counts.size()) ++counts[e.signal];
     }
-    return out;
+    for (std::size_t id = 0; id < per_signal.size(); ++id) per_signal[id].reserve(counts[id]);
+    for (const auto& e : timeline.events()) {
+        if (e.signal < per_signal.size()) per_signal[e.signal].push_back(e);
+    }
+    for (SignalId id = 0; id < per_signal.size(); ++id) {
+        per_signal[id] = dedupe(std::move(per_signal[id]), timeline.signals()[id]);
+    }
+    return per_signal;
 }
 
 std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header) {
@@ -78,10 +108,11 @@ std::string format_timeline_text(const Timeline& timeline, const TimelineHeader&
         out += "signal " + full_name(s) + " " + kind_name(s.kind) + " " +
                std::to_string(s.kind == SignalKind::Real ? 64u : s.width) + " " + std::to_string(s.clock_hz) + "\n";
     }
+    const auto all_changes = changes_by_signal(timeline);
     for (SignalId id = 0; id < signals.size(); ++id) {
         const SignalInfo& info = signals[id];
         out += "\n@" + full_name(info) + "\n";
-        const auto changes = changes_of(timeline, id);
+        const auto& changes = all_changes[id];
         if (changes.empty()) continue;
         out += std::to_string(changes[0].cycle) + " " + format_value(info, changes[0]) + "\n";
         std::vector<Pair> pairs;

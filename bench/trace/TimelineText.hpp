@@ -62,5 +62,7 @@ ParsedTimeline read_timeline_text(const std::string& path);
 
 // Events of one signal with unchanged values removed, in time order.
 std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id);
+// The same for every signal, indexed by SignalId, from one pass over the events.
+std::vector<std::vector<TimelineEvent>> changes_by_signal(const Timeline& timeline);
 
 }  // namespace avrbench

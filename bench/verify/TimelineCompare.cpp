@@ -84,35 +84,53 @@ std::vector<TimelineEvent> rising(const std::vector<TimelineEvent>& changes) {
     return out;
 }
 
-// Value of a piecewise-constant signal at `cycle`.
-double value_at(const std::vector<TimelineEvent>& changes, const SignalInfo& info, Cycle cycle) {
-    double v = 0;
-    for (const auto& e : changes) {
-        if (e.cycle > cycle) break;
-        v = info.kind == SignalKind::Real ? e.value.real : static_cast<double>(e.value.bits);
-    }
-    return v;
-}
+// Walks a piecewise-constant signal forward in time: each event is visited
+// a bounded number of times however many queries, so a comparison costs
+// O(events + windows), not their product.
+class Cursor {
+public:
+    Cursor(const std::vector<TimelineEvent>& changes, const SignalInfo& info) : c_(changes), info_(info) {}
 
-// Fraction of [begin, end) during which a wire is high.
-double duty(const std::vector<TimelineEvent>& changes, Cycle begin, Cycle end) {
-    if (end <= begin) return 0;
-    Cycle high = 0;
-    bool level = false;
-    Cycle t = begin;
-    for (const auto& e : changes) {
-        if (e.cycle <= begin) {
-            level = e.value.bits != 0;
-            continue;
+    // The value at `cycle` (0 before the first change); `cycle` must not decrease between calls.
+    double value_at(Cycle cycle) {
+        while (i_ < c_.size() && c_[i_].cycle <= cycle) {
+            value_ = info_.kind == SignalKind::Real ? c_[i_].value.real : static_cast<double>(c_[i_].value.bits);
+            level_ = c_[i_].value.bits != 0;
+            ++i_;
         }
-        if (e.cycle >= end) break;
-        if (level) high += e.cycle - t;
-        t = e.cycle;
-        level = e.value.bits != 0;
+        return value_;
     }
-    if (level) high += end - t;
-    return static_cast<double>(high) / static_cast<double>(end - begin);
-}
+
+    // Fraction of [begin, end) during which a wire is high; windows in order.
+    double duty(Cycle begin, Cycle end) {
+        if (end <= begin) return 0;
+        value_at(begin);
+        Cycle high = 0, t = begin;
+        bool level = level_;
+        for (std::size_t j = i_; j < c_.size() && c_[j].cycle < end; ++j) {
+            if (level) high += c_[j].cycle - t;
+            t = c_[j].cycle;
+            level = c_[j].value.bits != 0;
+        }
+        if (level) high += end - t;
+        return static_cast<double>(high) / static_cast<double>(end - begin);
+    }
+
+    // Events in [begin, end); windows in order.
+    std::size_t count(Cycle begin, Cycle end) {
+        while (k_ < c_.size() && c_[k_].cycle < begin) ++k_;
+        std::size_t j = k_;
+        while (j < c_.size() && c_[j].cycle < end) ++j;
+        return j - k_;
+    }
+
+private:
+    const std::vector<TimelineEvent>& c_;
+    const SignalInfo& info_;
+    std::size_t i_ = 0, k_ = 0;
+    double value_ = 0;
+    bool level_ = false;
+};
 
 void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule,
                      const std::vector<TimelineEvent>& g, const std::vector<TimelineEvent>& a,
@@ -192,26 +210,27 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
             const Cycle a_end = options.actual_end_cycle ? options.actual_end_cycle : (a.empty() ? 0 : a.back().cycle);
             const Cycle end = std::min(g_end, a_end);
             if (rule.kind == RuleKind::Band) {
-                std::vector<Cycle> times;
-                for (const auto& e : g) times.push_back(e.cycle);
-                for (const auto& e : a) times.push_back(e.cycle);
-                std::sort(times.begin(), times.end());
+                // Both signals at every time either changes, in time order (a merge of two sorted lists).
+                Cursor cg(g, info), ca(a, info);
                 double worst = 0;
-                for (Cycle t : times) {
-                    const double d = std::fabs(value_at(a, info, t) - value_at(g, info, t));
+                std::size_t ig = 0, ia = 0;
+                while (ig < g.size() || ia < a.size()) {
+                    const bool take_g = ia >= a.size() || (ig < g.size() && g[ig].cycle <= a[ia].cycle);
+                    const Cycle t = take_g ? g[ig++].cycle : a[ia++].cycle;
+                    const double vg = cg.value_at(t), va = ca.value_at(t);
+                    const double d = std::fabs(va - vg);
                     worst = std::max(worst, d);
                     if (d > rule.band) {
                         std::snprintf(buf, sizeof buf, "at %.9f s actual %.6g vs golden %.6g (band %.6g)",
-                                      static_cast<double>(t) / info.clock_hz, value_at(a, info, t),
-                                      value_at(g, info, t), rule.band);
+                                      static_cast<double>(t) / info.clock_hz, va, vg, rule.band);
                         r.passed = false;
                         r.verdict = "differs";
                         r.diverges = true;
                         r.divergence_cycle = t;
                         r.detail = buf;
-                        std::snprintf(buf, sizeof buf, "%.6g", value_at(g, info, t));
+                        std::snprintf(buf, sizeof buf, "%.6g", vg);
                         r.expected = buf;
-                        std::snprintf(buf, sizeof buf, "%.6g", value_at(a, info, t));
+                        std::snprintf(buf, sizeof buf, "%.6g", va);
                         r.actual = buf;
                         return;
                     }
@@ -222,10 +241,11 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
             }
             const Cycle window = std::max<Cycle>(1, static_cast<Cycle>(std::llround(rule.window_s * info.clock_hz)));
             const auto gs = rising(g), as = rising(a);
+            Cursor duty_g(g, info), duty_a(a, info), steps_g(gs, info), steps_a(as, info);
             for (Cycle begin = 0; begin < end; begin += window) {
                 const Cycle stop = std::min(end, begin + window);
                 if (rule.kind == RuleKind::PwmDuty) {
-                    const double dg = duty(g, begin, stop), da = duty(a, begin, stop);
+                    const double dg = duty_g.duty(begin, stop), da = duty_a.duty(begin, stop);
                     if (std::fabs(dg - da) > rule.band) {
                         std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.6f s (band %.4f)", da,
                                       dg, static_cast<double>(begin) / info.clock_hz, rule.band);
@@ -239,12 +259,8 @@ void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule
                         return;
                     }
                 } else {
-                    auto count = [&](const std::vector<TimelineEvent>& edges) {
-                        return static_cast<double>(std::count_if(edges.begin(), edges.end(), [&](const TimelineEvent& e) {
-                            return e.cycle >= begin && e.cycle < stop;
-                        }));
-                    };
-                    const double cg = count(gs), ca = count(as);
+                    const auto cg = static_cast<double>(steps_g.count(begin, stop));
+                    const auto ca = static_cast<double>(steps_a.count(begin, stop));
                     if (std::fabs(ca - cg) > rule.tolerance_rel * cg + 1) {
                         std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.6f s", ca, cg,
                                       static_cast<double>(begin) / info.clock_hz);
@@ -316,6 +332,9 @@ const ChannelResult* CompareResult::first_divergence() const {
 
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options) {
     CompareResult result;
+    // Each timeline's events grouped by signal in one pass.
+    const auto golden_changes = changes_by_signal(golden);
+    const auto actual_changes = changes_by_signal(actual);
     std::map<std::string, SignalId> actual_ids;
     for (SignalId id = 0; id < actual.signals().size(); ++id) actual_ids[full_name(actual.signals()[id])] = id;
     std::map<std::string, bool> seen;
@@ -334,7 +353,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
             }
         }
         r.rule = rule.kind;
-        const auto g = changes_of(golden, gid);
+        const auto& g = golden_changes[gid];
         r.golden_changes = g.size();
         auto it = actual_ids.find(r.signal);
         if (it == actual_ids.end()) {
@@ -350,7 +369,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
             result.channels.push_back(r);
             continue;
         }
-        const auto a = changes_of(actual, it->second);
+        const auto& a = actual_changes[it->second];
         r.actual_changes = a.size();
         compare_channel(r, info, rule, g, a, options);
         result.channels.push_back(r);
@@ -371,7 +390,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
         r.passed = false;
         r.verdict = "extra";
         r.detail = "recorded now but not in the golden timeline";
-        const auto a = changes_of(actual, id);
+        const auto& a = actual_changes[id];
         r.actual_changes = a.size();
         r.clock_hz = actual.signals()[id].clock_hz;
         if (!a.empty()) {
