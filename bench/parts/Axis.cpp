@@ -12,10 +12,11 @@ std::vector<ParamSpec> Axis::param_specs() {
     return {
         {"driver", PT::Text, Dimension::Dimensionless, true, "", {}, "", "the step_dir_driver part that moves it"},
         {"kind", PT::Choice, Dimension::Dimensionless, false, "linear", {"linear", "rotary"}, "", ""},
+        // 1e-3..1e6: a 1 mm lead screw at 1/256 of 200 steps is 51 200 steps/mm.
         {"steps_per_mm", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
-         "STEP pulses per mm at the driver's configured microsteps (linear)"},
+         "STEP pulses per mm at the driver's configured microsteps (linear)", 1e-3, 1e6},
         {"steps_per_rev", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
-         "STEP pulses per revolution at the driver's configured microsteps (rotary)"},
+         "STEP pulses per revolution at the driver's configured microsteps (rotary)", 1, 1e7},
         {"travel", PT::Quantity, Dimension::Length, false, "", {}, "", "length of travel (linear), from 0"},
         {"start_position", PT::Quantity, Dimension::Length, false, "0mm", {}, "assumed: the carriage starts at 0",
          "carriage position at power-on"},

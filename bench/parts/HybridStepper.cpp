@@ -93,16 +93,16 @@ std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
         for (const char* c : {"a", "b", "c", "d"}) {
             specs.push_back({std::string("coil_") + c, PT::Integer, D::Dimensionless, false,
                              std::to_string(1 + (c[0] - 'a')), {}, "",
-                             std::string("switch channel of half-winding ") + static_cast<char>(c[0] - 32)});
+                             std::string("switch channel of half-winding ") + static_cast<char>(c[0] - 32), 1, 8});
         }
         specs.push_back({"supply", PT::Quantity, D::Voltage, false, "12V", {}, "assumed (seed 001 gives none)",
                          "supply at the centre taps"});
         specs.push_back({"sense_resistor", PT::Quantity, D::Resistance, false, "0ohm", {},
                          "seed 001 §3.2: value absent", "R_sense per coil pair (A/C, B/D), 0 = none"});
         specs.push_back({"sense_ac_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC0",
-                         "ADC channel of the clock MCU that sees the A/C sense voltage (-1: none)"});
+                         "ADC channel of the clock MCU that sees the A/C sense voltage (-1: none)", -1, 15});
         specs.push_back({"sense_bd_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC1",
-                         "ADC channel that sees the B/D sense voltage (-1: none)"});
+                         "ADC channel that sees the B/D sense voltage (-1: none)", -1, 15});
     } else {
         specs.push_back({"bridge", PT::Text, D::Dimensionless, false, "", {}, "", "the l293d part driving the windings"});
         specs.push_back({"phase_a", PT::Text, D::Dimensionless, false, "1,2", {}, "",

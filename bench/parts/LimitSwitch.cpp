@@ -32,8 +32,8 @@ std::vector<ParamSpec> LimitSwitch::param_specs() {
         {"bounce", PT::Quantity, Dimension::Time, false, "0s", {}, "assumed: no bounce unless asked",
          "duration of contact bounce after each transition"},
         {"bounce_edges", PT::Integer, Dimension::Dimensionless, false, "4", {}, "assumed",
-         "extra make/break pairs during a bounce, at most"},
-        {"seed", PT::Integer, Dimension::Dimensionless, false, "1", {}, "", "seed for the bounce timing"},
+         "extra make/break pairs during a bounce, at most", 0, 1000},
+        {"seed", PT::Integer, Dimension::Dimensionless, false, "1", {}, "", "seed for the bounce timing", 0, 9007199254740992.0},
     };
 }
 

@@ -8,7 +8,7 @@ std::vector<ParamSpec> LowSideSwitch::param_specs() {
     using PT = ParamType;
     return {
         {"channels", PT::Integer, Dimension::Dimensionless, false, "4", {},
-         "seed 001 §3.2: four half-windings A, B, C, D", "number of switches (1..8), inputs in1..inN"},
+         "seed 001 §3.2: four half-windings A, B, C, D", "number of switches (1..8), inputs in1..inN", 1, 8},
         {"active", PT::Choice, Dimension::Dimensionless, false, "high", {"high", "low"},
          "seed 001 Fig. 3.1: NPN with a base resistor (input high = on)", "input level that turns a switch on"},
         {"v_sat", PT::Quantity, Dimension::Voltage, false, "0.3V", {},

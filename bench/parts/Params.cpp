@@ -1,22 +1,68 @@
 #include "parts/Params.hpp"
 
+#include "core/Time.hpp"
 #include "core/Units.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
 namespace {
 
+// " s", " m", ... after a range in SI units; "" for bare numbers.
+std::string si_unit_suffix(Dimension d) {
+    switch (d) {
+        case Dimension::Dimensionless: return "";
+        case Dimension::Time: return " s";
+        case Dimension::Length: return " m";
+        case Dimension::Frequency: return " Hz";
+        case Dimension::Angle: return " rad";
+        case Dimension::Voltage: return " V";
+        case Dimension::Current: return " A";
+        case Dimension::Resistance: return " ohm";
+        case Dimension::Power: return " W";
+        case Dimension::Temperature: return " degC";
+        case Dimension::ThermalResistance: return " K/W";
+        case Dimension::HeatCapacity: return " J/K";
+        case Dimension::ThermalConductance: return " W/K";
+        case Dimension::Torque: return " N*m";
+        case Dimension::Inductance: return " H";
+        case Dimension::Inertia: return " kg*m^2";
+        case Dimension::Speed: return " m/s";
+        case Dimension::Acceleration: return " m/s^2";
+        case Dimension::TorqueConstant: return " N*m/A";
+        case Dimension::RotaryDamping: return " N*m*s/rad";
+    }
+    return "";
+}
+
+std::string number_text(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+void check_range(const ParamSpec& spec, double v, const std::string& value, const std::string& what) {
+    const ParamRange r = range_of(spec);
+    if (v >= r.min && v <= r.max) return;
+    throw BadInput(what + ": '" + value + "' is outside " + number_text(r.min) + " .. " + number_text(r.max) +
+                   si_unit_suffix(spec.dimension));
+}
+
 void parse_into(const ParamSpec& spec, const std::string& value, const std::string& what, ParamValues& out) {
     switch (spec.type) {
-        case ParamType::Quantity:
-            out.set_quantity(spec.name, parse_quantity(value, spec.dimension, what));
+        case ParamType::Quantity: {
+            const double v = parse_quantity(value, spec.dimension, what);
+            check_range(spec, v, value, what);
+            out.set_quantity(spec.name, v);
             return;
+        }
         case ParamType::Integer: {
             const double v = parse_quantity(value, Dimension::Dimensionless, what);
             if (std::floor(v) != v) throw BadInput(what + ": '" + value + "' is not a whole number");
+            check_range(spec, v, value, what);
             out.set_quantity(spec.name, v);
             return;
         }
@@ -38,6 +84,37 @@ void parse_into(const ParamSpec& spec, const std::string& value, const std::stri
 }
 
 }  // namespace
+
+ParamRange dimension_range(Dimension dimension) {
+    switch (dimension) {
+        case Dimension::Dimensionless: return {-1e15, 1e15};  // counts and ratios; parts narrow them
+        case Dimension::Time: return {0, kMaxRunSeconds};     // no run is longer (core/Time.hpp)
+        case Dimension::Length: return {0, 1000};             // m: carriages, travels, filament
+        case Dimension::Frequency: return {0, 1e9};           // Hz: no AVR signal is faster
+        case Dimension::Angle: return {-1000, 1000};          // rad
+        case Dimension::Voltage: return {0, 1000};            // V: supplies and references
+        case Dimension::Current: return {0, 1000};            // A
+        case Dimension::Resistance: return {0, 1e12};         // ohm: 0 = a short or tie
+        case Dimension::Power: return {0, 1e6};               // W
+        case Dimension::Temperature: return {-273.15, 5000};  // degC: above absolute zero
+        case Dimension::ThermalResistance: return {0, 1e6};   // K/W
+        case Dimension::HeatCapacity: return {0, 1e7};        // J/K
+        case Dimension::ThermalConductance: return {0, 1e6};  // W/K
+        case Dimension::Torque: return {0, 1e4};              // N*m
+        case Dimension::Inductance: return {0, 100};          // H
+        case Dimension::Inertia: return {0, 1e3};             // kg*m^2
+        case Dimension::Speed: return {0, 1e3};               // m/s
+        case Dimension::Acceleration: return {0, 1e6};        // m/s^2
+        case Dimension::TorqueConstant: return {0, 1e3};      // N*m/A
+        case Dimension::RotaryDamping: return {0, 1e3};       // N*m*s/rad
+    }
+    return {-1e15, 1e15};
+}
+
+ParamRange range_of(const ParamSpec& spec) {
+    const ParamRange d = dimension_range(spec.dimension);
+    return {std::isnan(spec.min) ? d.min : spec.min, std::isnan(spec.max) ? d.max : spec.max};
+}
 
 double ParamValues::quantity(const std::string& name) const {
     auto it = quantities_.find(name);

@@ -3,6 +3,7 @@
 // them into SI numbers, naming file:line for anything wrong.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -27,7 +28,22 @@ struct ParamSpec {
     std::vector<std::string> choices;  // for Choice
     std::string source;                // where the default comes from (datasheet §, seed, "assumed")
     std::string help;
+    // Valid values, inclusive, in SI units (Quantity, Integer). NaN: the
+    // dimension's range (dimension_range). Checked with file:line for every
+    // value, given, preset or default.
+    double min = std::numeric_limits<double>::quiet_NaN();
+    double max = std::numeric_limits<double>::quiet_NaN();
 };
+
+// What any parameter of a dimension may be, before a part narrows it: the
+// physically meaningful range for anything on a bench (no negative
+// resistances, times or masses; temperatures above absolute zero; nothing so
+// large that the models overflow). Documented in docs/BOARDS.md.
+struct ParamRange {
+    double min, max;
+};
+ParamRange dimension_range(Dimension dimension);
+ParamRange range_of(const ParamSpec& spec);
 
 // A parameter as written in a board file.
 struct RawParam {

@@ -12,9 +12,9 @@ std::vector<ParamSpec> SerialPeer::param_specs() {
     using D = Dimension;
     return {
         {"baud", PT::Quantity, D::Dimensionless, false, "9600", {}, "SoftwareSerial examples: 9600 baud",
-         "bits per second"},
+         "bits per second", 50, 2e6},
         {"tolerance", PT::Quantity, D::Dimensionless, false, "0.05", {},
-         "ATmega328P §20.8 Table 20-2: 8N1 receiver error budget about +-4.5 %", "edge error allowed, in bits"},
+         "ATmega328P §20.8 Table 20-2: 8N1 receiver error budget about +-4.5 %", "edge error allowed, in bits", 1e-6, 0.499},
         {"send", PT::Text, D::Dimensionless, false, "", {}, "", "bytes to send once the board starts"},
         {"send_at", PT::Quantity, D::Time, false, "10ms", {}, "assumed: after the sketch's setup()",
          "when to start sending `send`"},

@@ -64,7 +64,7 @@ std::vector<ParamSpec> Thermistor::param_specs() {
         {"t3", PT::Quantity, D::Temperature, false, "", {}, "preset", "third datasheet point"},
         {"r3", PT::Quantity, D::Resistance, false, "", {}, "preset", ""},
         {"beta", PT::Quantity, D::Dimensionless, false, "", {}, "preset",
-         "beta in K, with t1/r1 as the reference point (instead of t2..r3)"},
+         "beta in K, with t1/r1 as the reference point (instead of t2..r3)", 100, 1e5},
         {"leg", PT::Choice, D::Dimensionless, false, "lower", {"lower", "upper"},
          "RAMPS 1.4 schematic and seed 001: NTC from the pin to GND", "where the NTC sits in the divider"},
         {"pullup", PT::Quantity, D::Resistance, false, "4.7kohm", {},
@@ -73,7 +73,7 @@ std::vector<ParamSpec> Thermistor::param_specs() {
          "Arduino Mega / UNO: the divider hangs from the 5 V rail = AVCC", "voltage at the top of the divider"},
         {"noise", PT::Quantity, D::Voltage, false, "0V", {}, "assumed: none unless asked",
          "RMS Gaussian noise added to each sample"},
-        {"seed", PT::Integer, D::Dimensionless, false, "1", {}, "", "seed of the noise generator"},
+        {"seed", PT::Integer, D::Dimensionless, false, "1", {}, "", "seed of the noise generator", 0, 9007199254740992.0},
         {"sample_interval", PT::Quantity, D::Time, false, "100ms", {}, "assumed",
          "at most one trace value per interval"},
     };
