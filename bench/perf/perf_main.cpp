@@ -4,7 +4,8 @@
 //   (a) through bare simavr configured as a careful user would:
 //       avr_make_mcu_by_name, avr_init, avr_load_firmware, the external
 //       interrupts' strict level polling off (avr_extint_set_strict_lvl_trig,
-//       which otherwise re-raises a held low level on every instruction), a
+//       which otherwise re-raises a held low level on every instruction), the
+//       USARTs' poll-sleep and stdio echo flags cleared (AVR_IOCTL_UART_SET_FLAGS), a
 //       no-op sleep callback (the raw one usleep()s to keep wall-clock pace),
 //       and a plain `while (state ok) avr_run()` loop, as run_avr does;
 //   (b) through avrbench as `avrbench run --vcd` runs it: Mcu with its
@@ -35,6 +36,7 @@
 
 extern "C" {
 #include <avr_extint.h>
+#include <avr_uart.h>
 #include <sim_avr.h>
 #include <sim_elf.h>
 }
@@ -66,15 +68,26 @@ double thread_cpu_seconds() {
 }
 
 // (a) bare simavr, as run_avr drives it, strict level polling off. Returns CPU seconds.
-__attribute__((noinline)) double run_bare_simavr(const avrbench::ElfImage& elf, avr_cycle_count_t cycles) {
+__attribute__((noinline)) double run_bare_simavr(const avrbench::ElfImage& elf, avr_cycle_count_t cycles,
+                                                 const avrbench::McuOptions& given = {}) {
     const double start = thread_cpu_seconds();
     elf_firmware_t firmware = elf.simavr_firmware();
     firmware.tracecount = 0;
+    if (!given.mcu_type.empty()) std::snprintf(firmware.mmcu, sizeof firmware.mmcu, "%s", given.mcu_type.c_str());
+    if (given.frequency_hz != 0) firmware.frequency = given.frequency_hz;
     avr_t* avr = avr_make_mcu_by_name(firmware.mmcu);
     avr_init(avr);
     avr_load_firmware(avr, &firmware);
     avr->sleep = &no_wall_clock_sleep;
     for (std::uint8_t line = 0; line < 8; ++line) avr_extint_set_strict_lvl_trig(avr, line, 0);
+    // Nor should every UCSRnA read usleep(1) (AVR_UART_FLAG_POLL_SLEEP, on by
+    // default) or received bytes be echoed to stdout.
+    for (char uart = '0'; uart <= '3'; ++uart) {
+        std::uint32_t flags = 0;
+        if (avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS(uart), &flags) < 0) continue;
+        flags &= ~static_cast<std::uint32_t>(AVR_UART_FLAG_POLL_SLEEP | AVR_UART_FLAG_STDIO);
+        avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS(uart), &flags);
+    }
     int state = cpu_Running;
     while ((state == cpu_Running || state == cpu_Sleeping) && avr->cycle < cycles) state = avr_run(avr);
     avr_terminate(avr);
@@ -84,10 +97,11 @@ __attribute__((noinline)) double run_bare_simavr(const avrbench::ElfImage& elf, 
 
 // (b) the bench as `avrbench run --vcd` runs it. Returns CPU seconds.
 __attribute__((noinline)) double run_avrbench(const avrbench::ElfImage& elf, avr_cycle_count_t cycles,
-                                              const std::string& vcd_path, std::uint64_t* events) {
+                                              const std::string& vcd_path, std::uint64_t* events,
+                                              const avrbench::McuOptions& given = {}) {
     const double start = thread_cpu_seconds();
     {
-        avrbench::Mcu mcu(elf);
+        avrbench::Mcu mcu(elf, given);
         avrbench::Timeline timeline;
         avrbench::Recorder recorder(timeline);
         recorder.trace_pins(mcu, "all");
@@ -264,6 +278,11 @@ int main(int argc, char** argv) {
     std::string only_workload, side = "bench";
     app.add_option("--workload", only_workload, "run only this workload (its ELF name), one side, once");
     app.add_option("--side", side, "bare | bench, with --workload")->check(CLI::IsMember({"bare", "bench"}));
+    std::string external_elf, external_mcu = "atmega328p";
+    double external_seconds = 5.0;
+    app.add_option("--elf", external_elf, "only this ELF (built outside the repo), idle, both sides");
+    app.add_option("--mcu", external_mcu, "its MCU (default atmega328p; 16 MHz)");
+    app.add_option("--seconds", external_seconds, "its simulated time (default 5)");
     std::size_t compare_edges = 0;
     app.add_option("--compare-edges", compare_edges, "only the comparison rules, on this many edges per signal");
     std::vector<double> rss_seconds;
@@ -294,6 +313,28 @@ int main(int argc, char** argv) {
         }
         std::fprintf(stderr, "avrbench_perf: no workload '%s'\n", only_workload.c_str());
         return 2;
+    }
+    if (!external_elf.empty()) {
+        // A firmware built outside this repository (grbl, Teacup, Marlin...),
+        // idle on both sides: no host, no board, same simulated time.
+        avrbench::McuOptions options;
+        options.mcu_type = external_mcu;
+        options.frequency_hz = 16'000'000;
+        const auto elf = avrbench::ElfImage::load(external_elf);
+        const auto cycles = static_cast<avr_cycle_count_t>(external_seconds * options.frequency_hz);
+        std::vector<double> bare, bench;
+        std::uint64_t events = 0;
+        for (int i = 0; i < repeats; ++i) {
+            bare.push_back(run_bare_simavr(elf, cycles, options));
+            bench.push_back(run_avrbench(elf, cycles, vcd_path, &events, options));
+        }
+        const double b = median(bare), a = median(bench);
+        std::printf("%s (%s, 16 MHz), %.1f s simulated: bare %.1fx real time (%.3f s CPU), bench %.1fx (%.3f s), "
+                    "ratio %.3f, %llu trace events\n",
+                    external_elf.c_str(), external_mcu.c_str(), external_seconds, external_seconds / b, b,
+                    external_seconds / a, a, a / b, static_cast<unsigned long long>(events));
+        std::filesystem::remove(vcd_path);
+        return 0;
     }
     if (compare_edges > 0) {
         run_compare_rows(compare_edges);
