@@ -21,6 +21,9 @@ std::pair<int, int> output_pair(const std::string& text, const std::string& part
     if (!(in >> a >> comma >> b) || comma != ',' || !(in >> std::ws).eof()) {
         throw BadInput("part '" + part + "': " + param + " '" + text + "' is not two outputs 'plus,minus' (e.g. 1,2)");
     }
+    for (int o : {a, b}) {
+        if (o < 1 || o > 4) throw BadInput("part '" + part + "': L293D outputs are 1..4");
+    }
     return {a, b};
 }
 
@@ -51,10 +54,13 @@ PartType hybrid_stepper() {
         if (bridge) {
             const auto a = output_pair(params.text("phase_a"), name, "phase_a");
             const auto b = output_pair(params.text("phase_b"), name, "phase_b");
-            motor->attach_bridge(static_cast<L293D&>(lookup(params.text("bridge"))), a.first, a.second, b.first,
-                                 b.second);
+            auto& l293d = static_cast<L293D&>(lookup(params.text("bridge")));
+            motor->attach(l293d, {[&l293d, a] { return l293d.winding(a.first, a.second); },
+                                  [&l293d, b] { return l293d.winding(b.first, b.second); }});
         } else {
-            motor->attach_driver(static_cast<StepDirDriver&>(lookup(params.text("driver"))));
+            auto& step_dir = static_cast<StepDirDriver&>(lookup(params.text("driver")));
+            motor->attach(step_dir,
+                          {[&step_dir] { return step_dir.winding(0); }, [&step_dir] { return step_dir.winding(1); }});
         }
         return motor;
     };
@@ -72,7 +78,17 @@ PartType unipolar_stepper() {
         const std::array<int, 4> channels = {
             static_cast<int>(params.integer("coil_a")), static_cast<int>(params.integer("coil_b")),
             static_cast<int>(params.integer("coil_c")), static_cast<int>(params.integer("coil_d"))};
-        motor->attach_switches(static_cast<LowSideSwitch&>(lookup(params.text("switches"))), channels);
+        auto& switches = static_cast<LowSideSwitch&>(lookup(params.text("switches")));
+        std::vector<std::function<WindingDrive()>> windings;
+        for (const int ch : channels) {
+            if (ch < 1 || ch > switches.channels()) {
+                throw BadInput("part '" + name + "': coil channel " + std::to_string(ch) + " is not a channel of '" +
+                               switches.name() + "' (1.." + std::to_string(switches.channels()) + ")");
+            }
+            HybridStepper* m = motor.get();
+            windings.push_back([&switches, ch, m] { return switches.winding(ch, m->supply_v(), m->sense_ohm()); });
+        }
+        motor->attach(switches, std::move(windings));
         return motor;
     };
     return t;

@@ -5,9 +5,6 @@
 
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
-#include "parts/L293D.hpp"
-#include "parts/LowSideSwitch.hpp"
-#include "parts/StepDirDriver.hpp"
 
 namespace avrbench {
 namespace {
@@ -19,9 +16,6 @@ constexpr double kTwoPi = 2 * kPi;
 // the next equilibrium; the extra quarter turn keeps a rotor rocking on the
 // unstable point from counting slips back and forth.
 constexpr double kSlipThreshold = 1.25 * kPi;
-// Forward voltage of a step/dir driver's MOSFET body diodes while its
-// outputs are disabled (assumed: the drivers' datasheets give ~0.7-1 V).
-constexpr double kDriverBodyDiodeV = 0.7;
 
 HybridStepperModel::Params model_params(const ParamValues& p, const std::string& name) {
     HybridStepperModel::Params m;
@@ -196,27 +190,16 @@ void HybridStepper::listen(DriveSource& source) {
     source.on_drive_change([this] { on_drive_change(); });
 }
 
-void HybridStepper::attach_bridge(L293D& bridge, int a_plus, int a_minus, int b_plus, int b_minus) {
-    for (int o : {a_plus, a_minus, b_plus, b_minus}) {
-        if (o < 1 || o > 4) throw BadInput("part '" + name() + "': L293D outputs are 1..4");
+void HybridStepper::attach(DriveSource& source, std::vector<std::function<WindingDrive()>> windings) {
+    if (windings.size() != model_.winding_count()) {
+        throw BadInput("part '" + name() + "': " + std::to_string(windings.size()) + " winding drives for " +
+                       std::to_string(model_.winding_count()) + " windings");
     }
-    sources_ = {[&bridge, a_plus, a_minus] { return bridge.winding(a_plus, a_minus); },
-                [&bridge, b_plus, b_minus] { return bridge.winding(b_plus, b_minus); }};
-    listen(bridge);
-}
-
-void HybridStepper::attach_switches(LowSideSwitch& switches, const std::array<int, 4>& channels) {
-    sources_.clear();
-    for (int k = 0; k < 4; ++k) {
-        const int ch = channels[static_cast<std::size_t>(k)];
-        if (ch < 1 || ch > switches.channels()) {
-            throw BadInput("part '" + name() + "': coil channel " + std::to_string(ch) + " is not a channel of '" +
-                           switches.name() + "' (1.." + std::to_string(switches.channels()) + ")");
-        }
-        sources_.push_back([&switches, ch, this] { return switches.winding(ch, supply_v_, sense_ohm_); });
-    }
-    listen(switches);
-    for (int pair = 0; pair < 2; ++pair) {
+    source_ = &source;
+    angle_from_source_ = source.commands_angle();
+    sources_ = std::move(windings);
+    listen(source);
+    for (int pair = 0; unipolar_ && pair < 2; ++pair) {
         const int channel = sense_adc_[pair];
         if (channel < 0) continue;
         Adc& adc = clock().adc();
@@ -229,11 +212,6 @@ void HybridStepper::attach_switches(LowSideSwitch& switches, const std::array<in
             return sense_voltage(pair);
         });
     }
-}
-
-void HybridStepper::attach_driver(StepDirDriver& driver) {
-    driver_ = &driver;
-    driver.on_outputs_change([this] { on_drive_change(); });
 }
 
 void HybridStepper::start() {
@@ -270,36 +248,14 @@ double HybridStepper::sense_voltage(int pair) const {
 }
 
 void HybridStepper::refresh_drive() {
-    if (driver_ != nullptr) {
-        const double vs = driver_->motor_supply_v();
-        if (driver_->enabled()) {
-            const double e = driver_->electrical_angle();
-            const double amps[2] = {driver_->set_current_a() * std::cos(e), driver_->set_current_a() * std::sin(e)};
-            for (int k = 0; k < 2; ++k) {
-                WindingDrive d;
-                d.current_mode = true;
-                d.target_a = amps[k];
-                d.supply_v = vs;
-                d.polarity = 1;
-                model_.set_drive(static_cast<std::size_t>(k), d);
-            }
-        } else {
-            // Outputs off: the current decays through the body diodes into the supply.
-            WindingDrive d;
-            d.v_pos = -(vs + 2 * kDriverBodyDiodeV);
-            d.v_neg = vs + 2 * kDriverBodyDiodeV;
-            for (std::size_t k = 0; k < 2; ++k) model_.set_drive(k, d);
-        }
-        return;
-    }
     for (std::size_t k = 0; k < sources_.size(); ++k) model_.set_drive(k, sources_[k]());
 }
 
 void HybridStepper::on_drive_change() {
     sync();
     refresh_drive();
-    if (driver_ != nullptr) {
-        if (driver_->enabled()) set_command(driver_->electrical_angle());
+    if (angle_from_source_) {
+        if (source_->outputs_enabled()) set_command(source_->commanded_electrical_angle());
     } else {
         update_command_from_polarity();
     }
@@ -371,7 +327,7 @@ void HybridStepper::set_command(double electrical) {
     const double rotor_e = model_.electrical_angle();
     if (!have_command_) {
         // The first excitation: the rotor turns to the nearest equilibrium of it.
-        if (driver_ != nullptr) {
+        if (angle_from_source_) {
             driver_offset_ = kTwoPi * std::round((rotor_e - electrical) / kTwoPi);
             command_e_ = electrical + driver_offset_;
         } else {
@@ -382,7 +338,7 @@ void HybridStepper::set_command(double electrical) {
         return;
     }
     double next;
-    if (driver_ != nullptr) {
+    if (angle_from_source_) {
         next = electrical + driver_offset_;
     } else {
         next = command_e_ + std::remainder(electrical - command_e_, kTwoPi);

@@ -30,10 +30,6 @@
 
 namespace avrbench {
 
-class L293D;
-class LowSideSwitch;
-class StepDirDriver;
-
 class HybridStepper final : public Part {
 public:
     static std::vector<ParamSpec> param_specs(bool unipolar);
@@ -50,13 +46,14 @@ public:
     std::string_view type() const override { return unipolar_ ? "unipolar_stepper" : "hybrid_stepper"; }
     void start() override;
 
-    // Wiring, one of (the part registry calls it after construction):
-    // a bipolar motor on an L293D, phase A from output a_plus to a_minus, B likewise;
-    void attach_bridge(L293D& bridge, int a_plus, int a_minus, int b_plus, int b_minus);
-    // a unipolar motor on low-side switch channels for half-windings A, B, C (= A-), D (= B-);
-    void attach_switches(LowSideSwitch& switches, const std::array<int, 4>& channels);
-    // a bipolar motor on a step/dir driver.
-    void attach_driver(StepDirDriver& driver);
+    // Wiring (the part registry calls it after construction): what drives
+    // the windings, and per winding (A, B; unipolar: A, B, C = A-, D = B-)
+    // the drive it imposes. The motor knows the interface, not the parts.
+    void attach(DriveSource& source, std::vector<std::function<WindingDrive()>> windings);
+    std::size_t winding_count() const { return model_.winding_count(); }
+    // Unipolar: the centre-tap supply and the sense resistor, for the switches' drives.
+    double supply_v() const { return supply_v_; }
+    double sense_ohm() const { return sense_ohm_; }
 
     // Brings the model up to the clock's present cycle.
     void sync();
@@ -95,9 +92,10 @@ private:
     Cycle sample_cycles_, release_cycles_, stall_quiet_cycles_;
     Cycle last_cycle_ = 0;
 
-    // Drive sources, one per winding; or the step/dir driver.
+    // What drives the windings, and one drive per winding.
+    DriveSource* source_ = nullptr;
+    bool angle_from_source_ = false;  // the source commands the angle (a step/dir driver)
     std::vector<std::function<WindingDrive()>> sources_;
-    StepDirDriver* driver_ = nullptr;
     double driver_offset_ = 0;  // 2*pi*m aligning the driver's angle with the rotor
 
     // Unipolar sense resistors.

@@ -179,7 +179,7 @@ void StepDirDriver::on_input(std::size_t pin, bool level) {
         on_dir_change();
     } else if (pin == enable_pin_) {
         publish(sig_enabled_, enabled() ? 1 : 0);
-        for (auto& fn : output_listeners_) fn();
+        notify_drive_change();
     }
 }
 
@@ -243,7 +243,26 @@ void StepDirDriver::on_step_edge(bool active) {
     ++steps_taken_;
     publish(sig_position_, static_cast<double>(position_256_) * configured_microsteps_ / 256.0);
     for (auto& fn : step_listeners_) fn(delta);
-    for (auto& fn : output_listeners_) fn();
+    notify_drive_change();
+}
+
+// Forward voltage of the output MOSFETs' body diodes while the outputs are
+// disabled (assumed: the drivers' datasheets give ~0.7-1 V).
+constexpr double kBodyDiodeV = 0.7;
+
+WindingDrive StepDirDriver::winding(int k) const {
+    WindingDrive d;
+    if (enabled()) {
+        const double e = electrical_angle();
+        d.current_mode = true;
+        d.target_a = current_a_ * (k == 0 ? std::cos(e) : std::sin(e));
+        d.supply_v = motor_supply_v_;
+        d.polarity = 1;
+    } else {
+        d.v_pos = -(motor_supply_v_ + 2 * kBodyDiodeV);
+        d.v_neg = motor_supply_v_ + 2 * kBodyDiodeV;
+    }
+    return d;
 }
 
 }  // namespace avrbench

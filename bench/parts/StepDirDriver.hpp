@@ -13,10 +13,11 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/WindingDrive.hpp"
 
 namespace avrbench {
 
-class StepDirDriver final : public Part {
+class StepDirDriver final : public Part, public DriveSource {
 public:
     static std::vector<ParamSpec> param_specs();
     // Datasheet timing per preset (name -> parameter -> value with unit).
@@ -51,8 +52,14 @@ public:
     }
     double set_current_a() const { return current_a_; }
     double motor_supply_v() const { return motor_supply_v_; }
-    // Called after a step and after ENABLE changes (the motor listens).
-    void on_outputs_change(std::function<void()> fn) { output_listeners_.push_back(std::move(fn)); }
+
+    // DriveSource: the motor is told after every step and ENABLE change.
+    bool commands_angle() const override { return true; }
+    double commanded_electrical_angle() const override { return electrical_angle(); }
+    bool outputs_enabled() const override { return enabled(); }
+    // Winding 0 (A) or 1 (B): the chopper's current while enabled; disabled,
+    // the current decays through the output MOSFETs' body diodes into the supply.
+    WindingDrive winding(int k) const;
 
 private:
     void on_input(std::size_t pin, bool level) override;
@@ -82,7 +89,6 @@ private:
     std::size_t sig_step_, sig_dir_, sig_position_, sig_enabled_;
     std::vector<std::function<void(int)>> step_listeners_;
     double current_a_, motor_supply_v_;
-    std::vector<std::function<void()>> output_listeners_;
 };
 
 }  // namespace avrbench

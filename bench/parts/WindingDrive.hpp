@@ -55,6 +55,14 @@ public:
     virtual ~DriveSource() = default;
     void on_drive_change(std::function<void()> fn) { drive_listeners_.push_back(std::move(fn)); }
 
+    // A driver that sets the electrical angle itself (a step/dir driver's
+    // microstep table) reports it, and the motor follows it; for a bridge or
+    // switches the motor infers the command from which windings are driven.
+    virtual bool commands_angle() const { return false; }
+    virtual double commanded_electrical_angle() const { return 0; }
+    // Outputs switched on (a driver's ENABLE); a bridge or a switch always is.
+    virtual bool outputs_enabled() const { return true; }
+
 protected:
     void notify_drive_change() {
         for (auto& fn : drive_listeners_) fn();
