@@ -27,16 +27,6 @@ std::pair<int, int> output_pair(const std::string& text, const std::string& part
     return {a, b};
 }
 
-template <class T>
-PartType simple(const std::string& type_name) {
-    PartType t;
-    t.name = type_name;
-    t.params = T::param_specs();
-    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
-        return std::make_unique<T>(name, clock, params);
-    };
-    return t;
-}
 
 PartType hybrid_stepper() {
     PartType t;
@@ -97,8 +87,8 @@ PartType unipolar_stepper() {
 }  // namespace
 
 std::vector<PartType> motor_part_types() {
-    return {simple<L293D>("l293d"), simple<LowSideSwitch>("low_side_switch"),
-            simple<ShiftRegister595>("shift_register_595"), hybrid_stepper(), unipolar_stepper()};
+    return {simple_part_type<L293D>("l293d"), simple_part_type<LowSideSwitch>("low_side_switch"),
+            simple_part_type<ShiftRegister595>("shift_register_595"), hybrid_stepper(), unipolar_stepper()};
 }
 
 }  // namespace avrbench

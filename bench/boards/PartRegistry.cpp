@@ -13,17 +13,6 @@
 namespace avrbench {
 namespace {
 
-PartType step_dir_driver() {
-    PartType t;
-    t.name = "step_dir_driver";
-    t.params = StepDirDriver::param_specs();
-    t.presets = StepDirDriver::presets();
-    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
-        return std::make_unique<StepDirDriver>(name, clock, params);
-    };
-    return t;
-}
-
 PartType axis(const std::string& kind) {
     PartType t;
     t.name = kind + "_axis";
@@ -45,26 +34,6 @@ PartType limit_switch() {
     t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup& lookup) {
         auto& axis_part = static_cast<Axis&>(lookup(params.text("axis")));
         return std::make_unique<LimitSwitch>(name, clock, params, axis_part);
-    };
-    return t;
-}
-
-PartType pull_resistor() {
-    PartType t;
-    t.name = "pull_resistor";
-    t.params = PullResistor::param_specs();
-    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
-        return std::make_unique<PullResistor>(name, clock, params);
-    };
-    return t;
-}
-
-PartType serial_peer() {
-    PartType t;
-    t.name = "serial_peer";
-    t.params = SerialPeer::param_specs();
-    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
-        return std::make_unique<SerialPeer>(name, clock, params);
     };
     return t;
 }
@@ -106,7 +75,8 @@ PartType on_plant(const std::string& type_name) {
 const std::map<std::string, PartType>& part_types() {
     static const std::map<std::string, PartType> types = [] {
         std::map<std::string, PartType> m;
-        for (PartType t : {step_dir_driver(), axis("linear"), axis("rotary"), limit_switch(), pull_resistor(), serial_peer(), thermal_plant(),
+        for (PartType t : {simple_part_type<StepDirDriver>("step_dir_driver"), axis("linear"), axis("rotary"), limit_switch(), simple_part_type<PullResistor>("pull_resistor"),
+                           simple_part_type<SerialPeer>("serial_peer"), thermal_plant(),
                            on_plant<Heater>("heater"), on_plant<Thermistor>("thermistor"), on_plant<Fan>("fan")}) {
             m.emplace(t.name, std::move(t));
         }

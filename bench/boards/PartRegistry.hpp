@@ -28,6 +28,20 @@ struct PartType {
         build;
 };
 
+// A part type built from its parameters alone (no references to other parts),
+// with the part's presets if it has any.
+template <class T>
+PartType simple_part_type(const std::string& type_name) {
+    PartType t;
+    t.name = type_name;
+    t.params = T::param_specs();
+    if constexpr (requires { T::presets(); }) t.presets = T::presets();
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
+        return std::make_unique<T>(name, clock, params);
+    };
+    return t;
+}
+
 // Every part type the bench ships, by name.
 const std::map<std::string, PartType>& part_types();
 
