@@ -57,8 +57,8 @@ void expect_nets_resolve(const std::string& mcu_type, const std::string& firmwar
         if (f.kind == FindingKind::FloatingInputRead) {
             ++floating;
             EXPECT_EQ(f.source, "divider_47k");
-            // The PC of the instruction that read PINB, in the firmware's pin_b().
-            EXPECT_NE(f.symbol.find("pin_b"), std::string::npos) << f.describe();
+            // The PC of the instruction that read PINB, in the firmware's read_pin_b().
+            EXPECT_NE(f.symbol.find("read_pin_b"), std::string::npos) << f.describe();
             EXPECT_NE(f.detail.find("0.57 VCC"), std::string::npos) << f.detail;
         }
         if (f.kind == FindingKind::NetContention) {

@@ -8,6 +8,8 @@
  *   EXT_SENSE          sense control register (EICRA; MCUCR on the m32)
  *   EXT_MASK           enable register (EIMSK; GICR on the m32)
  *   EXT_FLAGS          flag register (EIFR; GIFR on the m32)
+ *   PUD_REG            register holding PUD (MCUCR; SFIOR on the m32)
+ *   read_pin_b(bit)    PINB bit after the two-cycle synchroniser delay
  *
  * Marker pins are PORTB bits: the bench stamps their edges with the cycle of
  * the instruction that writes them (sbi/cbi, 2 cycles each).
@@ -24,6 +26,21 @@
 #define INT0_PIN PD2
 #define INT1_PIN PD3
 #endif
+
+/* PUD, pull-up disable: MCUCR on the 328P/2560 (§14.4.1), SFIOR on the m32. */
+#if defined(MCUCR) && defined(PUD) && !defined(SFIOR)
+#define PUD_REG MCUCR
+#else
+#define PUD_REG SFIOR
+#endif
+
+/* PINB bit `bit`, after the synchroniser delay (§14.2.4): two NOPs. Not
+ * inlined, so a finding about the read names this function. */
+static __attribute__((noinline, unused)) uint8_t read_pin_b(uint8_t bit)
+{
+    __asm__ __volatile__("nop\n\tnop");
+    return (uint8_t)((PINB >> bit) & 1);
+}
 
 #if defined(__AVR_ATmega32__) || defined(__AVR_ATmega16__)
 #define EXT_SENSE MCUCR

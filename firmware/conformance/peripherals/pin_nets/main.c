@@ -23,44 +23,32 @@
 #include <avr/io.h>
 
 #include "avrbench_mcu.h"
+#include "../common/periph.h"
 
 AVRBENCH_MCU_SECTION();
 
-#if defined(MCUCR) && defined(PUD) && !defined(SFIOR)
-#define PUD_REG MCUCR
-#else
-#define PUD_REG SFIOR
-#endif
-
 volatile uint8_t reads[8];
 volatile uint8_t done;
-
-/* The synchroniser delay (§14.2.4) before reading PINx: two NOPs. */
-static inline uint8_t pin_b(uint8_t bit)
-{
-    __asm__ __volatile__("nop\n\tnop");
-    return (uint8_t)((PINB >> bit) & 1);
-}
 
 int main(void)
 {
     DDRB = 0;
     PORTB = _BV(PB0) | _BV(PB1) | _BV(PB2);
-    reads[0] = pin_b(PB0);
-    reads[1] = pin_b(PB1);
-    reads[2] = pin_b(PB2);
+    reads[0] = read_pin_b(PB0);
+    reads[1] = read_pin_b(PB1);
+    reads[2] = read_pin_b(PB2);
     PUD_REG |= _BV(PUD);
-    reads[3] = pin_b(PB1);
+    reads[3] = read_pin_b(PB1);
     PUD_REG &= (uint8_t)~_BV(PUD);
     PORTB = 0;
 
-    reads[4] = pin_b(PB4);
+    reads[4] = read_pin_b(PB4);
     DDRB = _BV(PB3); /* PORTB3 = 0: the open-drain idiom pulls low through DDR */
-    reads[5] = pin_b(PB4);
+    reads[5] = read_pin_b(PB4);
     DDRB = _BV(PB4);
-    reads[6] = pin_b(PB3);
+    reads[6] = read_pin_b(PB3);
     DDRB = 0;
-    reads[7] = pin_b(PB4);
+    reads[7] = read_pin_b(PB4);
 
     PORTB = _BV(PB5);
     DDRB = _BV(PB5);

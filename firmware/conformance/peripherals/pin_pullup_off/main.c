@@ -20,42 +20,30 @@
 #include <avr/io.h>
 
 #include "avrbench_mcu.h"
+#include "../common/periph.h"
 
 AVRBENCH_MCU_SECTION();
 
-#if defined(MCUCR) && defined(PUD) && !defined(SFIOR)
-#define PUD_REG MCUCR
-#else
-#define PUD_REG SFIOR
-#endif
-
 volatile uint8_t reads[5];
 volatile uint8_t done;
-
-/* The synchroniser delay (§14.2.4) before reading PINx: two NOPs. */
-static inline uint8_t READ(void)
-{
-    __asm__ __volatile__("nop\n\tnop");
-    return (uint8_t)((PINB >> PB0) & 1);
-}
 
 int main(void)
 {
     DDRB &= (uint8_t)~_BV(PB0);
     PORTB |= _BV(PB0);
-    reads[0] = READ();
+    reads[0] = read_pin_b(PB0);
     PORTB &= (uint8_t)~_BV(PB0);
-    reads[1] = READ();
+    reads[1] = read_pin_b(PB0);
     DDRB |= _BV(PB0);
     PORTB |= _BV(PB0);
     DDRB &= (uint8_t)~_BV(PB0);
     PORTB &= (uint8_t)~_BV(PB0);
-    reads[2] = READ();
+    reads[2] = read_pin_b(PB0);
     PORTB |= _BV(PB0);
     PUD_REG |= _BV(PUD);
-    reads[3] = READ();
+    reads[3] = read_pin_b(PB0);
     PUD_REG &= (uint8_t)~_BV(PUD);
-    reads[4] = READ();
+    reads[4] = read_pin_b(PB0);
     done = 1;
     for (;;) {
     }
