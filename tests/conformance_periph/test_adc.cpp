@@ -67,9 +67,8 @@ void feed(Mcu& mcu) {
 constexpr std::uint16_t kCode[8] = {64, 256, 512, 128, 768, 384, 896, 640};
 
 std::uint16_t result(Mcu& mcu, int i) {
-    const auto base = static_cast<std::uint16_t>(mcu.elf().symbol_address("results").value() - 0x800000);
-    const auto* d = mcu.avr()->data;
-    return static_cast<std::uint16_t>(d[base + 2 * i] | (d[base + 2 * i + 1] << 8));
+    const auto d = mcu.read_ram("results", 2 * static_cast<std::size_t>(i) + 2);
+    return static_cast<std::uint16_t>(d[2 * i] | (d[2 * i + 1] << 8));
 }
 
 class AdcModes : public ::testing::TestWithParam<const Part*> {};

@@ -34,15 +34,8 @@ inline ElfImage timer_firmware(const std::string& name, const TimerPart& part) {
 
 // `count` consecutive bytes / little-endian words of a RAM array by its symbol.
 inline std::vector<unsigned> ram_bytes(const Mcu& mcu, const std::string& symbol, unsigned count) {
-    const auto address = mcu.elf().symbol_address(symbol);
-    std::vector<unsigned> out;
-    if (!address || *address < 0x800000) {
-        ADD_FAILURE() << "no RAM symbol " << symbol;
-        return out;
-    }
-    const std::uint32_t a = *address - 0x800000;
-    for (unsigned i = 0; i < count; ++i) out.push_back(mcu.avr()->data[a + i]);
-    return out;
+    const std::vector<std::uint8_t> bytes = mcu.read_ram(symbol, count);  // throws for a symbol not in RAM
+    return std::vector<unsigned>(bytes.begin(), bytes.end());
 }
 inline std::vector<unsigned> ram_words(const Mcu& mcu, const std::string& symbol, unsigned count) {
     const auto bytes = ram_bytes(mcu, symbol, 2 * count);

@@ -29,9 +29,8 @@ inline std::unique_ptr<Board> ramps_board(const std::string& firmware) {
 
 // Element `index` of a uint16_t array in the firmware's RAM.
 inline std::uint16_t read_u16_element(Mcu& mcu, const std::string& symbol, int index) {
-    const auto base = *mcu.elf().symbol_address(symbol) - 0x800000;
-    const auto* data = mcu.avr()->data;
-    return static_cast<std::uint16_t>(data[base + 2 * index] | (data[base + 2 * index + 1] << 8));
+    const auto bytes = mcu.read_ram(symbol, 2 * static_cast<std::size_t>(index) + 2);
+    return static_cast<std::uint16_t>(bytes[2 * index] | (bytes[2 * index + 1] << 8));
 }
 
 inline std::int16_t read_i16(Mcu& mcu, const std::string& symbol) {
