@@ -224,6 +224,15 @@ void print_text_tail(const std::string& text, std::size_t max_lines) {
 
 // A crash of the firmware (the MCU's own oracles); part, net and host findings
 // fail a run only with --strict.
+// --trace: the recorder's error, named after the option that gave the list.
+void trace_pins_for_cli(Recorder& recorder, Mcu& mcu, const std::string& spec) {
+    try {
+        recorder.trace_pins(mcu, spec);
+    } catch (const BadInput& e) {
+        throw BadInput(std::string("--trace: ") + e.what());
+    }
+}
+
 // --realtime 2.5s='!': a time and the bytes to send then, outside the line
 // stream: printable characters as they are, ^X for a control character
 // (grbl's soft reset Ctrl-X), 0xNN for any byte (grbl 1.1's overrides).
@@ -315,7 +324,7 @@ int run_board_command(const RunArgs& args) {
     for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
     if (!args.vcd.empty() || !args.report.empty()) {
         if (!args.trace.empty()) {
-            for (Mcu* m : board.mcus()) bench.recorder().trace_pins(*m, args.trace);
+            for (Mcu* m : board.mcus()) trace_pins_for_cli(bench.recorder(), *m, args.trace);
         } else {
             bench.trace_board();
         }
@@ -467,7 +476,7 @@ int run_command(const RunArgs& args) {
     Timeline timeline;
     Recorder recorder(timeline);
     const bool tracing = !args.vcd.empty() || !args.trace.empty();
-    if (tracing) recorder.trace_pins(mcu, args.trace.empty() ? "all" : args.trace);
+    if (tracing) trace_pins_for_cli(recorder, mcu, args.trace.empty() ? "all" : args.trace);
 
     Uart* uart0 = nullptr;
     try {

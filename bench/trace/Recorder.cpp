@@ -111,7 +111,7 @@ std::vector<SignalId> Recorder::trace_pins(Mcu& mcu, const std::string& spec) {
             names.push_back(upper);
         }
     }
-    if (names.empty()) throw BadInput("--trace: no pins in '" + spec + "'");
+    if (names.empty()) throw BadInput("no pins in '" + spec + "'");
     std::vector<SignalId> ids;
     for (const auto& name : names) ids.push_back(trace_pin(mcu, mcu.pin(name)));
     return ids;
