@@ -28,15 +28,15 @@ HybridStepperModel::Params model_params(const ParamValues& p, const std::string&
     m.rotor_teeth = static_cast<int>(std::lround(teeth));
     m.resistance_ohm = p.quantity("resistance");
     m.inductance_h = p.quantity("inductance");
-    m.torque_constant = p.quantity("torque_constant");
-    m.detent_torque = p.quantity("detent_torque");
-    m.inertia = p.quantity("rotor_inertia") + p.quantity("load_inertia");
-    m.viscous = p.quantity("viscous_damping");
-    m.coulomb = p.quantity("coulomb_friction");
-    m.load_torque = p.quantity("load_torque");
+    m.torque_constant_nm_per_a = p.quantity("torque_constant");
+    m.detent_torque_nm = p.quantity("detent_torque");
+    m.inertia_kg_m2 = p.quantity("rotor_inertia") + p.quantity("load_inertia");
+    m.viscous_nm_s_per_rad = p.quantity("viscous_damping");
+    m.coulomb_nm = p.quantity("coulomb_friction");
+    m.load_torque_nm = p.quantity("load_torque");
     m.max_step_s = p.quantity("max_step");
     m.chopper_tau_s = p.quantity("chopper_tau");
-    if (m.resistance_ohm <= 0 || m.inductance_h <= 0 || m.torque_constant <= 0 || m.inertia <= 0) {
+    if (m.resistance_ohm <= 0 || m.inductance_h <= 0 || m.torque_constant_nm_per_a <= 0 || m.inertia_kg_m2 <= 0) {
         throw BadInput("part '" + name + "': resistance, inductance, torque_constant and inertia must be positive");
     }
     if (m.max_step_s <= 0 || m.max_step_s > 1e-3 || m.chopper_tau_s <= 0) {

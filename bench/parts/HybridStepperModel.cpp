@@ -11,13 +11,13 @@ HybridStepperModel::HybridStepperModel(const Params& params, std::vector<Winding
     if (windings_.empty() || windings_.size() > kMaxWindings) {
         throw std::invalid_argument("a hybrid stepper has 1 to 4 windings");
     }
-    if (params_.resistance_ohm <= 0 || params_.inductance_h <= 0 || params_.inertia <= 0 ||
+    if (params_.resistance_ohm <= 0 || params_.inductance_h <= 0 || params_.inertia_kg_m2 <= 0 ||
         params_.max_step_s <= 0 || params_.rotor_teeth <= 0 || params_.chopper_tau_s <= 0 ||
-        params_.coulomb_speed <= 0) {
+        params_.coulomb_speed_rad_s <= 0) {
         throw std::invalid_argument("hybrid stepper: resistance, inductance, inertia, steps must be positive");
     }
     inv_l_ = 1.0 / params_.inductance_h;
-    inv_j_ = 1.0 / params_.inertia;
+    inv_j_ = 1.0 / params_.inertia_kg_m2;
     for (std::size_t k = 0; k < windings_.size(); ++k) drive_[k] = WindingDrive::open();
 }
 
@@ -41,7 +41,7 @@ double HybridStepperModel::phase_current(int phase) const {
 double HybridStepperModel::back_emf(std::size_t winding) const {
     const double e = params_.rotor_teeth * angle();
     const double g = windings_[winding].phase == 0 ? -std::sin(e) : std::cos(e);
-    return windings_[winding].sign * params_.torque_constant * speed() * g;
+    return windings_[winding].sign * params_.torque_constant_nm_per_a * speed() * g;
 }
 
 double HybridStepperModel::motor_torque() const {
@@ -51,7 +51,7 @@ double HybridStepperModel::motor_torque() const {
     for (std::size_t k = 0; k < windings_.size(); ++k) {
         t += windings_[k].sign * x_[static_cast<Eigen::Index>(k)] * g[windings_[k].phase];
     }
-    return params_.torque_constant * t - params_.detent_torque * std::sin(4.0 * e);
+    return params_.torque_constant_nm_per_a * t - params_.detent_torque_nm * std::sin(4.0 * e);
 }
 
 HybridStepperModel::Modes HybridStepperModel::choose_modes(const State& x) const {
@@ -68,7 +68,7 @@ HybridStepperModel::Modes HybridStepperModel::choose_modes(const State& x) const
         } else if (i < 0) {
             modes[k] = Mode::Negative;
         } else {
-            const double emf = windings_[k].sign * params_.torque_constant * x[kMaxWindings] * g[windings_[k].phase];
+            const double emf = windings_[k].sign * params_.torque_constant_nm_per_a * x[kMaxWindings] * g[windings_[k].phase];
             modes[k] = d.v_pos > emf ? Mode::Positive : d.v_neg < emf ? Mode::Negative : Mode::Held;
         }
     }
@@ -88,7 +88,7 @@ HybridStepperModel::State HybridStepperModel::derivative(const State& x, const M
         const double i = x[ki];
         const double gk = windings_[k].sign * g[windings_[k].phase];
         torque_sum += i * gk;
-        const double emf = params_.torque_constant * omega * gk;
+        const double emf = params_.torque_constant_nm_per_a * omega * gk;
         const WindingDrive& d = drive_[k];
         switch (modes[k]) {
             case Mode::Positive: dx[ki] = (d.v_pos - d.r_pos * i - r * i - emf) * inv_l_; break;
@@ -105,9 +105,9 @@ HybridStepperModel::State HybridStepperModel::derivative(const State& x, const M
     }
     // sin(4e) from sin(e), cos(e): sin 2e = 2sc, cos 2e = c^2 - s^2.
     const double sin4 = 2.0 * (2.0 * s * c) * (c * c - s * s);
-    const double torque = params_.torque_constant * torque_sum - params_.detent_torque * sin4 -
-                          params_.viscous * omega - params_.coulomb * std::tanh(omega / params_.coulomb_speed) -
-                          params_.load_torque;
+    const double torque = params_.torque_constant_nm_per_a * torque_sum - params_.detent_torque_nm * sin4 -
+                          params_.viscous_nm_s_per_rad * omega - params_.coulomb_nm * std::tanh(omega / params_.coulomb_speed_rad_s) -
+                          params_.load_torque_nm;
     dx[kMaxWindings] = torque * inv_j_;
     dx[kMaxWindings + 1] = omega;
     return dx;
@@ -130,7 +130,7 @@ double HybridStepperModel::event_value(const State& x, std::size_t k, Mode mode)
     if (mode != Mode::Held) return x[ki];
     const double e = params_.rotor_teeth * x[kMaxWindings + 1];
     const double g = windings_[k].phase == 0 ? -std::sin(e) : std::cos(e);
-    const double emf = windings_[k].sign * params_.torque_constant * x[kMaxWindings] * g;
+    const double emf = windings_[k].sign * params_.torque_constant_nm_per_a * x[kMaxWindings] * g;
     return std::max(drive_[k].v_pos - emf, emf - drive_[k].v_neg);
 }
 
@@ -138,7 +138,7 @@ double HybridStepperModel::event_value(const State& x, std::size_t k, Mode mode)
 HybridStepperModel::Mode HybridStepperModel::conducting_mode(const State& x, std::size_t k) const {
     const double e = params_.rotor_teeth * x[kMaxWindings + 1];
     const double g = windings_[k].phase == 0 ? -std::sin(e) : std::cos(e);
-    const double emf = windings_[k].sign * params_.torque_constant * x[kMaxWindings] * g;
+    const double emf = windings_[k].sign * params_.torque_constant_nm_per_a * x[kMaxWindings] * g;
     return drive_[k].v_pos - emf > emf - drive_[k].v_neg ? Mode::Positive : Mode::Negative;
 }
 

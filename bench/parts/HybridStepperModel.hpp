@@ -46,18 +46,18 @@ public:
     using State = Eigen::Matrix<double, kMaxWindings + 2, 1>;  // i_0..i_3, omega, theta
 
     struct Params {
-        int rotor_teeth = 50;            // Nr: 50 for a 1.8 degree motor
-        double resistance_ohm = 34;      // per winding
-        double inductance_h = 46e-3;     // per winding
-        double torque_constant = 0.5;    // Km, N*m/A (= V*s/rad), per winding
-        double detent_torque = 0;        // amplitude, N*m
-        double inertia = 3.5e-6;         // rotor + load, kg*m^2
-        double viscous = 0;              // B, N*m*s/rad
-        double coulomb = 0;              // T_c, N*m
-        double coulomb_speed = 0.05;     // omega_c of the tanh smoothing, rad/s
-        double load_torque = 0;          // N*m, acts towards -theta
-        double max_step_s = 10e-6;       // RK4 step bound
-        double chopper_tau_s = 20e-6;    // current-mode tracking time constant
+        int rotor_teeth = 50;                   // Nr: 50 for a 1.8 degree motor
+        double resistance_ohm = 34;             // per winding
+        double inductance_h = 46e-3;            // per winding
+        double torque_constant_nm_per_a = 0.5;  // Km, N*m/A (= V*s/rad), per winding
+        double detent_torque_nm = 0;            // amplitude, N*m
+        double inertia_kg_m2 = 3.5e-6;          // rotor + load, kg*m^2
+        double viscous_nm_s_per_rad = 0;        // B, N*m*s/rad
+        double coulomb_nm = 0;                  // T_c, N*m
+        double coulomb_speed_rad_s = 0.05;      // omega_c of the tanh smoothing, rad/s
+        double load_torque_nm = 0;              // N*m, acts towards -theta
+        double max_step_s = 10e-6;              // RK4 step bound
+        double chopper_tau_s = 20e-6;           // current-mode tracking time constant
     };
     struct Winding {
         int phase;  // 0 = A, 1 = B

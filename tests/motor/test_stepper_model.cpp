@@ -19,11 +19,11 @@ HybridStepperModel::Params sm42(double max_step_s) {
     p.rotor_teeth = 50;
     p.resistance_ohm = 34;
     p.inductance_h = 46e-3;
-    p.torque_constant = 0.607;
-    p.detent_torque = 0.015;
-    p.inertia = 35e-7 + 215e-7;
-    p.viscous = 5e-4;
-    p.coulomb = 0.002;
+    p.torque_constant_nm_per_a = 0.607;
+    p.detent_torque_nm = 0.015;
+    p.inertia_kg_m2 = 35e-7 + 215e-7;
+    p.viscous_nm_s_per_rad = 5e-4;
+    p.coulomb_nm = 0.002;
     p.max_step_s = max_step_s;
     return p;
 }
@@ -54,7 +54,7 @@ TEST(StepperModel, WindingCurrentRisesAsTheRlExponential) {
     // A rotor too heavy to move: the winding is a plain R-L circuit.
     // i(t) = V/R (1 - exp(-t R / L)); L/R = 46 mH / 34 ohm = 1.353 ms.
     auto p = sm42(20e-6);
-    p.inertia = 1e6;
+    p.inertia_kg_m2 = 1e6;
     HybridStepperModel m(p, {{0, 1}, {1, 1}});
     WindingDrive on;
     on.v_pos = 9.4;
@@ -79,7 +79,7 @@ TEST(StepperModel, BrakedWindingDecaysSlowerThanAnOpenOne) {
     const double tau = 46e-3 / 34.0;
     for (bool braked : {true, false}) {
         auto p = sm42(20e-6);
-        p.inertia = 1e6;
+        p.inertia_kg_m2 = 1e6;
         HybridStepperModel m(p, {{0, 1}, {1, 1}});
         m.set_drive(0, l293d(+1));
         m.advance(30 * tau);
