@@ -398,7 +398,8 @@ struct VcdStream::Impl {
         emitter.begin();
     }
     void take(Timeline& timeline) {
-        for (const TimelineEvent& e : timeline.take_events()) {
+        timeline.take_events_into(taken);
+        for (const TimelineEvent& e : taken) {
             held.push_back(Held{emitter.time_of(e, static_cast<std::size_t>(sequence)), sequence, e});
             ++sequence;
         }
@@ -406,7 +407,7 @@ struct VcdStream::Impl {
     void write_up_to(std::uint64_t limit) {
         // Held events in recording order; those due go out sorted by (time,
         // recording order), the rest stay in recording order.
-        std::vector<Held> due;
+        due.clear();
         std::size_t kept = 0;
         for (const Held& h : held) {
             if (h.time <= limit) {
@@ -428,6 +429,8 @@ struct VcdStream::Impl {
     Output out;
     VcdEmitter emitter;
     std::vector<Held> held;
+    std::vector<Held> due;            // reused: a drain every 10 ms allocates nothing
+    std::vector<TimelineEvent> taken;  // reused, swapped with the timeline's buffer
     std::uint64_t sequence = 0;
 };
 
