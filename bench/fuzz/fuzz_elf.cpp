@@ -1,7 +1,7 @@
 // The ELF loader on arbitrary bytes: BadInput or a loaded image, nothing else.
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "fuzz/FuzzInput.hpp"
+#include "FuzzInput.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     avrbench::fuzz::InputFile file(data, size, ".elf");

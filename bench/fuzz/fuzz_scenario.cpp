@@ -1,7 +1,7 @@
 // Scenario files: load_scenario on an arbitrary file (boards and firmware it
 // names resolve relative to /tmp, where mostly nothing is).
 #include "core/Errors.hpp"
-#include "fuzz/FuzzInput.hpp"
+#include "FuzzInput.hpp"
 #include "verify/Scenario.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
