@@ -10,14 +10,21 @@ extern "C" {
 
 namespace avrbench {
 
-McuPinTerminal::McuPinTerminal(Mcu& mcu, Pin& pin) : mcu_(mcu), pin_(pin), level_(pin.level()) {
+McuPinTerminal::McuPinTerminal(Mcu& mcu, Pin& pin) : mcu_(mcu), pin_(pin), level_(pin.level()), drive_(drive_state()) {
     // A level change of an output (PORT write, compare output, reset) re-resolves
     // the net. simavr stores an IRQ's new value only after its listeners ran,
     // so the level comes from the notification, not from the pin.
     pin_.on_change([this](Cycle, bool level) {
         level_ = level;
-        drive_changed();
+        refresh();
     });
+}
+
+void McuPinTerminal::refresh() {
+    const Drive now = drive_state();
+    if (now == drive_) return;
+    drive_ = now;
+    drive_changed();
 }
 
 Drive McuPinTerminal::drive_state() const {

@@ -41,13 +41,16 @@ public:
 
     Mcu& mcu() const { return mcu_; }
     Pin& pin() const { return pin_; }
-    // The firmware may have changed the pin's direction or pull-up.
-    void refresh() { drive_changed(); }
+    // The firmware may have changed the pin's direction or pull-up: the net
+    // resolves again only if what the pin drives did change (every PORT write
+    // of a step pulse comes here).
+    void refresh();
 
 private:
     Mcu& mcu_;
     Pin& pin_;
-    bool level_;  // the pin's level as last raised
+    bool level_;   // the pin's level as last raised
+    Drive drive_;  // what the net last heard this pin drive
 };
 
 // One per MCU with pins on nets.
