@@ -205,8 +205,62 @@ void Board::build_nets() {
         }
         n->set_clock(*clock);
     }
+    build_twi_buses();
     for (auto& p : parts_) p->start();
     for (auto& n : nets_) n->settle();
+}
+
+Net* Board::net_of(Mcu& mcu, const std::string& pin_name) const {
+    Pin* pin = &mcu.pin(pin_name);
+    for (const auto& t : mcu_terminals_) {
+        if (&t->mcu() == &mcu && &t->pin() == pin) return t->net();
+    }
+    return nullptr;
+}
+
+void Board::build_twi_buses() {
+    // Two TWI modules talk when their SDA pins share a net and their SCL pins
+    // share a net, as on the real board (the pull-ups are the nets' business).
+    struct Lines {
+        Twi* twi;
+        Net* sda;
+        Net* scl;
+    };
+    std::vector<Lines> wired;
+    for (const auto& m : mcus_) {
+        Twi* twi = m->twi();
+        if (twi == nullptr) continue;
+        const TwiPins pins = twi_pins(m->mcu_type());
+        Lines lines{twi, net_of(*m, pins.sda), net_of(*m, pins.scl)};
+        if (lines.sda != nullptr || lines.scl != nullptr) wired.push_back(lines);
+    }
+    for (std::size_t i = 0; i < wired.size(); ++i) {
+        for (std::size_t j = i + 1; j < wired.size(); ++j) {
+            const Lines& a = wired[i];
+            const Lines& b = wired[j];
+            const bool sda_shared = a.sda != nullptr && a.sda == b.sda;
+            const bool scl_shared = a.scl != nullptr && a.scl == b.scl;
+            if (sda_shared == scl_shared) continue;
+            // SDA shared without SCL (or the reverse) is a wiring mistake, not a bus.
+            const Net* shared = sda_shared ? a.sda : a.scl;
+            std::string location = spec_.path;
+            for (const auto& decl : spec_.nets) {
+                if (decl.name == shared->name()) location = decl.location;
+            }
+            throw BadInput(location + ": net '" + shared->name() + "' joins the TWI " + (sda_shared ? "SDA" : "SCL") +
+                           " pins of " + a.twi->owner_name() + " and " + b.twi->owner_name() + " but their " +
+                           (sda_shared ? "SCL" : "SDA") + " pins are not on one net");
+        }
+    }
+    std::map<std::pair<Net*, Net*>, TwiBus*> by_lines;
+    for (const Lines& lines : wired) {
+        auto& bus = by_lines[{lines.sda, lines.scl}];
+        if (bus == nullptr) {
+            twi_buses_.push_back(std::make_unique<TwiBus>());
+            bus = twi_buses_.back().get();
+        }
+        lines.twi->attach(*bus);
+    }
 }
 
 McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {

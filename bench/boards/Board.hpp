@@ -11,6 +11,7 @@
 #include "core/Errors.hpp"
 #include "core/Lockstep.hpp"
 #include "core/Mcu.hpp"
+#include "core/Twi.hpp"
 #include "parts/Part.hpp"
 #include "wiring/McuPinTerminal.hpp"
 #include "wiring/Net.hpp"
@@ -57,6 +58,8 @@ public:
     void drive_pin(const std::string& endpoint_or_label, bool level);
     void release_pin(const std::string& endpoint_or_label);
     const std::vector<std::unique_ptr<Net>>& nets() const { return nets_; }
+    // I2C buses: the MCUs whose TWI SDA and SCL pins share nets.
+    const std::vector<std::unique_ptr<TwiBus>>& twi_buses() const { return twi_buses_; }
 
     Lockstep& lockstep() { return lockstep_; }
     // Advances every MCU to `end_ps` of simulated time: afterwards now_ps() >=
@@ -76,6 +79,8 @@ private:
     void build_mcus(const std::map<std::string, std::string>& firmware);
     void build_parts();
     void build_nets();
+    void build_twi_buses();
+    Net* net_of(Mcu& mcu, const std::string& pin_name) const;
     McuPinTerminal& add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net);
     Terminal& stimulus_for(const std::string& endpoint_or_label);
 
@@ -86,6 +91,7 @@ private:
     std::vector<std::unique_ptr<McuPinTerminal>> mcu_terminals_;
     std::map<const Pin*, std::unique_ptr<Terminal>> stimuli_;
     std::vector<std::unique_ptr<Net>> nets_;
+    std::vector<std::unique_ptr<TwiBus>> twi_buses_;
     Lockstep lockstep_;
 };
 

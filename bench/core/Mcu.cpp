@@ -18,6 +18,7 @@ extern "C" {
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
+#include "core/Twi.hpp"
 #include "core/fixes/Fix.hpp"
 #include "core/fixes/Interrupts.hpp"
 
@@ -112,6 +113,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     fixes_ = std::make_unique<SimavrFixes>(avr_);
     scheduler_ = std::make_unique<Scheduler>(avr_);
     adc_ = std::make_unique<Adc>(avr_, mcu_type_);
+    twi_ = Twi::install(avr_, mcu_type_, *scheduler_, options_.name);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
@@ -133,6 +135,7 @@ Mcu::~Mcu() {
     uarts_.clear();
     pins_.clear();
     adc_.reset();
+    twi_.reset();
     scheduler_.reset();
     fixes_.reset();  // the fixes unhook themselves from the core: before it is freed
     if (avr_ != nullptr) {
@@ -226,6 +229,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
         ++resets_;
         // avr_reset() drops every cycle timer: put the scheduler's back.
         scheduler_->rearm();
+        if (twi_) twi_->reset();
         for (auto& fn : reset_listeners_) fn();
         if (watchdog_reset_seen_) {
             watchdog_reset_seen_ = false;

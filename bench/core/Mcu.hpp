@@ -25,6 +25,7 @@ struct avr_io_t;
 namespace avrbench {
 
 class Adc;
+class Twi;
 
 struct McuOptions {
     std::string name = "mcu";        // the MCU's name on the board, used in scopes and findings
@@ -81,6 +82,8 @@ public:
     // USART n. Throws BadInput when the MCU has no such USART.
     Uart& uart(int index = 0);
     Scheduler& scheduler() { return *scheduler_; }
+    // The TWI (I2C) module, or nullptr when the bench does not model the MCU's.
+    Twi* twi() { return twi_.get(); }
     // The ADC: analog sources per channel, pin -> channel (core/Adc.hpp).
     Adc& adc() { return *adc_; }
 
@@ -114,6 +117,7 @@ private:
     std::unique_ptr<SimavrFixes> fixes_;
     std::unique_ptr<Scheduler> scheduler_;
     std::unique_ptr<Adc> adc_;
+    std::unique_ptr<Twi> twi_;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
     std::vector<Finding> findings_;
