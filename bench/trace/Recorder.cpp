@@ -12,6 +12,7 @@ extern "C" {
 
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
+#include "core/Twi.hpp"
 
 namespace avrbench {
 
@@ -54,6 +55,15 @@ SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
         {mcu.name(), "uart" + std::to_string(uart.index()) + "_tx", SignalKind::Bus, 8, mcu.frequency_hz(), true});
     Timeline* timeline = &timeline_;
     uart.on_transmit([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
+    return id;
+}
+
+SignalId Recorder::trace_twi(Mcu& mcu, Twi& twi) {
+    const SignalId id = timeline_.add_signal({mcu.name(), "twi", SignalKind::Bus, 8, mcu.frequency_hz(), true});
+    Timeline* timeline = &timeline_;
+    twi.on_event([timeline, id](const TwiEvent& e) {
+        if (e.kind == TwiEvent::Kind::Address || e.kind == TwiEvent::Kind::Data) timeline->record(id, e.cycle, e.byte);
+    });
     return id;
 }
 

@@ -25,6 +25,9 @@ public:
     // Adds "<mcu name>.uart<n>_tx" as an 8-bit bus: one event per byte, at the
     // cycle of the UDR write.
     SignalId trace_uart_tx(Mcu& mcu, Uart& uart);
+    // Every address and data byte the MCU puts on its I2C bus as master, as
+    // an 8-bit bus signal "twi" (one event per byte, at the end of its ACK bit).
+    SignalId trace_twi(Mcu& mcu, Twi& twi);
 
     // Every signal the part publishes (positions, levels, temperatures), in a
     // scope named after the part, stamped with the part's clock.

@@ -145,6 +145,14 @@ void Bench::trace_board() {
         Mcu& m = board_->mcu(s.mcu);
         recorder_.trace_uart_tx(m, m.uart(s.usart));
     }
+    for (Mcu* m : board_->mcus()) {
+        // Only MCUs on a board's I2C bus: the others have nobody to talk to.
+        Twi* twi = m->twi();
+        if (twi == nullptr) continue;
+        for (const auto& bus : board_->twi_buses()) {
+            if (&twi->bus() == bus.get()) recorder_.trace_twi(*m, *twi);
+        }
+    }
     for (Part* p : board_->parts()) recorder_.trace_part(*p);
 }
 

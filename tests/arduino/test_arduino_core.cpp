@@ -163,5 +163,40 @@ nets:
     EXPECT_TRUE(board.findings().empty()) << board.findings().front().describe();
 }
 
+// The Wire library on two MCUs: an UNO master (A4 = PC4 SDA, A5 = PC5 SCL)
+// and a Mega slave at address 8 (D20 = PD1 SDA, D21 = PD0 SCL), with only
+// the internal pull-ups twi_init() switches on, as two boards joined by
+// three wires. Expected text from the sketches and Wire's API: beginTransmission/
+// endTransmission returns 0 when every byte was ACKed; requestFrom returns
+// the count received; onReceive runs at the STOP with the bytes written.
+TEST(ArduinoCore, WireMasterAndSlaveOnTwoMcus) {
+    const std::string board_text = R"(
+mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+  mega: {type: atmega2560, clock: 16MHz}
+nets:
+  sda: [uno.PC4, mega.PD1]
+  scl: [uno.PC5, mega.PD0]
+)";
+    Board board(parse_board_text(board_text, "wire-pair.yaml"),
+                {{"uno", test::firmware("ard_wire_master")}, {"mega", test::firmware("ard_wire_slave_mega")}});
+    Uart& master_serial = board.mcu("uno").uart(0);
+    Uart& slave_serial = board.mcu("mega").uart(0);
+    // Five rounds 20 ms apart (plus the serial printing): done by 0.15 s.
+    board.run_for_seconds(0.15);
+    std::string master_expected = "master\r\n";
+    std::string slave_expected = "slave\r\n";
+    for (int round = 0; round < 5; ++round) {
+        const std::string n = std::to_string(round);
+        // The slave has counted round + 1 writes when the read comes.
+        master_expected += "tx 0\r\nrx 6 ok#" + std::to_string(round + 1) + "..\r\n";
+        slave_expected += "got 3 n=" + n + "\r\n";
+    }
+    master_expected += "done\r\n";
+    EXPECT_EQ(master_serial.transmitted_text(), master_expected);
+    EXPECT_EQ(slave_serial.transmitted_text(), slave_expected);
+    EXPECT_TRUE(board.findings().empty()) << board.findings().front().describe();
+}
+
 }  // namespace
 }  // namespace avrbench
