@@ -18,6 +18,7 @@ extern "C" {
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
+#include "core/IdleLoopSkip.hpp"
 #include "core/Twi.hpp"
 #include "core/fixes/Fix.hpp"
 #include "core/fixes/Interrupts.hpp"
@@ -114,6 +115,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     scheduler_ = std::make_unique<Scheduler>(avr_);
     adc_ = std::make_unique<Adc>(avr_, mcu_type_);
     twi_ = Twi::install(avr_, mcu_type_, *scheduler_, options_.name);
+    if (options_.skip_idle_loops && !options_.reference_run_loop) skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
@@ -147,6 +149,16 @@ Mcu::~Mcu() {
 }
 
 Cycle Mcu::cycle() const { return avr_->cycle; }
+void Mcu::set_skip_idle_loops(bool on) {
+    options_.skip_idle_loops = on;
+    if (!on || options_.reference_run_loop) {
+        skipper_.reset();
+    } else if (!skipper_) {
+        skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
+    }
+}
+std::uint64_t Mcu::idle_jumps() const { return skipper_ ? skipper_->jumps() : 0; }
+std::uint64_t Mcu::idle_cycles_skipped() const { return skipper_ ? skipper_->cycles_skipped() : 0; }
 std::uint32_t Mcu::pc_bytes() const { return avr_->pc; }
 std::uint16_t Mcu::stack_pointer() const {
     return static_cast<std::uint16_t>(avr_->data[R_SPL] | (avr_->data[R_SPH] << 8));
@@ -178,7 +190,9 @@ StopReason Mcu::run_until(Cycle target_cycle) {
     SimavrStepper stepper(avr);
     // One unsigned comparison covers PC = 0 (a reset) and PC past the program.
     const std::uint32_t code_end_minus_one = code_end_bytes_ - 1;
+    IdleLoopSkipper* const skipper = skipper_.get();
     while (avr->cycle < target_cycle) {
+        if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
         const std::uint32_t pc_before = avr->pc;
         const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
         ++steps_;

@@ -25,6 +25,7 @@ struct avr_io_t;
 namespace avrbench {
 
 class Adc;
+class IdleLoopSkipper;
 class Twi;
 
 struct McuOptions {
@@ -34,6 +35,10 @@ struct McuOptions {
     // Step through simavr's own avr_run instead of core/SimavrStep (tests
     // prove the two end in the same state).
     bool reference_run_loop = false;
+    // Jump over the passes of an idle loop up to the next event
+    // (core/IdleLoopSkip.hpp); exact, so on unless a test compares without.
+    // The reference run loop never skips.
+    bool skip_idle_loops = true;
 };
 
 enum class StopReason {
@@ -90,6 +95,11 @@ public:
     const std::vector<Finding>& findings() const { return findings_; }
     // Number of avr_run() steps taken: instructions plus sleep fast-forwards.
     std::uint64_t steps() const { return steps_; }
+    // Switches idle-loop skipping on or off (McuOptions::skip_idle_loops).
+    void set_skip_idle_loops(bool on);
+    // Idle-loop jumps taken and the cycles they covered (core/IdleLoopSkip.hpp).
+    std::uint64_t idle_jumps() const;
+    std::uint64_t idle_cycles_skipped() const;
     // How many times the core went through a reset after power-on.
     unsigned resets() const { return resets_; }
     // Called after each reset (watchdog, jump to the reset vector), once the
@@ -118,6 +128,8 @@ private:
     std::unique_ptr<Scheduler> scheduler_;
     std::unique_ptr<Adc> adc_;
     std::unique_ptr<Twi> twi_;
+    std::unique_ptr<IdleLoopSkipper> skipper_;  // nullptr: never skip
+    std::uint32_t skip_countdown_ = 1;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
     std::vector<Finding> findings_;

@@ -67,6 +67,7 @@ struct RunArgs {
     std::string family;        // --family: overrides the board's
     std::string line_timeout;  // --line-timeout: overrides the board's
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
+    bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
 };
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
@@ -260,6 +261,14 @@ std::pair<Picoseconds, std::string> parse_realtime(const std::string& item) {
 
 bool is_mcu_finding(const Finding& f) { return f.kind <= FindingKind::JumpToReset; }
 
+// How much of the run the idle-loop skipper covered (core/IdleLoopSkip.hpp).
+void print_idle_skip(const Mcu& mcu, bool name_it) {
+    if (mcu.idle_jumps() == 0) return;
+    std::printf("  idle skip  %s%llu jumps over %.6f s of idle-loop passes\n",
+                name_it ? (mcu.name() + ": ").c_str() : "", static_cast<unsigned long long>(mcu.idle_jumps()),
+                static_cast<double>(mcu.idle_cycles_skipped()) / mcu.frequency_hz());
+}
+
 int run_board_command(const RunArgs& args) {
     if (!args.mcu.empty() || !args.freq.empty()) {
         throw BadInput("--mcu/--freq do not apply with --board: the board file gives each MCU's type and clock");
@@ -288,6 +297,7 @@ int run_board_command(const RunArgs& args) {
 
     Bench bench(std::move(spec), firmware);
     Board& board = bench.board();
+    for (Mcu* m : board.mcus()) m->set_skip_idle_loops(!args.no_idle_skip);
     if (board.spec().serial.empty() && (!uart_in.empty() || !uart_out.empty() || !args.gcode.empty())) {
         throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --uart-in, --uart-out)");
     }
@@ -376,6 +386,7 @@ int run_board_command(const RunArgs& args) {
     }
     std::printf("  simulated  %.6f s\n", simulated_s);
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
+    for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);
     if (host != nullptr) {
         std::printf("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s\n", args.gcode.c_str(),
                     host->lines_acknowledged(), host->lines().size(), host->oks(), host->errors(), to_string(outcome));
@@ -456,6 +467,7 @@ int run_command(const RunArgs& args) {
     McuOptions options;
     options.name = "mcu";
     options.mcu_type = args.mcu;
+    options.skip_idle_loops = !args.no_idle_skip;
     if (!args.freq.empty()) options.frequency_hz = parse_frequency_hz(args.freq, "--freq");
     const Picoseconds duration_ps = parse_duration_ps(args.duration, "--for");
     // Without a board there is one port: USART0 ("0=FILE" is accepted too).
@@ -518,6 +530,7 @@ int run_command(const RunArgs& args) {
                 mcu.frequency_hz() / 1e6);
     std::printf("  simulated  %.6f s (%llu cycles)\n", simulated_s, static_cast<unsigned long long>(mcu.cycle()));
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
+    print_idle_skip(mcu, false);
     if (args.until_sleep) std::printf("  stopped    %s\n", slept ? "firmware executed SLEEP" : "time limit");
     if (mcu.halted()) std::printf("  halted     %s\n", mcu.halt_reason().c_str());
     if (uart0 != nullptr) {
@@ -684,6 +697,8 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--uart-out", run.uart_out,
                         "FILE or PORT=FILE: write what the firmware sent on a serial port (repeatable)");
     run_cmd->add_flag("-q,--quiet", run.quiet, "no progress bar");
+    run_cmd->add_flag("--no-idle-skip", run.no_idle_skip,
+                      "run every pass of the firmware's idle loops instead of jumping over them (same results, slower)");
 
     CheckArgs check;
     CLI::App* check_cmd = app.add_subcommand("check", "run scenario files: stimulus, expectations, golden comparison");

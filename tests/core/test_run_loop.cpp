@@ -1,4 +1,5 @@
-// core/SimavrStep against simavr's own avr_run: every firmware the build
+// core/SimavrStep (with and without skipping idle loops) against simavr's
+// own avr_run: every firmware the build
 // makes runs 20 ms both ways, with every pin and USART0 traced, and must end
 // in the same state (cycle, PC, registers, I/O and all of RAM, step count)
 // with the same recorded timeline and the same findings. Firmware with a
@@ -32,11 +33,15 @@ struct EndState {
     std::vector<TimelineEvent> events;
     std::vector<std::string> findings;
     std::uint64_t steps = 0;
+    std::uint64_t idle_jumps = 0;
 };
 
-EndState run(const std::string& name, bool reference) {
+enum class Loop { Reference, Stepper, StepperSkippingIdleLoops };
+
+EndState run(const std::string& name, Loop loop) {
     McuOptions options;
-    options.reference_run_loop = reference;
+    options.reference_run_loop = loop == Loop::Reference;
+    options.skip_idle_loops = loop == Loop::StepperSkippingIdleLoops;
     const ElfImage elf = ElfImage::load(test::firmware(name));
     if (elf.embedded_mcu().empty()) {
         // Arduino sketches and other ELFs without .mmcu: the board they were built for.
@@ -62,7 +67,21 @@ EndState run(const std::string& name, bool reference) {
     s.events = timeline.events();
     for (const auto& f : mcu.findings()) s.findings.push_back(f.describe());
     s.steps = mcu.steps();
+    s.idle_jumps = mcu.idle_jumps();
     return s;
+}
+
+void expect_same_end(const EndState& a, const EndState& b, const std::string& name) {
+    EXPECT_EQ(a.cycle, b.cycle) << name;
+    EXPECT_EQ(a.pc, b.pc) << name;
+    EXPECT_TRUE(a.data == b.data) << name << ": registers, I/O or RAM differ";
+    EXPECT_EQ(a.findings, b.findings) << name;
+    ASSERT_EQ(a.events.size(), b.events.size()) << name;
+    for (std::size_t i = 0; i < a.events.size(); ++i) {
+        const bool same = a.events[i].cycle == b.events[i].cycle && a.events[i].signal == b.events[i].signal &&
+                          a.events[i].value.bits == b.events[i].value.bits;
+        ASSERT_TRUE(same) << name << ": event " << i << " differs";
+    }
 }
 
 std::vector<std::string> all_firmware() {
@@ -78,18 +97,30 @@ TEST(RunLoop, SimavrStepEndsWhereAvrRunEndsOnEveryFirmware) {
     const auto names = all_firmware();
     ASSERT_GT(names.size(), 100u);  // the build's whole firmware set, not an empty folder
     for (const auto& name : names) {
-        const EndState a = run(name, true), b = run(name, false);
-        EXPECT_EQ(a.cycle, b.cycle) << name;
-        EXPECT_EQ(a.pc, b.pc) << name;
-        EXPECT_TRUE(a.data == b.data) << name << ": registers, I/O or RAM differ";
+        const EndState a = run(name, Loop::Reference), b = run(name, Loop::Stepper);
+        expect_same_end(a, b, name);
         EXPECT_EQ(a.steps, b.steps) << name;
-        EXPECT_EQ(a.findings, b.findings) << name;
-        ASSERT_EQ(a.events.size(), b.events.size()) << name;
-        for (std::size_t i = 0; i < a.events.size(); ++i) {
-            const bool same = a.events[i].cycle == b.events[i].cycle && a.events[i].signal == b.events[i].signal &&
-                              a.events[i].value.bits == b.events[i].value.bits;
-            ASSERT_TRUE(same) << name << ": event " << i << " differs";
-        }
+    }
+}
+
+// The idle-loop skipper (core/IdleLoopSkip.hpp) against simavr's avr_run on
+// the same set: the same end state and byte-identical timelines, in fewer
+// steps wherever a loop was skipped. It must also actually skip: waiting
+// for the next received byte (uart_echo), for TWINT (twi_master), or in
+// the Arduino core's loop() between Timer0 overflows.
+TEST(RunLoop, SkippingIdleLoopsEndsWhereAvrRunEndsOnEveryFirmware) {
+    const auto names = all_firmware();
+    ASSERT_GT(names.size(), 100u);
+    std::size_t skipped = 0;
+    for (const auto& name : names) {
+        const EndState a = run(name, Loop::Reference), b = run(name, Loop::StepperSkippingIdleLoops);
+        expect_same_end(a, b, name);
+        EXPECT_LE(b.steps, a.steps) << name;
+        if (b.idle_jumps > 0) ++skipped;
+    }
+    EXPECT_GT(skipped, 10u) << "the skipper jumped on too few firmware to prove anything";
+    for (const char* name : {"uart_echo", "twi_master", "ard_millis_delay"}) {
+        EXPECT_GT(run(name, Loop::StepperSkippingIdleLoops).idle_jumps, 0u) << name;
     }
 }
 
