@@ -44,6 +44,10 @@ namespace {
 // ahead keeps that jump short. run_until() cancels it on the way out.
 avr_cycle_count_t horizon_timer(avr_t* avr, avr_cycle_count_t, void*) { return avr->cycle + 1; }
 
+// Due at once: a stop requested from inside an instruction (an I/O hook)
+// ends run_until's fast path, which looks only at the first timer.
+avr_cycle_count_t stop_timer(avr_t*, avr_cycle_count_t, void*) { return 0; }
+
 bool is_out_to(const avr_t* avr, std::uint32_t pc_bytes, unsigned io_address) {
     const unsigned opcode = avr->flash[pc_bytes] | (avr->flash[pc_bytes + 1] << 8);
     // OUT A,Rr: 1011 1AAr rrrr AAAA (AVR Instruction Set Manual).
@@ -149,6 +153,11 @@ Mcu::~Mcu() {
 }
 
 Cycle Mcu::cycle() const { return avr_->cycle; }
+
+void Mcu::request_stop() {
+    stop_requested_ = true;
+    avr_cycle_timer_register(avr_, 0, &stop_timer, this);
+}
 void Mcu::set_skip_idle_loops(bool on) {
     options_.skip_idle_loops = on;
     if (!on || options_.reference_run_loop) {
@@ -186,16 +195,14 @@ StopReason Mcu::run_until(Cycle target_cycle) {
     // instruction executes inside avr_run) jumps to its next cycle timer, and
     // without this one that could lie far past the target.
     if (avr->cycle < target_cycle) avr_cycle_timer_register(avr, target_cycle - avr->cycle, &horizon_timer, this);
+    run_target_ = target_cycle;
     const bool reference = options_.reference_run_loop;
     SimavrStepper stepper(avr);
     // One unsigned comparison covers PC = 0 (a reset) and PC past the program.
     const std::uint32_t code_end_minus_one = code_end_bytes_ - 1;
-    IdleLoopSkipper* const skipper = skipper_.get();
-    while (avr->cycle < target_cycle) {
-        if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
-        const std::uint32_t pc_before = avr->pc;
-        const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
-        ++steps_;
+    // The crash oracles after an instruction; findings that halt also
+    // request the stop. True when the run must stop.
+    const auto check = [&](int state, std::uint32_t pc_before) -> bool {
         const std::uint32_t pc = avr->pc;
         const std::uint16_t sp = static_cast<std::uint16_t>(avr->data[R_SPL] | (avr->data[R_SPH] << 8));
         // cpu_Running = 2 and cpu_Sleeping = 3 (sim_avr.h): one comparison for both.
@@ -204,11 +211,67 @@ StopReason Mcu::run_until(Cycle target_cycle) {
                                  pc == bad_interrupt_pc_ || sp < stack_floor_,
                              0)) {
             check_after_step(state, pc_before);
+            return stop_requested_;
         }
-        // A finding that halts the core also requests the stop (add_finding, check_after_step).
+        return false;
+    };
+    IdleLoopSkipper* const skipper = skipper_.get();
+    while (avr->cycle < target_cycle) {
+        if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
+        const std::uint32_t pc_before = avr->pc;
+        const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
+        ++steps_;
+        check(state, pc_before);
+        if (__builtin_expect(stop_requested_, 0)) break;
+        if (reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
+
+        // Fast path: while the core runs, no interrupt is on its way and no
+        // cycle timer is due, a step of SimavrStepper is avr_run_one and the
+        // new PC. Anything else is finished by SimavrStepper::finish, as
+        // step() would, and the loop goes back to the general step. The
+        // horizon timer (at the target, put back after a reset) is in the
+        // list, so the first timer is never later than the target and
+        // "first timer due" also stops the loop at the target.
+        const avr_cycle_timer_slot_p head = avr->cycle_timers.timer;
+        if (head == nullptr || head->when > target_cycle) continue;
+        std::uint32_t countdown = skip_countdown_;
+        const std::uint32_t countdown_before = countdown;
+        // avr->data is fixed once the core is made (fixes/MemoryGuard grows it then).
+        const std::uint8_t* const data = avr->data;
+        const std::uint16_t stack_floor = stack_floor_;
+        const std::uint32_t bad_interrupt_pc = bad_interrupt_pc_;
+        while (countdown > 1) {  // at 1 the general step ticks the skipper
+            --countdown;
+            // avr_run_one leaves avr->pc alone: it still holds the PC before the instruction.
+            const std::uint32_t pc = avr_run_one(avr);
+            // Never null here: the horizon timer stays in the list until run_until
+            // cancels it (only a reset drops it, and resets happen in timers).
+            const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
+            if (__builtin_expect(first->when <= avr->cycle, 0) || __builtin_expect(avr->state != cpu_Running, 0) ||
+                __builtin_expect(avr->interrupt_state != 0, 0)) {
+                const std::uint32_t fast_pc_before = avr->pc;
+                check(stepper.finish(pc), fast_pc_before);
+                break;
+            }
+            const std::uint16_t sp = static_cast<std::uint16_t>(data[R_SPL] | (data[R_SPH] << 8));
+            if (__builtin_expect(pc - 1 >= code_end_minus_one || pc == bad_interrupt_pc || sp < stack_floor, 0)) {
+                const std::uint32_t fast_pc_before = avr->pc;
+                avr->pc = pc;
+                check_after_step(cpu_Running, fast_pc_before);
+                if (stop_requested_) break;
+                continue;
+            }
+            avr->pc = pc;
+            // A stop requested during the instruction made stop_timer due:
+            // the next turn leaves through finish() above.
+        }
+        const std::uint32_t steps = countdown_before - countdown;
+        skip_countdown_ = countdown;
+        steps_ += steps;  // one per turn of the loop above, each one countdown
         if (__builtin_expect(stop_requested_, 0)) break;
     }
     avr_cycle_timer_cancel(avr, &horizon_timer, this);
+    run_target_ = 0;
     if (halted_) return StopReason::Halted;
     if (stop_requested_) {
         stop_requested_ = false;
@@ -243,6 +306,10 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
         ++resets_;
         // avr_reset() drops every cycle timer: put the scheduler's back.
         scheduler_->rearm();
+        // And the run's horizon: run_until's fast path counts on it.
+        if (avr_->cycle < run_target_) {
+            avr_cycle_timer_register(avr_, run_target_ - avr_->cycle, &horizon_timer, this);
+        }
         if (twi_) twi_->reset();
         for (auto& fn : reset_listeners_) fn();
         if (watchdog_reset_seen_) {
@@ -292,7 +359,7 @@ void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string deta
     if (halt) {
         halted_ = true;
         halt_reason_ = findings_.back().describe();
-        stop_requested_ = true;
+        request_stop();
     }
 }
 

@@ -80,7 +80,7 @@ public:
     StopReason run_for(Cycle cycles) { return run_until(cycle() + cycles); }
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
-    void request_stop() { stop_requested_ = true; }
+    void request_stop();
 
     // "PB5" (also "B5"). Throws BadInput for a port the MCU does not have.
     Pin& pin(std::string_view name);
@@ -130,6 +130,7 @@ private:
     std::unique_ptr<Twi> twi_;
     std::unique_ptr<IdleLoopSkipper> skipper_;  // nullptr: never skip
     std::uint32_t skip_countdown_ = 1;
+    Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
     std::vector<Finding> findings_;

@@ -17,7 +17,9 @@
 //
 // Why it is faster: avr_run calls the run loop through a function pointer
 // and the timer pool through a call on every instruction; here both are
-// inline or skipped (docs/PERFORMANCE.md).
+// inline or skipped, and Mcu::run_until's fast path reduces a step with
+// nothing due and nothing pending to avr_run_one and the new PC, handing
+// anything else to finish() (docs/PERFORMANCE.md).
 #pragma once
 
 extern "C" {
@@ -42,7 +44,19 @@ public:
         }
         avr_flashaddr_t new_pc = avr->pc;
         if (avr->state == cpu_Running) new_pc = avr_run_one(avr);
+        return finish(new_pc);
+    }
 
+    // True when the next steps may take the fast path of Mcu::run_until:
+    // simavr's raw loop, the core running, no interrupt on its way.
+    bool fast_path_open() const {
+        return raw_ && avr_->state == cpu_Running && avr_->interrupt_state == 0;
+    }
+
+    // The rest of step() after avr_run_one returned `new_pc`: the cycle
+    // timers (only when the first is due), the new PC, sleep, interrupts.
+    __attribute__((always_inline)) int finish(avr_flashaddr_t new_pc) {
+        avr_t* const avr = avr_;
         // avr_cycle_timer_process, or (nothing due) what it would return.
         const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
         const bool due = first == nullptr || first->when <= avr->cycle;
