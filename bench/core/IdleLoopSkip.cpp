@@ -20,6 +20,10 @@ constexpr std::uint32_t kMaxInterval = 65536;
 // A pass longer than this is not the kind of loop worth watching.
 constexpr std::uint32_t kMaxPassInstructions = 1024;
 constexpr std::size_t kMaxWrittenBytes = 64;
+// After a delay loop, how often and how many instructions apart to look for
+// it again before watching other code (an ISR is typically tens of instructions).
+constexpr unsigned kDelayLoopGraceLooks = 64;
+constexpr std::uint32_t kDelayLoopGraceInterval = 16;
 
 constexpr std::uint32_t kIoBase = 0x20;
 
@@ -71,9 +75,27 @@ std::uint32_t IdleLoopSkipper::give_up() {
 std::uint32_t IdleLoopSkipper::start_watching(std::uint64_t run_end_cycle) {
     avr_t* const avr = avr_;
     if (avr->state != cpu_Running || avr->interrupt_state != 0 || avr_has_pending_interrupts(avr)) return give_up();
-    if (skip_delay_loop(run_end_cycle)) {
+    switch (skip_delay_loop(run_end_cycle)) {
+    case DelayLoop::None:
+        // Just left a delay loop: most likely for an interrupt's service
+        // routine, and it comes back. Looking in a little while is cheaper
+        // than watching the routine pass by instruction by instruction.
+        if (in_delay_loop_ && delay_misses_ < kDelayLoopGraceLooks) {
+            ++delay_misses_;
+            return kDelayLoopGraceInterval;
+        }
+        in_delay_loop_ = false;
+        break;
+    case DelayLoop::AtItsBranch:
+        return 1;  // the loop's first instruction comes next
+    case DelayLoop::Skipped:
+    case DelayLoop::EventTooClose:
+        // Look again after one pass (two instructions): back at the loop's
+        // first instruction, past the event unless it was an interrupt.
+        in_delay_loop_ = true;
+        delay_misses_ = 0;
         backoff_ = kMinInterval;
-        return kMinInterval;
+        return 2;
     }
     head_pc_ = avr->pc;
     head_cycle_ = avr->cycle;
@@ -118,7 +140,7 @@ std::uint32_t IdleLoopSkipper::tick(std::uint64_t run_end_cycle) {
     return 1;
 }
 
-bool IdleLoopSkipper::skip_delay_loop(std::uint64_t run_end_cycle) {
+IdleLoopSkipper::DelayLoop IdleLoopSkipper::skip_delay_loop(std::uint64_t run_end_cycle) {
     // The two-instruction count-down loops of avr-libc's _delay_loop_1/2,
     // Arduino's delayMicroseconds and most hand-written delays (AVR
     // Instruction Set Manual: SBIW 2 cycles, DEC 1, BRNE 2 when taken):
@@ -129,11 +151,15 @@ bool IdleLoopSkipper::skip_delay_loop(std::uint64_t run_end_cycle) {
     // the flags are the ones that pass computes.
     avr_t* const avr = avr_;
     const std::uint32_t pc = avr->pc;
-    if (pc + 3 > avr->flashend) return false;
+    if (pc + 3 > avr->flashend) return DelayLoop::None;
     const unsigned op = avr->flash[pc] | (avr->flash[pc + 1] << 8);
     const unsigned next = avr->flash[pc + 2] | (avr->flash[pc + 3] << 8);
     constexpr unsigned kBrneBackTwoWords = 0xF7F1;  // brne .-4: 1111 01kk kkkk k001, k = -2
-    if (next != kBrneBackTwoWords) return false;
+    const auto counts_down = [](unsigned word) { return (word & 0xFFCF) == 0x9701 || (word & 0xFE0F) == 0x940A; };
+    if (op == kBrneBackTwoWords && pc >= 2 && counts_down(avr->flash[pc - 2] | (avr->flash[pc - 1] << 8))) {
+        return DelayLoop::AtItsBranch;
+    }
+    if (next != kBrneBackTwoWords) return DelayLoop::None;
     std::uint32_t count = 0;
     unsigned cycles_per_pass = 0;
     int low = -1;
@@ -150,22 +176,22 @@ bool IdleLoopSkipper::skip_delay_loop(std::uint64_t run_end_cycle) {
         if (count == 0) count = 0x100;
         cycles_per_pass = 3;
     } else {
-        return false;
+        return DelayLoop::None;
     }
     const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
     const std::uint64_t limit = std::min<std::uint64_t>(first != nullptr ? first->when : ~0ull, run_end_cycle);
-    if (avr->cycle >= limit) return false;
+    if (avr->cycle >= limit) return DelayLoop::EventTooClose;
     // Passes that come back here: count - 1 (the last falls through), and
     // only as many as end before the next event.
     const std::uint64_t passes = std::min<std::uint64_t>(count - 1, (limit - 1 - avr->cycle) / cycles_per_pass);
-    if (passes < 2) return false;
+    if (passes < 2) return DelayLoop::EventTooClose;
     const std::uint32_t left = count - static_cast<std::uint32_t>(passes - 1);
     avr->data[low] = static_cast<std::uint8_t>(left);
     if (word) avr->data[low + 1] = static_cast<std::uint8_t>(left >> 8);
     avr->cycle += (passes - 1) * cycles_per_pass;
     ++jumps_;
     cycles_skipped_ += (passes - 1) * cycles_per_pass;
-    return true;
+    return DelayLoop::Skipped;
 }
 
 bool IdleLoopSkipper::back_where_it_started() const {

@@ -52,7 +52,8 @@ private:
 
     std::uint32_t start_watching(std::uint64_t run_end_cycle);
     // A count-down delay loop at PC: skips its passes up to the next event.
-    bool skip_delay_loop(std::uint64_t run_end_cycle);
+    enum class DelayLoop : std::uint8_t { None, Skipped, EventTooClose, AtItsBranch };
+    DelayLoop skip_delay_loop(std::uint64_t run_end_cycle);
     std::uint32_t give_up();
     // Checks the instruction at PC before it runs; records what it will write.
     Access inspect_next_instruction();
@@ -73,6 +74,8 @@ private:
     std::vector<Written> written_;
     std::uint32_t watched_ = 0;
     std::uint32_t backoff_ = 0;
+    bool in_delay_loop_ = false;  // the last look found a delay loop
+    unsigned delay_misses_ = 0;   // looks since that found none
 
     std::uint64_t jumps_ = 0;
     std::uint64_t cycles_skipped_ = 0;
