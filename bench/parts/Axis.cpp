@@ -59,8 +59,29 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDrive
         }
         carriage_256_ = std::llround(start_m / metres_per_256_);
     }
-    sig_position_ = add_signal(rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? 0.0 : position_mm());
+    PartSignalInfo position;
+    position.name = rotary_ ? "angle_deg" : "position_mm";
+    position.real = true;
+    position.unit = rotary_ ? "deg" : "mm";
+    position.role = SignalRole::Position;
+    sig_position_ = add_signal(std::move(position), rotary_ ? 0.0 : position_mm());
     driver_.on_step([this](int delta) { on_step(delta); });
+}
+
+std::string Axis::summary() {
+    char line[200];
+    const StepDirDriver& d = driver_;
+    if (rotary_) {
+        std::snprintf(line, sizeof line, "axis %-5s %llu steps (%llu ignored while disabled), %.3f deg, peak %.0f steps/s",
+                      name().c_str(), static_cast<unsigned long long>(d.steps_taken()),
+                      static_cast<unsigned long long>(d.steps_ignored()), position_deg(), d.peak_step_rate_hz());
+    } else {
+        std::snprintf(line, sizeof line,
+                      "axis %-5s %llu steps (%llu ignored while disabled), at %.4f mm, peak %.0f steps/s", name().c_str(),
+                      static_cast<unsigned long long>(d.steps_taken()), static_cast<unsigned long long>(d.steps_ignored()),
+                      position_mm(), d.peak_step_rate_hz());
+    }
+    return line;
 }
 
 double Axis::position_steps() const {

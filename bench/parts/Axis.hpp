@@ -29,6 +29,7 @@ public:
     double position_deg() const;
     double travel_mm() const { return travel_m_ * 1e3; }
     std::uint64_t steps() const { return driver_.steps_taken(); }
+    std::string summary() override;
     unsigned crashes() const { return crashes_; }
 
     void on_move(std::function<void(double position_m)> fn) { move_listeners_.push_back(std::move(fn)); }

@@ -39,13 +39,22 @@ std::size_t Part::add_pin(std::string name, TerminalRole role) {
 }
 
 std::size_t Part::add_signal(std::string name, bool real, double initial) {
-    signal_infos_.push_back({std::move(name), real});
+    PartSignalInfo info;
+    info.name = std::move(name);
+    info.real = real;
+    return add_signal(std::move(info), initial);
+}
+
+std::size_t Part::add_signal(PartSignalInfo info, double initial) {
+    signal_infos_.push_back(std::move(info));
     signal_values_.push_back(initial);
+    signal_changes_.push_back(0);
     return signal_infos_.size() - 1;
 }
 
 void Part::publish(std::size_t signal, double value) {
     signal_values_[signal] = value;
+    ++signal_changes_[signal];
     const Cycle now = clock_->cycle();
     for (auto& fn : signal_listeners_) fn(signal, now, value);
 }

@@ -52,10 +52,25 @@ private:
     bool level_ = false;
 };
 
+// What a signal means to the views that show it (report plots, summaries),
+// so they find it by meaning rather than by part type or signal name.
+enum class SignalRole : std::uint8_t {
+    None,
+    Position,           // where a moving part is (unit "mm" or "deg")
+    Temperature,        // a body's temperature (degC)
+    SensorTemperature,  // what a temperature sensor on it reads (degC)
+    HeaterOn,           // a heater's gate (0/1), for the part in `concerns`
+    HeaterDuty,         // its duty over the last PWM period (0..1)
+    HeaterPower,        // its electrical power (W)
+};
+
 // A value a part exposes for tracing (a position, a temperature, a level).
 struct PartSignalInfo {
     std::string name;
     bool real = false;  // a real number, else a 0/1 wire
+    std::string unit;   // "mm", "deg", "degC", "W", ... ("" for none)
+    SignalRole role = SignalRole::None;
+    std::string concerns;  // the part this signal is about, when not its own (a heater's plant)
 };
 
 class Part {
@@ -96,12 +111,19 @@ public:
     // Signals for the trace recorder, and a subscription to their changes.
     const std::vector<PartSignalInfo>& signals() const { return signal_infos_; }
     double signal_value(std::size_t signal) const { return signal_values_[signal]; }
+    // How many times the signal was published since the start (0: never changed).
+    std::uint64_t signal_changes(std::size_t signal) const { return signal_changes_[signal]; }
+
+    // One line about the part's state for the run summary ("" for none);
+    // not const: a model may first catch up with the clock.
+    virtual std::string summary() { return {}; }
     using SignalListener = std::function<void(std::size_t signal, Cycle cycle, double value)>;
     void watch_signals(SignalListener fn) { signal_listeners_.push_back(std::move(fn)); }
 
 protected:
     std::size_t add_pin(std::string name, TerminalRole role);
     std::size_t add_signal(std::string name, bool real, double initial = 0);
+    std::size_t add_signal(PartSignalInfo info, double initial);
     void publish(std::size_t signal, double value);
 
     // Called when an injected fault takes effect ("none": repaired).
@@ -128,6 +150,7 @@ private:
     std::vector<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;
     std::vector<double> signal_values_;
+    std::vector<std::uint64_t> signal_changes_;
     std::vector<SignalListener> signal_listeners_;
     std::string fault_ = "none";
     std::vector<FaultEvent> fault_history_;

@@ -105,14 +105,29 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
 
-    sig_block_ = add_signal("block_degC", true, initial);
-    sig_sensor_ = add_signal("sensor_degC", true, initial);
+    PartSignalInfo block;
+    block.name = "block_degC";
+    block.real = true;
+    block.unit = "degC";
+    block.role = SignalRole::Temperature;
+    sig_block_ = add_signal(block, initial);
+    PartSignalInfo sensor = block;
+    sensor.name = "sensor_degC";
+    sensor.role = SignalRole::SensorTemperature;
+    sig_sensor_ = add_signal(sensor, initial);
     if (surface_ >= 0) sig_surface_ = add_signal("surface_degC", true, initial);
     sig_fan_ = add_signal("fan_speed", true, 0);
 
     if (filament_driver_ != nullptr) {
         filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
     }
+}
+
+std::string ThermalPlant::summary() {
+    char line[200];
+    std::snprintf(line, sizeof line, "thermal    %s: block %.2f degC, sensor %.2f degC, heater %.1f W now", name().c_str(),
+                  block_degC(), sensor_degC(), heater_power_W());
+    return line;
 }
 
 void ThermalPlant::start() {

@@ -36,6 +36,7 @@ public:
     ThermalPlant(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver* filament_driver = nullptr);
     std::string_view type() const override { return "thermal_plant"; }
     void start() override;
+    std::string summary() override;
 
     // Temperatures now (advances the model to the clock's current cycle).
     double block_degC();

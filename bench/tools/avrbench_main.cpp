@@ -391,23 +391,8 @@ int run_board_command(const RunArgs& args) {
         std::printf("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s\n", args.gcode.c_str(),
                     host->lines_acknowledged(), host->lines().size(), host->oks(), host->errors(), to_string(outcome));
     }
-    for (Axis* axis : board.parts_of_type<Axis>()) {
-        const StepDirDriver& d = axis->driver();
-        if (axis->rotary()) {
-            std::printf("  axis %-5s %llu steps (%llu ignored while disabled), %.3f deg, peak %.0f steps/s\n",
-                        axis->name().c_str(), static_cast<unsigned long long>(d.steps_taken()),
-                        static_cast<unsigned long long>(d.steps_ignored()), axis->position_deg(),
-                        d.peak_step_rate_hz());
-        } else {
-            std::printf("  axis %-5s %llu steps (%llu ignored while disabled), at %.4f mm, peak %.0f steps/s\n",
-                        axis->name().c_str(), static_cast<unsigned long long>(d.steps_taken()),
-                        static_cast<unsigned long long>(d.steps_ignored()), axis->position_mm(),
-                        d.peak_step_rate_hz());
-        }
-    }
-    for (ThermalPlant* plant : board.parts_of_type<ThermalPlant>()) {
-        std::printf("  thermal    %s: block %.2f degC, sensor %.2f degC, heater %.1f W now\n", plant->name().c_str(),
-                    plant->block_degC(), plant->sensor_degC(), plant->heater_power_W());
+    for (Part* part : board.parts()) {
+        if (const std::string line = part->summary(); !line.empty()) std::printf("  %s\n", line.c_str());
     }
     print_findings(findings);
     if (host != nullptr) {

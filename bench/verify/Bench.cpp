@@ -222,25 +222,45 @@ RunReport Bench::make_report(const std::string& title) const {
     Mcu& first = *board_->mcus().front();
     r.end_cycle = first.cycle();
     r.end_clock_hz = first.frequency_hz();
-    for (Axis* a : board_->parts_of_type<Axis>()) {
-        if (a->steps() == 0) continue;  // an axis that never moved has nothing to plot
-        const long id = timeline_.find(a->name(), a->rotary() ? "angle_deg" : "position_mm");
-        if (id >= 0) r.axes.push_back({a->name(), static_cast<SignalId>(id), a->rotary()});
+    // The report's plots come from what the parts' signals declare they are
+    // (PartSignalInfo::role), not from part types.
+    struct Declared {
+        Part* part;
+        const PartSignalInfo* info;
+        SignalId id;
+        std::size_t index;
+    };
+    std::vector<Declared> declared;
+    for (Part* p : board_->parts()) {
+        for (std::size_t i = 0; i < p->signals().size(); ++i) {
+            const PartSignalInfo& info = p->signals()[i];
+            if (info.role == SignalRole::None) continue;
+            const long id = timeline_.find(p->name(), info.name);
+            if (id >= 0) declared.push_back({p, &info, static_cast<SignalId>(id), i});
+        }
+    }
+    std::vector<Part*> plants;  // parts with a temperature, in board order
+    for (const Declared& d : declared) {
+        if (d.info->role == SignalRole::Position) {
+            // A position that never changed has nothing to plot.
+            if (d.part->signal_changes(d.index) > 0) r.axes.push_back({d.part->name(), d.id, d.info->unit == "deg"});
+        } else if (d.info->role == SignalRole::Temperature) {
+            plants.push_back(d.part);
+        }
     }
     // Temperature targets from the G-code the hosts sent: M104/M109 S.. set a
     // tool heater (T<n> picks the n-th plant that is not a bed), M140/M190 S..
     // the plant whose name contains "bed".
-    std::vector<ThermalPlant*> plants = board_->parts_of_type<ThermalPlant>();
-    std::vector<ThermalPlant*> tools;
-    ThermalPlant* bed = nullptr;
-    for (ThermalPlant* p : plants) {
+    std::vector<Part*> tools;
+    Part* bed = nullptr;
+    for (Part* p : plants) {
         if (p->name().find("bed") != std::string::npos) {
             if (bed == nullptr) bed = p;
         } else {
             tools.push_back(p);
         }
     }
-    std::map<const ThermalPlant*, std::vector<std::pair<double, double>>> targets;
+    std::map<const Part*, std::vector<std::pair<double, double>>> targets;
     for (const auto& [name, host] : hosts_) {
         const std::uint32_t hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
         for (const auto& e : host->transcript()) {
@@ -248,7 +268,7 @@ RunReport Bench::make_report(const std::string& title) const {
             const auto words = gcode_words(e.text);
             const auto m = words.find('M'), target = words.find('S');
             if (m == words.end() || target == words.end()) continue;
-            const ThermalPlant* plant = nullptr;
+            const Part* plant = nullptr;
             if (m->second == 140 || m->second == 190) {
                 plant = bed;
             } else if (m->second == 104 || m->second == 109) {
@@ -259,19 +279,15 @@ RunReport Bench::make_report(const std::string& title) const {
             if (plant != nullptr) targets[plant].emplace_back(static_cast<double>(e.cycle) / hz, target->second);
         }
     }
-    for (ThermalPlant* plant : plants) {
-        const long temperature = timeline_.find(plant->name(), "block_degC");
-        if (temperature < 0) continue;
+    for (Part* plant : plants) {
         TemperatureSeries series;
         series.name = plant->name();
-        series.temperature_degC = static_cast<SignalId>(temperature);
-        if (const long sensor = timeline_.find(plant->name(), "sensor_degC"); sensor >= 0) {
-            series.sensor_degC = static_cast<SignalId>(sensor);
-        }
-        for (Heater* heater : board_->parts_of_type<Heater>()) {
-            if (&heater->plant() != plant) continue;
-            if (const long on = timeline_.find(heater->name(), "on"); on >= 0) series.heater_on = static_cast<SignalId>(on);
-            if (const long duty = timeline_.find(heater->name(), "duty"); duty >= 0) series.duty = static_cast<SignalId>(duty);
+        for (const Declared& d : declared) {
+            if (d.part == plant && d.info->role == SignalRole::Temperature) series.temperature_degC = d.id;
+            if (d.part == plant && d.info->role == SignalRole::SensorTemperature) series.sensor_degC = d.id;
+            if (d.info->concerns != plant->name()) continue;
+            if (d.info->role == SignalRole::HeaterOn) series.heater_on = d.id;
+            if (d.info->role == SignalRole::HeaterDuty) series.duty = d.id;
         }
         series.target_steps = targets[plant];
         r.temperatures.push_back(series);
