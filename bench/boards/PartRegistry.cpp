@@ -5,6 +5,7 @@
 #include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
 #include "parts/PullResistor.hpp"
+#include "parts/RcServo.hpp"
 #include "parts/SerialPeer.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
@@ -76,7 +77,7 @@ const std::map<std::string, PartType>& part_types() {
     static const std::map<std::string, PartType> types = [] {
         std::map<std::string, PartType> m;
         for (PartType t : {simple_part_type<StepDirDriver>("step_dir_driver"), axis("linear"), axis("rotary"), limit_switch(), simple_part_type<PullResistor>("pull_resistor"),
-                           simple_part_type<SerialPeer>("serial_peer"), thermal_plant(),
+                           simple_part_type<SerialPeer>("serial_peer"), simple_part_type<RcServo>("rc_servo"), thermal_plant(),
                            on_plant<Heater>("heater"), on_plant<Thermistor>("thermistor"), on_plant<Fan>("fan")}) {
             m.emplace(t.name, std::move(t));
         }

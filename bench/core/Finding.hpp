@@ -32,6 +32,7 @@ enum class FindingKind {
     Overheat,            // a thermal plant passed its safe maximum temperature
     HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
     SerialFraming,       // a pin-level serial frame with a bad stop bit or edges off the bit grid
+    ServoPulseOutOfRange,  // an RC servo pulse wider or narrower than its calibrated range
 
     // Found by the nets (wiring/).
     NetContention,       // two outputs drive one net to opposite levels

@@ -6,11 +6,11 @@ namespace avrbench {
 
 SimavrFixes::SimavrFixes(avr_t* avr) {
     for (auto install : {&install_memory_guard, &install_virtual_sleep, &install_uart_framing,
-                         // peripherals (issue 4)
+                         // peripherals
                          &install_interrupt_timing, &install_external_interrupts, &install_port_pins,
                          &install_watchdog, &install_adc_conversion, &install_uart_transmitter,
                          &install_uart_ursel, &install_eeprom_timing,
-                         // timers (issue 4)
+                         // timers
                          &install_timer_flags, &install_timer_model}) {
         if (auto fix = install(avr)) fixes_.push_back(std::move(fix));
     }

@@ -62,6 +62,7 @@ enum class SignalRole : std::uint8_t {
     HeaterOn,           // a heater's gate (0/1), for the part in `concerns`
     HeaterDuty,         // its duty over the last PWM period (0..1)
     HeaterPower,        // its electrical power (W)
+    ServoAngle,         // an RC servo's horn angle (deg)
 };
 
 // A value a part exposes for tracing (a position, a temperature, a level).

@@ -246,6 +246,8 @@ RunReport Bench::make_report(const std::string& title) const {
             if (d.part->signal_changes(d.index) > 0) r.axes.push_back({d.part->name(), d.id, d.info->unit == "deg"});
         } else if (d.info->role == SignalRole::Temperature) {
             plants.push_back(d.part);
+        } else if (d.info->role == SignalRole::ServoAngle) {
+            r.servos.push_back({d.part->name(), d.id});
         }
     }
     // Temperature targets from the G-code the hosts sent: M104/M109 S.. set a

@@ -16,7 +16,7 @@ std::unique_ptr<Fix> install_virtual_sleep(avr_t* avr);
 // USART: no usleep on UCSRnA polls, no stdout echo, datasheet frame length.
 std::unique_ptr<Fix> install_uart_framing(avr_t* avr);
 
-// --- peripherals (issue 4): interrupts, ports, sleep, watchdog, ADC, USART, EEPROM
+// --- peripherals: interrupts, ports, sleep, watchdog, ADC, USART, EEPROM
 // Interrupt response 4/5 cycles, one instruction after RETI/SEI, exact
 // wake-up from SLEEP (+ response + start-up time), SLEEP with SE = 0 is a NOP.
 std::unique_ptr<Fix> install_interrupt_timing(avr_t* avr);
@@ -43,7 +43,7 @@ std::unique_ptr<Fix> install_uart_ursel(avr_t* avr);
 // after EEPE/EERE, EE_READY is a level interrupt.
 std::unique_ptr<Fix> install_eeprom_timing(avr_t* avr);
 
-// --- timers (issue 4)
+// --- timers
 // TIFRn write-one-to-clear by OUT/STS and by SBI (one bit); enabling TIMSKn
 // with the flag already set interrupts.
 std::unique_ptr<Fix> install_timer_flags(avr_t* avr);
