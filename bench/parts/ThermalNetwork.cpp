@@ -192,13 +192,27 @@ void ThermalNetwork::rebuild() const {
 
 void ThermalNetwork::rebuild_input() const {
     fill_b_vector(b_);
+    input_dirty_ = false;
+    for (const InputMemo& m : input_memo_) {
+        if (m.model == decompositions_ && m.ambient_degC == ambient_ && m.b.size() == b_.size() && m.b == b_) {
+            if (modal_) w_ = m.w;
+            loss_offset_ = m.loss_offset;
+            return;
+        }
+    }
     if (modal_) {
         if (w_.size() != b_.size()) w_.resize(b_.size());
         w_.noalias() = v_inv_ * b_;
     }
     loss_offset_ = 0;
     for (const auto& node : nodes_) loss_offset_ += node.ambient_g * ambient_;
-    input_dirty_ = false;
+    InputMemo& m = input_memo_[input_memo_next_];
+    input_memo_next_ = (input_memo_next_ + 1) % 2u;
+    m.b = b_;
+    m.w = w_;
+    m.loss_offset = loss_offset_;
+    m.ambient_degC = ambient_;
+    m.model = decompositions_;
 }
 
 void ThermalNetwork::advance(double dt_s) {
@@ -220,23 +234,39 @@ void ThermalNetwork::advance(double dt_s) {
         for (int j = 0; j < n; ++j) s += v_inv_(i, j) * x_[j];
         z[i] = s;
     }
+    const StepMemo* memo = nullptr;
+    for (const StepMemo& m : step_memo_) {
+        if (m.model == decompositions_ && m.dt_s == dt_s) memo = &m;
+    }
+    if (memo == nullptr) {
+        StepMemo& m = step_memo_[step_memo_next_];
+        step_memo_next_ = (step_memo_next_ + 1) % 2u;
+        m.dt_s = dt_s;
+        m.model = decompositions_;
+        for (int i = 0; i < n; ++i) {
+            const double l = lambda_(i);
+            const double x = l * dt_s;
+            double e, p1, p2;  // e^{λt}, ∫e^{λs}ds, ∫∫
+            if (std::abs(x) < 1e-3) {
+                e = std::exp(x);
+                p1 = dt_s * (1 + x * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24))));
+                p2 = dt_s * dt_s * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24 + x * (1.0 / 120))));
+            } else {
+                const double em1 = std::expm1(x);
+                e = em1 + 1;
+                p1 = em1 / l;
+                p2 = (p1 - dt_s) / l;
+            }
+            m.e[i] = e;
+            m.p1[i] = p1;
+            m.p2[i] = p2;
+        }
+        memo = &m;
+    }
     double lost = -loss_offset_ * dt_s;
     for (int i = 0; i < n; ++i) {
-        const double l = lambda_(i);
-        const double x = l * dt_s;
-        double e, p1, p2;  // e^{λt}, ∫e^{λs}ds, ∫∫
-        if (std::abs(x) < 1e-3) {
-            e = std::exp(x);
-            p1 = dt_s * (1 + x * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24))));
-            p2 = dt_s * dt_s * (1.0 / 2 + x * (1.0 / 6 + x * (1.0 / 24 + x * (1.0 / 120))));
-        } else {
-            const double em1 = std::expm1(x);
-            e = em1 + 1;
-            p1 = em1 / l;
-            p2 = (p1 - dt_s) / l;
-        }
-        zi[i] = p1 * z[i] + p2 * w_(i);  // ∫ z over the interval
-        z[i] = e * z[i] + p1 * w_(i);
+        zi[i] = memo->p1[i] * z[i] + memo->p2[i] * w_(i);  // ∫ z over the interval
+        z[i] = memo->e[i] * z[i] + memo->p1[i] * w_(i);
         lost += loss_row_(i) * zi[i];
     }
     for (int i = 0; i < n; ++i) {

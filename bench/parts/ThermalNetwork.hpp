@@ -103,6 +103,25 @@ private:
     mutable Eigen::VectorXd b_, lambda_, w_;
     mutable Eigen::RowVectorXd loss_row_;  // g_ambᵀ V: loss rate from modal coordinates
     mutable double loss_offset_ = 0;       // Σ g_amb · T_amb
+
+    // A heater's PWM alternates between two powers and two interval lengths:
+    // the last two inputs (b -> w, loss offset) and the last two intervals'
+    // modal coefficients are kept, keyed by the exact values they were
+    // computed from, so a repeat costs a comparison and gives the same bits.
+    struct InputMemo {
+        Eigen::VectorXd b, w;
+        double loss_offset = 0;
+        double ambient_degC = 0;
+        unsigned model = ~0u;  // decompositions_ when it was made
+    };
+    struct StepMemo {
+        double dt_s = -1;
+        unsigned model = ~0u;
+        std::array<double, kMaxNodes> e{}, p1{}, p2{};
+    };
+    mutable std::array<InputMemo, 2> input_memo_;
+    mutable std::array<StepMemo, 2> step_memo_;
+    mutable unsigned input_memo_next_ = 0, step_memo_next_ = 0;
 };
 
 }  // namespace avrbench
