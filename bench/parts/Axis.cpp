@@ -59,12 +59,8 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDrive
         }
         carriage_256_ = std::llround(start_m / metres_per_256_);
     }
-    PartSignalInfo position;
-    position.name = rotary_ ? "angle_deg" : "position_mm";
-    position.real = true;
-    position.unit = rotary_ ? "deg" : "mm";
-    position.role = SignalRole::Position;
-    sig_position_ = add_signal(std::move(position), rotary_ ? 0.0 : position_mm());
+    sig_position_ = add_signal({rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? "deg" : "mm", SignalRole::Position, ""},
+                               rotary_ ? 0.0 : position_mm());
     driver_.on_step([this](int delta) { on_step(delta); });
 }
 

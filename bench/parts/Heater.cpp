@@ -64,21 +64,9 @@ Heater::Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalP
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    PartSignalInfo on;
-    on.name = "on";
-    on.role = SignalRole::HeaterOn;
-    on.concerns = plant_.name();
-    sig_on_ = add_signal(on, 0);
-    PartSignalInfo duty = on;
-    duty.name = "duty";
-    duty.real = true;
-    duty.role = SignalRole::HeaterDuty;
-    sig_duty_ = add_signal(duty, 0);
-    PartSignalInfo power = duty;
-    power.name = "power_W";
-    power.unit = "W";
-    power.role = SignalRole::HeaterPower;
-    sig_power_ = add_signal(power, 0);
+    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant_.name()}, 0);
+    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant_.name()}, 0);
+    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant_.name()}, 0);
 }
 
 void Heater::start() {

@@ -39,10 +39,7 @@ std::size_t Part::add_pin(std::string name, TerminalRole role) {
 }
 
 std::size_t Part::add_signal(std::string name, bool real, double initial) {
-    PartSignalInfo info;
-    info.name = std::move(name);
-    info.real = real;
-    return add_signal(std::move(info), initial);
+    return add_signal({std::move(name), real, "", SignalRole::None, ""}, initial);
 }
 
 std::size_t Part::add_signal(PartSignalInfo info, double initial) {

@@ -63,20 +63,9 @@ RcServo::RcServo(std::string name, Mcu& clock, const ParamValues& params)
     from_deg_ = target_deg_ = std::clamp(initial, table_.front().deg, table_.back().deg);
     signal_pin_ = add_pin("signal", TerminalRole::Input);
 
-    PartSignalInfo angle;
-    angle.name = "angle_deg";
-    angle.real = true;
-    angle.unit = "deg";
-    angle.role = SignalRole::ServoAngle;
-    sig_angle_ = add_signal(angle, from_deg_);
-    PartSignalInfo target = angle;
-    target.name = "target_deg";
-    target.role = SignalRole::None;
-    sig_target_ = add_signal(target, target_deg_);
-    PartSignalInfo pulse = target;
-    pulse.name = "pulse_us";
-    pulse.unit = "us";
-    sig_pulse_ = add_signal(pulse, 0);
+    sig_angle_ = add_signal({"angle_deg", true, "deg", SignalRole::ServoAngle, ""}, from_deg_);
+    sig_target_ = add_signal({"target_deg", true, "deg", SignalRole::None, ""}, target_deg_);
+    sig_pulse_ = add_signal({"pulse_us", true, "us", SignalRole::None, ""}, 0);
 }
 
 double RcServo::angle_for_pulse_us(double width_us) const {
