@@ -4,6 +4,7 @@
 #include <set>
 
 #include "boards/PartRegistry.hpp"
+#include "core/Adc.hpp"
 #include "core/Units.hpp"
 
 namespace avrbench {
@@ -61,8 +62,9 @@ void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
 }
 
 void Board::build_parts() {
-    // Each part is clocked by the MCU its nets lead to, else by the part it
-    // refers to, else by the board's first MCU.
+    // Each part is clocked by the MCU its nets lead to: directly (a pin or an
+    // analog output on a net with an MCU pin), else through port nets from a
+    // part that is; else by the board's first MCU.
     std::map<std::string, Mcu*> clock_of;
     for (const auto& net : spec_.nets) {
         Mcu* net_mcu = nullptr;
@@ -74,126 +76,173 @@ void Board::build_parts() {
             if (spec_.find_part(e.owner) != nullptr && clock_of.count(e.owner) == 0) clock_of[e.owner] = net_mcu;
         }
     }
-
-    // A part with an analog input (adc_pin: mcu.PIN, a thermistor) is clocked
-    // by that MCU: its ADC samples the part.
-    for (const auto& decl : spec_.parts) {
-        const RawParam* raw = find_param(decl, "adc_pin");
-        if (raw == nullptr || clock_of.count(decl.name) != 0) continue;
-        const auto dot = raw->value.find('.');
-        if (dot != std::string::npos && spec_.find_mcu(raw->value.substr(0, dot)) != nullptr) {
-            clock_of[decl.name] = &mcu(raw->value.substr(0, dot));
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (const auto& net : spec_.nets) {
+            Mcu* shared = nullptr;
+            for (const auto& e : net.endpoints) {
+                auto it = clock_of.find(e.owner);
+                if (it != clock_of.end()) {
+                    shared = it->second;
+                    break;
+                }
+            }
+            if (shared == nullptr) continue;
+            for (const auto& e : net.endpoints) {
+                if (spec_.find_part(e.owner) != nullptr && clock_of.emplace(e.owner, shared).second) changed = true;
+            }
         }
     }
 
-    std::map<std::string, Part*> built;
-    std::set<std::string> pending;
-    for (const auto& d : spec_.parts) pending.insert(d.name);
-    while (!pending.empty()) {
-        bool progress = false;
-        for (const auto& decl : spec_.parts) {
-            if (pending.count(decl.name) == 0) continue;
-            auto type_it = part_types().find(decl.type);
-            if (type_it == part_types().end()) {
-                throw BadInput(decl.location + ": part '" + decl.name + "': unknown part type '" + decl.type +
-                               "' (known: " + known_types() + ")");
-            }
-            const PartType& type = type_it->second;
-            // References must name declared parts of the right type; wait
-            // until those are built.
-            bool ready = true;
-            Mcu* referenced_clock = nullptr;
-            for (const auto& [param, allowed] : type.references) {
-                const RawParam* raw = find_param(decl, param);
-                if (raw == nullptr) continue;  // resolve_params reports the missing required one
-                const PartDecl* target = spec_.find_part(raw->value);
-                if (target == nullptr) {
-                    throw BadInput(raw->location + ": part '" + decl.name + "': " + param + " '" + raw->value +
-                                   "' is not a part of this board");
-                }
-                bool type_ok = false;
-                for (const auto& a : allowed) type_ok = type_ok || a == target->type;
-                if (!type_ok) {
-                    throw BadInput(raw->location + ": part '" + decl.name + "': " + param + " '" + raw->value +
-                                   "' is a " + target->type + ", expected " + allowed.front());
-                }
-                auto b = built.find(raw->value);
-                if (b == built.end()) {
-                    ready = false;
-                } else if (referenced_clock == nullptr) {
-                    referenced_clock = &b->second->clock();
-                }
-            }
-            if (!ready) continue;
-
-            std::map<std::string, std::string> preset = type.implied;
-            if (!type.presets.empty()) {
-                const RawParam* raw = find_param(decl, "preset");
-                std::string preset_name = raw != nullptr ? raw->value : "";
-                if (preset_name.empty()) {
-                    for (const auto& spec : type.params) {
-                        if (spec.name == "preset") preset_name = spec.default_value;
-                    }
-                }
-                auto p = type.presets.find(preset_name);
-                if (p != type.presets.end()) {
-                    for (const auto& [k, v] : p->second) preset[k] = v;
-                }
-            }
-            const ParamValues values = resolve_params(type.params, preset, decl.params, decl.name, decl.location);
-            Mcu* clock = clock_of.count(decl.name) ? clock_of[decl.name]
-                         : referenced_clock != nullptr ? referenced_clock
-                                                       : mcus_.front().get();
-            auto lookup = [&built](const std::string& n) -> Part& { return *built.at(n); };
-            try {
-                parts_.push_back(type.build(decl.name, *clock, values, lookup));
-            } catch (const BadInput& e) {
-                throw BadInput(decl.location + ": " + e.what());
-            }
-            built[decl.name] = parts_.back().get();
-            pending.erase(decl.name);
-            progress = true;
+    for (const auto& decl : spec_.parts) {
+        auto type_it = part_types().find(decl.type);
+        if (type_it == part_types().end()) {
+            throw BadInput(decl.location + ": part '" + decl.name + "': unknown part type '" + decl.type +
+                           "' (known: " + known_types() + ")");
         }
-        if (!progress) {
-            const PartDecl* stuck = spec_.find_part(*pending.begin());
-            throw BadInput(stuck->location + ": part '" + stuck->name + "' is part of a circular reference");
+        const PartType& type = type_it->second;
+        std::map<std::string, std::string> preset = type.implied;
+        if (!type.presets.empty()) {
+            const RawParam* raw = find_param(decl, "preset");
+            std::string preset_name = raw != nullptr ? raw->value : "";
+            if (preset_name.empty()) {
+                for (const auto& spec : type.params) {
+                    if (spec.name == "preset") preset_name = spec.default_value;
+                }
+            }
+            auto p = type.presets.find(preset_name);
+            if (p != type.presets.end()) {
+                for (const auto& [k, v] : p->second) preset[k] = v;
+            }
+        }
+        const ParamValues values = resolve_params(type.params, preset, decl.params, decl.name, decl.location);
+        auto clock = clock_of.find(decl.name);
+        try {
+            parts_.push_back(type.build(decl.name, clock != clock_of.end() ? *clock->second : *mcus_.front(), values));
+        } catch (const BadInput& e) {
+            throw BadInput(decl.location + ": " + e.what());
         }
     }
 }
 
+namespace {
+
+std::string pins_and_ports(Part& p) {
+    std::string list;
+    for (std::size_t i = 0; i < p.pin_count(); ++i) list += (list.empty() ? "" : ", ") + p.pin(i).name();
+    std::string ports;
+    for (std::size_t i = 0; i < p.port_count(); ++i) {
+        ports += (ports.empty() ? "" : ", ") + p.port(i).name + " (" + std::string(port_kind_name(p.port(i).kind)) +
+                 (p.port(i).provides ? "" : " in") + ")";
+    }
+    return "pins: " + (list.empty() ? std::string("none") : list) + "; ports: " + (ports.empty() ? "none" : ports);
+}
+
+}  // namespace
+
 void Board::build_nets() {
+    // A port that requires a kind, joined to the part that provides it.
+    struct PortLink {
+        Part* part;
+        std::size_t port;
+        Part* provider;
+    };
+    std::vector<PortLink> links;
     for (const auto& decl : spec_.nets) {
-        auto net = std::make_unique<Net>(decl.name);
-        std::vector<std::string> drivers;
+        struct PortEnd {
+            Part* part;
+            std::size_t port;
+            const Endpoint* endpoint;
+        };
+        std::vector<PortEnd> ports;
+        std::vector<const Endpoint*> pins;
         for (const auto& e : decl.endpoints) {
             if (spec_.find_mcu(e.owner) != nullptr) {
-                Mcu& m = mcu(e.owner);
-                Pin* pin = nullptr;
-                try {
-                    pin = &m.pin(e.pin);
-                } catch (const BadInput& err) {
-                    throw BadInput(e.location + ": " + err.what());
-                }
-                add_mcu_terminal(m, *pin, *net);
+                pins.push_back(&e);
                 continue;
             }
             Part& p = part(e.owner);
-            PartPin* pin = p.find_pin(e.pin);
-            if (pin == nullptr) {
-                std::string list;
-                for (std::size_t i = 0; i < p.pin_count(); ++i) list += (list.empty() ? "" : ", ") + p.pin(i).name();
-                throw BadInput(e.location + ": part '" + p.name() + "' (" + std::string(p.type()) + ") has no pin '" +
-                               e.pin + "' (pins: " + list + ")");
+            std::size_t index = 0;
+            if (p.find_pin(e.pin) != nullptr) {
+                pins.push_back(&e);
+            } else if (p.find_port(e.pin, &index) != nullptr) {
+                ports.push_back({&p, index, &e});
+            } else {
+                throw BadInput(e.location + ": part '" + p.name() + "' (" + std::string(p.type()) + ") has no pin or port '" +
+                               e.pin + "' (" + pins_and_ports(p) + ")");
             }
-            if (pin->role() == TerminalRole::Output) drivers.push_back(e.text());
-            net->connect(*pin);
         }
-        if (drivers.size() > 1) {
-            throw BadInput(decl.location + ": net '" + decl.name + "' is driven by two outputs: " + drivers[0] + " and " +
-                           drivers[1]);
+        if (ports.empty()) {
+            build_electrical_net(decl);
+            continue;
         }
-        nets_.push_back(std::move(net));
+        // Ports of one kind, exactly one of them providing it.
+        const PortInfo& first = ports.front().part->port(ports.front().port);
+        const PortEnd* provider = nullptr;
+        for (const PortEnd& end : ports) {
+            const PortInfo& info = end.part->port(end.port);
+            if (info.kind != first.kind) {
+                throw BadInput(decl.location + ": net '" + decl.name + "' joins a " + std::string(port_kind_name(first.kind)) +
+                               " port (" + ports.front().endpoint->text() + ") and a " +
+                               std::string(port_kind_name(info.kind)) + " port (" + end.endpoint->text() + ")");
+            }
+            if (!info.provides) continue;
+            if (provider != nullptr) {
+                throw BadInput(decl.location + ": net '" + decl.name + "' has two " +
+                               std::string(port_kind_name(info.kind)) + " providers: " + provider->endpoint->text() +
+                               " and " + end.endpoint->text());
+            }
+            provider = &end;
+        }
+        if (provider == nullptr) {
+            throw BadInput(decl.location + ": net '" + decl.name + "' has no part providing its " +
+                           std::string(port_kind_name(first.kind)) + " port (" + ports.front().endpoint->text() +
+                           " needs one, e.g. " + (first.kind == PortKind::Thermal   ? "a thermal_plant's body"
+                                                  : first.kind == PortKind::Steps   ? "a step_dir_driver's steps"
+                                                  : first.kind == PortKind::Carriage ? "a linear axis' carriage"
+                                                  : first.kind == PortKind::Windings ? "an l293d's windings"
+                                                                                     : "an analog output") +
+                           ")");
+        }
+        if (first.kind == PortKind::Analog) {
+            build_analog_net(decl, *provider->part, provider->port, pins);
+            continue;
+        }
+        if (!pins.empty()) {
+            throw BadInput(pins.front()->location + ": net '" + decl.name + "' joins the pin " + pins.front()->text() +
+                           " and the " + std::string(port_kind_name(first.kind)) + " port " +
+                           provider->endpoint->text() + ": only analog outputs share a net with pins");
+        }
+        for (const PortEnd& end : ports) {
+            if (&end != provider) links.push_back({end.part, end.port, provider->part});
+        }
     }
+
+    // Ports are connected part by part in declaration order (the order
+    // listeners are called in), then every required one must be.
+    for (auto& p : parts_) {
+        for (std::size_t port = 0; port < p->port_count(); ++port) {
+            const PortInfo& info = p->port(port);
+            const PortLink* link = nullptr;
+            for (const auto& l : links) {
+                if (l.part == p.get() && l.port == port) link = &l;
+            }
+            const std::string location = spec_.find_part(p->name())->location;
+            if (link == nullptr) {
+                if (info.required) {
+                    throw BadInput(location + ": part '" + p->name() + "' (" + std::string(p->type()) + "): port '" +
+                                   info.name + "' is not connected: join it to " + info.help + " in nets:");
+                }
+                continue;
+            }
+            try {
+                p->connect_port(port, *link->provider);
+            } catch (const BadInput& e) {
+                throw BadInput(location + ": " + e.what());
+            }
+        }
+    }
+
     for (auto& n : nets_) {
         // Findings of a net carry the cycle of an MCU on it (else the board's first).
         Mcu* clock = mcus_.front().get();
@@ -208,6 +257,58 @@ void Board::build_nets() {
     build_twi_buses();
     for (auto& p : parts_) p->start();
     for (auto& n : nets_) n->settle();
+}
+
+void Board::build_electrical_net(const NetDecl& decl) {
+    auto net = std::make_unique<Net>(decl.name);
+    std::vector<std::string> drivers;
+    for (const auto& e : decl.endpoints) {
+        if (spec_.find_mcu(e.owner) != nullptr) {
+            Mcu& m = mcu(e.owner);
+            Pin* pin = nullptr;
+            try {
+                pin = &m.pin(e.pin);
+            } catch (const BadInput& err) {
+                throw BadInput(e.location + ": " + err.what());
+            }
+            add_mcu_terminal(m, *pin, *net);
+            continue;
+        }
+        PartPin* pin = part(e.owner).find_pin(e.pin);
+        if (pin->role() == TerminalRole::Output) drivers.push_back(e.text());
+        net->connect(*pin);
+    }
+    if (drivers.size() > 1) {
+        throw BadInput(decl.location + ": net '" + decl.name + "' is driven by two outputs: " + drivers[0] + " and " +
+                       drivers[1]);
+    }
+    nets_.push_back(std::move(net));
+}
+
+void Board::build_analog_net(const NetDecl& decl, Part& source, std::size_t port,
+                             const std::vector<const Endpoint*>& pins) {
+    // The ADC of every MCU pin on the net samples the output's voltage, at
+    // the start of each conversion. The output answers in its own clock's
+    // cycles, so it must be clocked by that MCU.
+    for (const Endpoint* e : pins) {
+        if (spec_.find_mcu(e->owner) == nullptr) {
+            throw BadInput(e->location + ": net '" + decl.name + "' joins the analog output " + source.name() + "." +
+                           source.port(port).name + " and the digital pin " + e->text() +
+                           ": an analog net holds MCU pins only");
+        }
+        Mcu& m = mcu(e->owner);
+        if (&m != &source.clock()) {
+            throw BadInput(e->location + ": " + source.name() + "." + source.port(port).name + " is clocked by MCU '" +
+                           source.clock().name() + "' and cannot also be sampled by '" + m.name() + "'");
+        }
+        int channel = 0;
+        try {
+            channel = m.adc().channel_for_pin(e->pin);
+        } catch (const BadInput& err) {
+            throw BadInput(e->location + ": " + err.what());
+        }
+        m.adc().connect(channel, [&source, port](Cycle cycle) { return source.analog_volts(port, cycle); });
+    }
 }
 
 Net* Board::net_of(Mcu& mcu, const std::string& pin_name) const {

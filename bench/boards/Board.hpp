@@ -79,6 +79,8 @@ private:
     void build_mcus(const std::map<std::string, std::string>& firmware);
     void build_parts();
     void build_nets();
+    void build_electrical_net(const NetDecl& decl);
+    void build_analog_net(const NetDecl& decl, Part& source, std::size_t port, const std::vector<const Endpoint*>& pins);
     void build_twi_buses();
     Net* net_of(Mcu& mcu, const std::string& pin_name) const;
     McuPinTerminal& add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net);

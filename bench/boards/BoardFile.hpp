@@ -8,9 +8,10 @@
 //     uno: {type: atmega328p, clock: 16MHz}
 //   parts:
 //     x_driver: {type: step_dir_driver, preset: a4988, microsteps: 16}
-//     x: {type: linear_axis, driver: x_driver, steps_per_mm: 250, travel: 200mm}
+//     x: {type: linear_axis, steps_per_mm: 250, travel: 200mm}
 //   nets:
 //     x_step: [uno.PD2, x_driver.step]
+//     x_motion: [x_driver.steps, x.drive]       # a port net (parts/Part.hpp)
 //   serial:
 //     host: {mcu: uno, usart: 0, flow: character_counting, rx_buffer: 128}
 //   labels:

@@ -1,5 +1,6 @@
-// The part types a board file may name: for each, its parameters, presets,
-// the other parts it refers to, and how to build it.
+// The part types a board file may name: for each, its parameters, presets
+// and how to build it. A part's pins and ports are its own (Part); the
+// board's nets connect them.
 #pragma once
 
 #include <functional>
@@ -20,23 +21,17 @@ struct PartType {
     std::map<std::string, std::map<std::string, std::string>> presets;
     // Fixed values this type name implies (linear_axis -> kind: linear).
     std::map<std::string, std::string> implied;
-    // Parameters that name other parts, with the part type they must have.
-    std::map<std::string, std::vector<std::string>> references;
-    using Lookup = std::function<Part&(const std::string& name)>;
-    std::function<std::unique_ptr<Part>(const std::string& name, Mcu& clock, const ParamValues& params,
-                                        const Lookup& lookup)>
-        build;
+    std::function<std::unique_ptr<Part>(const std::string& name, Mcu& clock, const ParamValues& params)> build;
 };
 
-// A part type built from its parameters alone (no references to other parts),
-// with the part's presets if it has any.
+// A part type built from its parameters, with the part's presets if it has any.
 template <class T>
 PartType simple_part_type(const std::string& type_name) {
     PartType t;
     t.name = type_name;
     t.params = T::param_specs();
     if constexpr (requires { T::presets(); }) t.presets = T::presets();
-    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params, const PartType::Lookup&) {
+    t.build = [](const std::string& name, Mcu& clock, const ParamValues& params) {
         return std::make_unique<T>(name, clock, params);
     };
     return t;

@@ -10,7 +10,6 @@ namespace avrbench {
 std::vector<ParamSpec> Axis::param_specs() {
     using PT = ParamType;
     return {
-        {"driver", PT::Text, Dimension::Dimensionless, true, "", {}, "", "the step_dir_driver part that moves it"},
         {"kind", PT::Choice, Dimension::Dimensionless, false, "linear", {"linear", "rotary"}, "", ""},
         // 1e-3..1e6: a 1 mm lead screw at 1/256 of 200 steps is 51 200 steps/mm.
         {"steps_per_mm", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
@@ -23,9 +22,8 @@ std::vector<ParamSpec> Axis::param_specs() {
     };
 }
 
-Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver& driver)
-    : Part(std::move(name), clock), driver_(driver), rotary_(params.text("kind") == "rotary") {
-    const double microsteps = driver.configured_microsteps();
+Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
+    : Part(std::move(name), clock), rotary_(params.text("kind") == "rotary") {
     if (rotary_) {
         if (!params.has("steps_per_rev")) throw BadInput("part '" + this->name() + "': a rotary axis needs steps_per_rev");
         const double steps_per_rev = params.quantity("steps_per_rev");
@@ -33,9 +31,7 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDrive
         if (!(steps_per_rev > 0 && steps_per_rev <= 1e7)) {
             throw BadInput("part '" + this->name() + "': steps_per_rev must be above 0 and at most 1e7");
         }
-        // One 1/256 full step is (256 / microsteps)^-1 of a configured step.
-        radians_per_256_ = 2.0 * 3.14159265358979323846 / steps_per_rev * microsteps / 256.0;
-        metres_per_256_ = 0;
+        steps_per_unit_ = steps_per_rev;
     } else {
         if (!params.has("steps_per_mm")) throw BadInput("part '" + this->name() + "': a linear axis needs steps_per_mm");
         if (!params.has("travel")) throw BadInput("part '" + this->name() + "': a linear axis needs travel");
@@ -48,25 +44,36 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDrive
         if (!(params.quantity("travel") > 0 && params.quantity("travel") <= 100)) {
             throw BadInput("part '" + this->name() + "': travel must be longer than 0 and at most 100 m");
         }
-        const double steps_per_m = steps_per_mm * 1e3;
-        metres_per_256_ = microsteps / 256.0 / steps_per_m;
-        radians_per_256_ = 0;
+        steps_per_unit_ = steps_per_mm * 1e3;
         travel_m_ = params.quantity("travel");
-        travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
-        const double start_m = params.quantity("start_position");
-        if (start_m < 0 || start_m > travel_m_) {
+        start_m_ = params.quantity("start_position");
+        if (start_m_ < 0 || start_m_ > travel_m_) {
             throw BadInput("part '" + this->name() + "': start_position outside 0..travel");
         }
-        carriage_256_ = std::llround(start_m / metres_per_256_);
+        provide_port("carriage", PortKind::Carriage, "the carriage position limit switches watch");
+    }
+    require_port("drive", PortKind::Steps, true, "a step_dir_driver's steps");
+}
+
+void Axis::connect_port(std::size_t, Part& provider) {
+    driver_ = &dynamic_cast<StepDirDriver&>(provider);
+    // Steps are counted in 1/256 full steps: one is (256 / microsteps)^-1 of a configured step.
+    const double microsteps = driver_->configured_microsteps();
+    if (rotary_) {
+        radians_per_256_ = 2.0 * 3.14159265358979323846 / steps_per_unit_ * microsteps / 256.0;
+    } else {
+        metres_per_256_ = microsteps / 256.0 / steps_per_unit_;
+        travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
+        carriage_256_ = std::llround(start_m_ / metres_per_256_);
     }
     sig_position_ = add_signal({rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? "deg" : "mm", SignalRole::Position, ""},
                                rotary_ ? 0.0 : position_mm());
-    driver_.on_step([this](int delta) { on_step(delta); });
+    driver_->on_step([this](int delta) { on_step(delta); });
 }
 
 std::string Axis::summary() {
     char line[200];
-    const StepDirDriver& d = driver_;
+    const StepDirDriver& d = *driver_;
     if (rotary_) {
         std::snprintf(line, sizeof line, "axis %-5s %llu steps (%llu ignored while disabled), %.3f deg, peak %.0f steps/s",
                       name().c_str(), static_cast<unsigned long long>(d.steps_taken()),
@@ -81,7 +88,7 @@ std::string Axis::summary() {
 }
 
 double Axis::position_steps() const {
-    return static_cast<double>(driver_.position_256()) * driver_.configured_microsteps() / 256.0;
+    return static_cast<double>(driver_->position_256()) * driver_->configured_microsteps() / 256.0;
 }
 
 double Axis::position_deg() const { return angle_rad_ * 180.0 / 3.14159265358979323846; }

@@ -1,5 +1,6 @@
 // A stepper driver on a linear axis (steps/mm, travel) or a rotary axis
-// (steps/rev). Tracks the commanded steps and the carriage position; driving
+// (steps/rev): port `drive` requires a step_dir_driver's `steps`; a linear
+// axis provides `carriage` for limit switches. Tracks the commanded steps and the carriage position; driving
 // the carriage into either end of travel is a finding (a crash), and the
 // carriage stays at the end it hit, as a real one would.
 #pragma once
@@ -17,18 +18,19 @@ class Axis final : public Part {
 public:
     static std::vector<ParamSpec> param_specs();
 
-    Axis(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver& driver);
+    Axis(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return rotary_ ? "rotary_axis" : "linear_axis"; }
 
     bool rotary() const { return rotary_; }
-    StepDirDriver& driver() const { return driver_; }
+    StepDirDriver& driver() const { return *driver_; }
     // Net steps at the driver's configured resolution (signed).
     double position_steps() const;
     // Linear: carriage position in mm (0 .. travel). Rotary: degrees.
     double position_mm() const { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
     double position_deg() const;
     double travel_mm() const { return travel_m_ * 1e3; }
-    std::uint64_t steps() const { return driver_.steps_taken(); }
+    std::uint64_t steps() const { return driver_->steps_taken(); }
     std::string summary() override;
     unsigned crashes() const { return crashes_; }
 
@@ -37,10 +39,12 @@ public:
 private:
     void on_step(int delta_256);
 
-    StepDirDriver& driver_;
+    StepDirDriver* driver_ = nullptr;
     bool rotary_;
-    double metres_per_256_;  // carriage travel per 1/256 full step (linear)
-    double radians_per_256_;  // per 1/256 full step (rotary)
+    double steps_per_unit_ = 0;  // STEP pulses per metre (linear) or per revolution (rotary)
+    double start_m_ = 0;
+    double metres_per_256_ = 0;  // carriage travel per 1/256 full step (linear)
+    double radians_per_256_ = 0;  // per 1/256 full step (rotary)
     double travel_m_ = 0;
     // Carriage position in 1/256 full steps from the lower end: an integer,
     // so millions of steps do not accumulate rounding.
@@ -49,7 +53,7 @@ private:
     double angle_rad_ = 0;
     bool in_crash_ = false;
     unsigned crashes_ = 0;
-    std::size_t sig_position_;
+    std::size_t sig_position_ = 0;
     std::vector<std::function<void(double)>> move_listeners_;
 };
 

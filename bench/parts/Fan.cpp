@@ -12,7 +12,6 @@ std::vector<ParamSpec> Fan::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     return {
-        {"plant", PT::Text, D::Dimensionless, true, "", {}, "", "the thermal_plant it cools"},
         {"active", PT::Choice, D::Dimensionless, false, "high", {"high", "low"},
          "RAMPS 1.4 schematic: D9 drives the fan MOSFET gate, high = on", "drive level that runs the fan"},
         {"spin_time_constant", PT::Quantity, D::Time, false, "0.5s", {},
@@ -23,8 +22,7 @@ std::vector<ParamSpec> Fan::param_specs() {
     };
 }
 
-Fan::Fan(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant)
-    : Part(std::move(name), clock), plant_(plant) {
+Fan::Fan(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
     active_level_ = params.text("active") == "high";
     tau_s_ = params.quantity("spin_time_constant");
     const double interval = params.quantity("sample_interval");
@@ -34,7 +32,10 @@ Fan::Fan(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& 
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     pwm_pin_ = add_pin("pwm", TerminalRole::Input);
     sig_speed_ = add_signal("speed", true, 0);
+    require_port("body", PortKind::Thermal, true, "the thermal_plant it cools");
 }
+
+void Fan::connect_port(std::size_t, Part& provider) { plant_ = &dynamic_cast<ThermalPlant&>(provider); }
 
 void Fan::start() {
     last_cycle_ = clock().cycle();
@@ -83,8 +84,8 @@ void Fan::on_sample(Cycle scheduled) {
     // Within 1e-4 of its target the speed counts as there.
     const double target = driven_ ? 1.0 : 0.0;
     const double s = std::abs(speed_ - target) < 1e-4 ? target : speed_;
-    if (std::abs(s - plant_.fan_speed()) >= 1e-4 || (s == target && plant_.fan_speed() != target)) {
-        plant_.set_fan_speed(s);
+    if (std::abs(s - plant_->fan_speed()) >= 1e-4 || (s == target && plant_->fan_speed() != target)) {
+        plant_->set_fan_speed(s);
     }
     publish(sig_speed_, speed_);
     clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });

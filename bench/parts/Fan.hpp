@@ -22,7 +22,9 @@ public:
 
     static std::vector<ParamSpec> param_specs();
 
-    Fan(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant);
+    // Port `body` requires the thermal_plant it cools.
+    Fan(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "fan"; }
     void start() override;
 
@@ -38,7 +40,7 @@ private:
     void settle_speed();
     void on_sample(Cycle scheduled);
 
-    ThermalPlant& plant_;
+    ThermalPlant* plant_ = nullptr;
     std::size_t pwm_pin_;
     bool active_level_;
     double tau_s_;

@@ -13,7 +13,6 @@ std::vector<ParamSpec> Heater::param_specs() {
     return {
         {"preset", PT::Choice, D::Dimensionless, false, "cartridge_40w_12v",
          {"cartridge_40w_12v", "cartridge_40w_24v", "bed_12v", "custom"}, "", "heater element"},
-        {"plant", PT::Text, D::Dimensionless, true, "", {}, "", "the thermal_plant it heats"},
         {"node", PT::Choice, D::Dimensionless, false, "block", {"block", "surface"}, "", "the plant node it heats"},
         {"supply", PT::Quantity, D::Voltage, false, "", {}, "preset", "heater supply voltage"},
         {"resistance", PT::Quantity, D::Resistance, false, "", {}, "preset", "heater element resistance"},
@@ -41,8 +40,8 @@ const std::map<std::string, std::map<std::string, std::string>>& Heater::presets
     return table;
 }
 
-Heater::Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant)
-    : Part(std::move(name), clock), plant_(plant) {
+Heater::Heater(std::string name, Mcu& clock, const ParamValues& params)
+    : Part(std::move(name), clock), node_(params.text("node")) {
     if (!params.has("supply") || !params.has("resistance")) {
         throw BadInput("part '" + this->name() + "': a custom heater needs supply and resistance");
     }
@@ -55,18 +54,23 @@ Heater::Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalP
     // P = I^2 R with I = V / (R + R_series).
     power_on_W_ = v * v * r / ((r + rs) * (r + rs));
     gate_active_level_ = params.text("gate_active") == "high";
-    try {
-        source_ = plant_.add_heat_source(params.text("node"));
-    } catch (const BadInput& e) {
-        throw BadInput("part '" + this->name() + "': " + e.what());
-    }
     gate_pin_ = add_pin("gate", TerminalRole::Input);
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant_.name()}, 0);
-    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant_.name()}, 0);
-    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant_.name()}, 0);
+    require_port("body", PortKind::Thermal, true, "the thermal_plant it heats");
+}
+
+void Heater::connect_port(std::size_t, Part& provider) {
+    plant_ = &dynamic_cast<ThermalPlant&>(provider);
+    try {
+        source_ = plant_->add_heat_source(node_);
+    } catch (const BadInput& e) {
+        throw BadInput("part '" + name() + "': " + e.what());
+    }
+    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant_->name()}, 0);
+    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant_->name()}, 0);
+    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant_->name()}, 0);
 }
 
 void Heater::start() {
@@ -103,7 +107,7 @@ void Heater::update() {
     if (on_) on_total_ += now - on_since_;
     on_ = on;
     on_since_ = now;
-    plant_.set_heat_source_power(source_, on ? power_on_W_ : 0.0);
+    plant_->set_heat_source_power(source_, on ? power_on_W_ : 0.0);
     publish(sig_on_, on ? 1 : 0);
 }
 

@@ -26,12 +26,14 @@ public:
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 
-    Heater(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant);
+    // Port `body` requires a thermal_plant's `body`.
+    Heater(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "heater"; }
     void start() override;
 
     bool on() const { return on_; }
-    const ThermalPlant& plant() const { return plant_; }
+    const ThermalPlant& plant() const { return *plant_; }
     double power_on_W() const { return power_on_W_; }  // dissipation while on
     double power_W() const { return on_ ? power_on_W_ : 0.0; }
     // Energy dissipated since power-on (exact to the cycle), J.
@@ -48,9 +50,11 @@ private:
     void update();
     void on_sample(Cycle scheduled);
 
-    ThermalPlant& plant_;
-    int source_;
+    ThermalPlant* plant_ = nullptr;
+    std::string node_;
+    int source_ = -1;
     std::size_t gate_pin_;
+    std::size_t sig_on_ = 0, sig_duty_ = 0, sig_power_ = 0;
     bool gate_active_level_;
     double power_on_W_;
     Fault fault_state_ = Fault::None;
@@ -60,7 +64,6 @@ private:
     Cycle sample_cycles_;
     Cycle last_sample_ = 0;
     Cycle on_at_last_sample_ = 0;
-    std::size_t sig_on_, sig_duty_, sig_power_;
 };
 
 }  // namespace avrbench

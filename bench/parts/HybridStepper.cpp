@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
@@ -16,6 +17,17 @@ constexpr double kTwoPi = 2 * kPi;
 // the next equilibrium; the extra quarter turn keeps a rotor rocking on the
 // unstable point from counting slips back and forth.
 constexpr double kSlipThreshold = 1.25 * kPi;
+
+// "1,2" -> {1, 2}: a winding's plus and minus outputs on its bridge.
+std::pair<int, int> output_pair(const std::string& text, const std::string& part, const std::string& param) {
+    std::istringstream in(text);
+    int plus = 0, minus = 0;
+    char comma = 0;
+    if (!(in >> plus >> comma >> minus) || comma != ',' || !(in >> std::ws).eof()) {
+        throw BadInput("part '" + part + "': " + param + " '" + text + "' is not two outputs 'plus,minus' (e.g. 1,2)");
+    }
+    return {plus, minus};
+}
 
 HybridStepperModel::Params model_params(const ParamValues& p, const std::string& name) {
     HybridStepperModel::Params m;
@@ -82,8 +94,6 @@ std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
          "a stall event ends after this long without another pole slip"},
     };
     if (unipolar) {
-        specs.push_back({"switches", PT::Text, D::Dimensionless, true, "", {}, "",
-                         "the low_side_switch part switching the half-windings"});
         for (const char* c : {"a", "b", "c", "d"}) {
             specs.push_back({std::string("coil_") + c, PT::Integer, D::Dimensionless, false,
                              std::to_string(1 + (c[0] - 'a')), {}, "",
@@ -93,18 +103,11 @@ std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
                          "supply at the centre taps"});
         specs.push_back({"sense_resistor", PT::Quantity, D::Resistance, false, "0ohm", {},
                          "seed 001 §3.2: value absent", "R_sense per coil pair (A/C, B/D), 0 = none"});
-        specs.push_back({"sense_ac_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC0",
-                         "ADC channel of the clock MCU that sees the A/C sense voltage (-1: none)", -1, 15});
-        specs.push_back({"sense_bd_adc", PT::Integer, D::Dimensionless, false, "-1", {}, "seed 001: ADC1",
-                         "ADC channel that sees the B/D sense voltage (-1: none)", -1, 15});
     } else {
-        specs.push_back({"bridge", PT::Text, D::Dimensionless, false, "", {}, "", "the l293d part driving the windings"});
         specs.push_back({"phase_a", PT::Text, D::Dimensionless, false, "1,2", {}, "",
-                         "bridge outputs of winding A: plus,minus"});
+                         "bridge outputs of winding A: plus,minus (a step/dir driver: ignored)"});
         specs.push_back({"phase_b", PT::Text, D::Dimensionless, false, "3,4", {}, "",
-                         "bridge outputs of winding B: plus,minus"});
-        specs.push_back({"driver", PT::Text, D::Dimensionless, false, "", {}, "",
-                         "or: the step_dir_driver part driving the windings"});
+                         "bridge outputs of winding B: plus,minus (a step/dir driver: ignored)"});
     }
     return specs;
 }
@@ -168,8 +171,33 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
     if (unipolar_) {
         supply_v_ = params.quantity("supply");
         sense_ohm_ = params.quantity("sense_resistor");
-        sense_adc_[0] = static_cast<int>(params.integer("sense_ac_adc"));
-        sense_adc_[1] = static_cast<int>(params.integer("sense_bd_adc"));
+        // Winding order A, B, C (= A-), D (= B-): the centre tap at the
+        // supply, the half-winding's end on its switch channel.
+        for (const char* coil : {"coil_a", "coil_b", "coil_c", "coil_d"}) {
+            WindingTap tap;
+            tap.minus = static_cast<int>(params.integer(coil));
+            tap.supply_v = supply_v_;
+            tap.series_ohm = sense_ohm_;
+            taps_.push_back(tap);
+        }
+    } else {
+        for (int phase = 0; phase < 2; ++phase) {
+            const char* param = phase == 0 ? "phase_a" : "phase_b";
+            const auto [plus, minus] = output_pair(params.text(param), this->name(), param);
+            taps_.push_back({phase, plus, minus, 0, 0});
+        }
+    }
+    require_port("windings", PortKind::Windings, true,
+                 unipolar_ ? "a low_side_switch's windings" : "an l293d's or a step_dir_driver's windings");
+    if (unipolar_) {
+        for (int pair = 0; pair < 2; ++pair) {
+            provide_analog(pair == 0 ? "sense_ac" : "sense_bd",
+                           [this, pair](Cycle) {
+                               sync();
+                               return sense_voltage(pair);
+                           },
+                           pair == 0 ? "the A/C sense resistor's voltage" : "the B/D sense resistor's voltage");
+        }
     }
 
     sig_angle_ = add_signal("angle_deg", true);
@@ -190,28 +218,15 @@ void HybridStepper::listen(DriveSource& source) {
     source.on_drive_change([this] { on_drive_change(); });
 }
 
-void HybridStepper::attach(DriveSource& source, std::vector<std::function<WindingDrive()>> windings) {
-    if (windings.size() != model_.winding_count()) {
-        throw BadInput("part '" + name() + "': " + std::to_string(windings.size()) + " winding drives for " +
-                       std::to_string(model_.winding_count()) + " windings");
+void HybridStepper::connect_port(std::size_t, Part& provider) {
+    auto& source = dynamic_cast<DriveSource&>(provider);
+    for (const WindingTap& tap : taps_) {
+        const std::string problem = source.tap_problem(tap);
+        if (!problem.empty()) throw BadInput("part '" + name() + "': " + problem);
     }
     source_ = &source;
     angle_from_source_ = source.commands_angle();
-    sources_ = std::move(windings);
     listen(source);
-    for (int pair = 0; unipolar_ && pair < 2; ++pair) {
-        const int channel = sense_adc_[pair];
-        if (channel < 0) continue;
-        Adc& adc = clock().adc();
-        if (!adc.present() || channel >= adc.channel_count()) {
-            throw BadInput("part '" + name() + "': MCU '" + clock().name() + "' has no ADC channel " +
-                           std::to_string(channel));
-        }
-        adc.connect(channel, [this, pair](Cycle) {
-            sync();
-            return sense_voltage(pair);
-        });
-    }
 }
 
 void HybridStepper::start() {
@@ -248,7 +263,7 @@ double HybridStepper::sense_voltage(int pair) const {
 }
 
 void HybridStepper::refresh_drive() {
-    for (std::size_t k = 0; k < sources_.size(); ++k) model_.set_drive(k, sources_[k]());
+    for (std::size_t k = 0; k < taps_.size(); ++k) model_.set_drive(k, source_->winding_at(taps_[k]));
 }
 
 void HybridStepper::on_drive_change() {

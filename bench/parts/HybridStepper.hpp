@@ -46,10 +46,12 @@ public:
     std::string_view type() const override { return unipolar_ ? "unipolar_stepper" : "hybrid_stepper"; }
     void start() override;
 
-    // Wiring (the part registry calls it after construction): what drives
-    // the windings, and per winding (A, B; unipolar: A, B, C = A-, D = B-)
-    // the drive it imposes. The motor knows the interface, not the parts.
-    void attach(DriveSource& source, std::vector<std::function<WindingDrive()>> windings);
+    // Port `windings` requires what drives the windings (a DriveSource: the
+    // motor knows the interface, not the parts); per winding (A, B; unipolar:
+    // A, B, C = A-, D = B-) its tap on that source comes from phase_a/phase_b
+    // or coil_a..coil_d. A unipolar motor provides its sense resistors'
+    // voltages on analog ports `sense_ac` and `sense_bd`.
+    void connect_port(std::size_t port, Part& provider) override;
     std::size_t winding_count() const { return model_.winding_count(); }
     // Unipolar: the centre-tap supply and the sense resistor, for the switches' drives.
     double supply_v() const { return supply_v_; }
@@ -95,12 +97,11 @@ private:
     // What drives the windings, and one drive per winding.
     DriveSource* source_ = nullptr;
     bool angle_from_source_ = false;  // the source commands the angle (a step/dir driver)
-    std::vector<std::function<WindingDrive()>> sources_;
+    std::vector<WindingTap> taps_;
     double driver_offset_ = 0;  // 2*pi*m aligning the driver's angle with the rotor
 
     // Unipolar sense resistors.
     double supply_v_ = 0, sense_ohm_ = 0;
-    int sense_adc_[2] = {-1, -1};
 
     // The commanded (electrical) angle, from the excitation.
     bool have_command_ = false;

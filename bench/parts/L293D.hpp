@@ -37,6 +37,8 @@ public:
     Output output(int channel) const;
     // The drive of a winding wired from output `plus` to output `minus`.
     WindingDrive winding(int plus, int minus) const;
+    WindingDrive winding_at(const WindingTap& tap) const override { return winding(tap.plus, tap.minus); }
+    std::string tap_problem(const WindingTap& tap) const override;
     double supply_v() const { return supply_v_; }
 
 private:

@@ -12,7 +12,6 @@ namespace avrbench {
 std::vector<ParamSpec> LimitSwitch::param_specs() {
     using PT = ParamType;
     return {
-        {"axis", PT::Text, Dimension::Dimensionless, true, "", {}, "", "the axis whose carriage trips it"},
         {"side", PT::Choice, Dimension::Dimensionless, false, "min", {"min", "max"}, "",
          "min: trips at or below position; max: at or above"},
         {"position", PT::Quantity, Dimension::Length, false, "", {}, "",
@@ -37,9 +36,10 @@ std::vector<ParamSpec> LimitSwitch::param_specs() {
     };
 }
 
-LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params, Axis& axis)
+LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params)
     : Part(std::move(name), clock),
-      axis_(axis),
+      position_given_(params.has("position")),
+      position_m_(position_given_ ? params.quantity("position") : 0.0),
       min_side_(params.text("side") == "min"),
       hysteresis_m_(params.quantity("hysteresis")),
       normally_open_(params.text("contact") == "NO"),
@@ -53,21 +53,26 @@ LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params
                                                           "parameter 'bounce_edges'", 0, 1000))),
       rng_(static_cast<std::uint64_t>(checked_integer(static_cast<double>(params.integer("seed")), "parameter 'seed'", 0,
                                                       std::int64_t{1} << 53))) {
-    if (axis.rotary()) throw BadInput("part '" + this->name() + "': limit switches go on linear axes");
-    trip_m_ = params.has("position") ? params.quantity("position") : (min_side_ ? 0.0 : axis.travel_mm() * 1e-3);
-    if (trip_m_ < 0 || trip_m_ > axis.travel_mm() * 1e-3) {
-        throw BadInput("part '" + this->name() + "': position must lie within the axis' travel (0.." +
-                       std::to_string(axis.travel_mm()) + " mm)");
-    }
     out_pin_ = add_pin("out", TerminalRole::Output);
     sig_closed_ = add_signal("closed", false);
-    axis_.on_move([this](double position_m) { on_axis_move(position_m); });
+    require_port("axis", PortKind::Carriage, true, "a linear axis' carriage");
+}
+
+void LimitSwitch::connect_port(std::size_t, Part& provider) {
+    axis_ = &dynamic_cast<Axis&>(provider);
+    const double travel_m = axis_->travel_mm() * 1e-3;
+    trip_m_ = position_given_ ? position_m_ : (min_side_ ? 0.0 : travel_m);
+    if (trip_m_ < 0 || trip_m_ > travel_m) {
+        throw BadInput("part '" + name() + "': position must lie within the axis' travel (0.." +
+                       std::to_string(axis_->travel_mm()) + " mm)");
+    }
+    axis_->on_move([this](double position_m) { on_axis_move(position_m); });
 }
 
 bool LimitSwitch::contact_closed() const { return normally_open_ ? triggered_ : !triggered_; }
 
 void LimitSwitch::start() {
-    on_axis_move(axis_.position_mm() * 1e-3);
+    on_axis_move(axis_->position_mm() * 1e-3);
     apply_contact(contact_closed());
 }
 

@@ -1,4 +1,5 @@
-// A limit (end-stop) switch on an axis: trips at a position with hysteresis;
+// A limit (end-stop) switch on an axis (port `axis` requires a linear
+// axis' `carriage`): trips at a position with hysteresis;
 // NO or NC contact switched to GND or VCC; the level of the open contact comes
 // from a pull-up (the MCU's internal one, as the firmware sets it, or an
 // external resistor) or pull-down; optional contact bounce, deterministic from
@@ -18,7 +19,8 @@ class LimitSwitch final : public Part {
 public:
     static std::vector<ParamSpec> param_specs();
 
-    LimitSwitch(std::string name, Mcu& clock, const ParamValues& params, Axis& axis);
+    LimitSwitch(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "limit_switch"; }
 
     bool triggered() const { return triggered_; }
@@ -34,10 +36,12 @@ private:
     void set_contact(bool closed);
     void apply_contact(bool closed);
 
-    Axis& axis_;
+    Axis* axis_ = nullptr;
+    bool position_given_;
+    double position_m_;  // the trip position as given (default: the side's end)
     std::size_t out_pin_;
     bool min_side_;
-    double trip_m_, hysteresis_m_;
+    double trip_m_ = 0, hysteresis_m_;
     bool normally_open_;
     bool closed_level_;        // the output level with the contact closed
     std::string pull_;         // internal_up | external_up | external_down | none | push_pull

@@ -33,6 +33,15 @@ LowSideSwitch::LowSideSwitch(std::string name, Mcu& clock, const ParamValues& pa
         in_pins_.push_back(add_pin("in" + std::to_string(i), TerminalRole::Input));
         sig_on_.push_back(add_signal("on" + std::to_string(i), false));
     }
+    provide_port("windings", PortKind::Windings, "a unipolar motor's half-windings, one per channel");
+}
+
+std::string LowSideSwitch::tap_problem(const WindingTap& tap) const {
+    if (tap.minus < 1 || tap.minus > channels()) {
+        return "coil channel " + std::to_string(tap.minus) + " is not a channel of '" + name() + "' (1.." +
+               std::to_string(channels()) + ")";
+    }
+    return {};
 }
 
 void LowSideSwitch::start() {

@@ -34,6 +34,10 @@ public:
     // The drive of a winding from a supply of `supply_v` to this channel, with
     // `series_ohm` more in the switched path (a sense resistor).
     WindingDrive winding(int channel, double supply_v, double series_ohm) const;
+    WindingDrive winding_at(const WindingTap& tap) const override {
+        return winding(tap.minus, tap.supply_v, tap.series_ohm);
+    }
+    std::string tap_problem(const WindingTap& tap) const override;
 
 private:
     void on_input(std::size_t pin, bool level) override;

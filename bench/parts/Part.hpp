@@ -1,6 +1,14 @@
-// A model of one real component: its pins, parameters (with units and
-// sources), state, and how it evolves between pin events. A part knows nothing
-// of its neighbours; the board's nets connect its pins.
+// A model of one real component: its pins and ports, parameters (with units
+// and sources), state, and how it evolves between pin events. A part knows
+// nothing of its neighbours; the board's nets connect its pins and ports.
+//
+// Connections, one mechanism (docs/ARCHITECTURE.md "Connection model"): a
+// board net joins endpoints "owner.name". A digital pin (PartPin) joins MCU
+// pins and other part pins on an electrical net. Every other coupling is a
+// typed port: a part provides a port (a thermal body, a step output, winding
+// drives, an analog voltage) or requires one, and a net joins one provider
+// with the ports that require its kind. The board calls connect_port() on
+// the requiring part with the provider, before start().
 //
 // Time: a part is clocked by one MCU of the board (the one its nets lead to):
 // clock().cycle() is "now", clock().scheduler() schedules its own events.
@@ -52,6 +60,25 @@ private:
     bool level_ = false;
 };
 
+// What a non-digital port carries. Two ports can share a net only if they
+// have the same kind; the kind fixes the C++ interface the provider offers.
+enum class PortKind : std::uint8_t {
+    Analog,   // a voltage an MCU's ADC samples (provider: Part::analog_volts)
+    Steps,    // a step/dir driver's shaft motion (provider: StepDirDriver)
+    Carriage, // a linear axis' carriage position (provider: Axis)
+    Thermal,  // a thermal body heaters, sensors and fans couple to (ThermalPlant)
+    Windings, // motor winding drives (provider: DriveSource)
+};
+std::string_view port_kind_name(PortKind kind);
+
+struct PortInfo {
+    std::string name;
+    PortKind kind = PortKind::Analog;
+    bool provides = false;  // offers the kind's interface; else requires it
+    bool required = false;  // a requiring port that must be connected
+    std::string help;       // what to join it to, for messages and docs
+};
+
 // What a signal means to the views that show it (report plots, summaries),
 // so they find it by meaning rather than by part type or signal name.
 enum class SignalRole : std::uint8_t {
@@ -89,6 +116,16 @@ public:
     PartPin& pin(std::size_t index) { return *pins_[index]; }
     PartPin* find_pin(std::string_view name);
 
+    // Ports (see the file comment). connect_port is called once per requiring
+    // port with the part that provides its kind; it throws BadInput when the
+    // provider does not fit (a channel the provider lacks).
+    std::size_t port_count() const { return ports_.size(); }
+    const PortInfo& port(std::size_t index) const { return ports_[index]; }
+    const PortInfo* find_port(std::string_view name, std::size_t* index = nullptr) const;
+    virtual void connect_port(std::size_t port, Part& provider);
+    // An Analog port's voltage at `cycle` of this part's clock.
+    double analog_volts(std::size_t port, Cycle cycle) const;
+
     // After all nets are connected: drive initial outputs, arm timers.
     virtual void start() {}
 
@@ -123,6 +160,9 @@ public:
 
 protected:
     std::size_t add_pin(std::string name, TerminalRole role);
+    std::size_t provide_port(std::string name, PortKind kind, std::string help);
+    std::size_t require_port(std::string name, PortKind kind, bool required, std::string help);
+    std::size_t provide_analog(std::string name, std::function<double(Cycle)> volts, std::string help);
     std::size_t add_signal(std::string name, bool real, double initial = 0);
     std::size_t add_signal(PartSignalInfo info, double initial);
     void publish(std::size_t signal, double value);
@@ -148,6 +188,8 @@ private:
     std::string name_;
     Mcu* clock_;
     std::vector<std::unique_ptr<PartPin>> pins_;
+    std::vector<PortInfo> ports_;
+    std::vector<std::function<double(Cycle)>> analog_sources_;  // per port; empty but for Analog providers
     std::vector<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;
     std::vector<double> signal_values_;

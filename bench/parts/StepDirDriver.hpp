@@ -60,6 +60,8 @@ public:
     // Winding 0 (A) or 1 (B): the chopper's current while enabled; disabled,
     // the current decays through the output MOSFETs' body diodes into the supply.
     WindingDrive winding(int k) const;
+    WindingDrive winding_at(const WindingTap& tap) const override { return winding(tap.phase); }
+    std::string tap_problem(const WindingTap& tap) const override;
 
 private:
     void on_input(std::size_t pin, bool level) override;

@@ -29,8 +29,6 @@ std::vector<ParamSpec> ThermalPlant::param_specs() {
          "surface to ambient"},
         {"sensor_time_constant", PT::Quantity, D::Time, false, "", {}, "preset",
          "thermistor bead lag behind the block (0: reads the block itself)"},
-        {"filament_driver", PT::Text, D::Dimensionless, false, "", {}, "",
-         "the extruder's step_dir_driver: its steps feed cold filament into the block"},
         {"filament_steps_per_mm", PT::Quantity, D::Dimensionless, false, "500", {},
          "Marlin Configuration.h DEFAULT_AXIS_STEPS_PER_UNIT E = 500 (at the driver's configured microsteps)",
          "driver steps per mm of filament", 1e-3, 1e6},
@@ -68,8 +66,7 @@ const std::map<std::string, std::map<std::string, std::string>>& ThermalPlant::p
     return table;
 }
 
-ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver* filament_driver)
-    : Part(std::move(name), clock), filament_driver_(filament_driver) {
+ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
     auto need = [&](const char* param) {
         if (!params.has(param)) {
             throw BadInput("part '" + this->name() + "': a " + params.text("preset") + " plant needs " + param);
@@ -109,10 +106,14 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     sig_sensor_ = add_signal({"sensor_degC", true, "degC", SignalRole::SensorTemperature, ""}, initial);
     if (surface_ >= 0) sig_surface_ = add_signal("surface_degC", true, initial);
     sig_fan_ = add_signal("fan_speed", true, 0);
+    provide_port("body", PortKind::Thermal, "the block heaters heat, thermistors read and fans cool");
+    require_port("filament", PortKind::Steps, false,
+                 "the extruder's step_dir_driver steps: they feed cold filament into the block");
+}
 
-    if (filament_driver_ != nullptr) {
-        filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
-    }
+void ThermalPlant::connect_port(std::size_t, Part& provider) {
+    filament_driver_ = &dynamic_cast<StepDirDriver&>(provider);
+    filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
 }
 
 std::string ThermalPlant::summary() {

@@ -32,8 +32,11 @@ public:
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 
-    // `filament_driver` (may be null): the extruder's driver, whose steps feed filament.
-    ThermalPlant(std::string name, Mcu& clock, const ParamValues& params, StepDirDriver* filament_driver = nullptr);
+    // Port `body` provides the plant to heaters, thermistors and fans; port
+    // `filament` (optional) requires the extruder's step_dir_driver `steps`,
+    // whose steps feed cold filament.
+    ThermalPlant(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "thermal_plant"; }
     void start() override;
     std::string summary() override;
@@ -90,7 +93,7 @@ private:
     Cycle last_cycle_ = 0;
     Cycle sample_cycles_;
 
-    StepDirDriver* filament_driver_;
+    StepDirDriver* filament_driver_ = nullptr;
     double filament_steps_per_mm_;
     std::int64_t feed_256_ = 0;  // driver steps in 1/256 full steps since the last sample
     double filament_position_mm_ = 0, filament_high_water_mm_ = 0;

@@ -55,8 +55,6 @@ std::vector<ParamSpec> Thermistor::param_specs() {
         {"preset", PT::Choice, D::Dimensionless, false, "epcos_b57560g104f",
          {"epcos_b57560g104f", "ntc_100k_3950", "custom"}, "",
          "epcos_b57560g104f (Marlin thermistor 1, its default), ntc_100k_3950, or custom points / beta"},
-        {"plant", PT::Text, D::Dimensionless, true, "", {}, "", "the thermal_plant whose sensor node it is"},
-        {"adc_pin", PT::Text, D::Dimensionless, true, "", {}, "", "the MCU's analog input: mega.PK5 (or PK5)"},
         {"t1", PT::Quantity, D::Temperature, false, "", {}, "preset", "first datasheet point"},
         {"r1", PT::Quantity, D::Resistance, false, "", {}, "preset", ""},
         {"t2", PT::Quantity, D::Temperature, false, "", {}, "preset", "second datasheet point"},
@@ -93,8 +91,8 @@ const std::map<std::string, std::map<std::string, std::string>>& Thermistor::pre
     return table;
 }
 
-Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant)
-    : Part(std::move(name), clock), plant_(plant), rng_(static_cast<std::uint64_t>(params.integer("seed"))) {
+Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params)
+    : Part(std::move(name), clock), rng_(static_cast<std::uint64_t>(params.integer("seed"))) {
     const std::string where = "part '" + this->name() + "': ";
     if (!params.has("t1") || !params.has("r1")) throw BadInput(where + "a custom thermistor needs t1 and r1");
     if (params.has("beta")) {
@@ -118,23 +116,17 @@ Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params, 
         throw BadInput(where + "pullup and reference must be positive, noise not negative");
     }
 
-    // adc_pin: "PK5" or "<mcu>.PK5" naming this part's clock.
-    std::string pin = params.text("adc_pin");
-    const auto dot = pin.find('.');
-    if (dot != std::string::npos) {
-        if (pin.substr(0, dot) != clock.name()) {
-            throw BadInput(where + "adc_pin '" + pin + "' is not on MCU '" + clock.name() + "'");
-        }
-        pin = pin.substr(dot + 1);
-    }
-    channel_ = clock.adc().channel_for_pin(pin);
-    clock.adc().connect(channel_, [this](Cycle c) { return sample(c); });
-
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput(where + "sample_interval must be positive");
     publish_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    sig_temperature_ = add_signal("bead_degC", true, plant_.sensor_degC());
-    sig_volts_ = add_signal("volts", true, divider_volts(plant_.sensor_degC()));
+    require_port("body", PortKind::Thermal, true, "the thermal_plant whose sensor node it is");
+    provide_analog("out", [this](Cycle c) { return sample(c); }, "the divider's output, for an ADC pin");
+}
+
+void Thermistor::connect_port(std::size_t, Part& provider) {
+    plant_ = &dynamic_cast<ThermalPlant&>(provider);
+    sig_temperature_ = add_signal("bead_degC", true, plant_->sensor_degC());
+    sig_volts_ = add_signal("volts", true, divider_volts(plant_->sensor_degC()));
 }
 
 double Thermistor::divider_volts_for_resistance(double ohm) const {
@@ -145,7 +137,7 @@ double Thermistor::divider_volts_for_resistance(double ohm) const {
 double Thermistor::divider_volts(double degC) const { return divider_volts_for_resistance(curve_.resistance_ohm(degC)); }
 
 double Thermistor::volts_now() {
-    const double t = plant_.sensor_degC();
+    const double t = plant_->sensor_degC();
     switch (fault_state_) {
         case Fault::Open: return divider_volts_for_resistance(std::numeric_limits<double>::infinity());
         case Fault::Shorted: return divider_volts_for_resistance(0.0);
@@ -168,7 +160,7 @@ double Thermistor::sample(Cycle cycle) {
     if (!published_once_ || cycle - last_publish_ >= publish_cycles_) {
         published_once_ = true;
         last_publish_ = cycle;
-        publish(sig_temperature_, plant_.sensor_degC());
+        publish(sig_temperature_, plant_->sensor_degC());
         publish(sig_volts_, v);
     }
     return v;
@@ -184,7 +176,7 @@ void Thermistor::apply_fault(const std::string& fault) {
                    : fault == "shorted"  ? Fault::Shorted
                    : fault == "detached" ? Fault::Detached
                                          : Fault::None;
-    plant_.set_sensor_detached(fault_state_ == Fault::Detached);
+    plant_->set_sensor_detached(fault_state_ == Fault::Detached);
 }
 
 }  // namespace avrbench

@@ -46,12 +46,14 @@ public:
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 
-    // The ADC pin is on `clock` (the board clocks a part with adc_pin by that MCU).
-    Thermistor(std::string name, Mcu& clock, const ParamValues& params, ThermalPlant& plant);
+    // Port `body` requires the thermal_plant whose sensor node it is; port
+    // `out` provides the divider's voltage (a net joins it to an ADC pin of
+    // `clock`, the MCU that samples it).
+    Thermistor(std::string name, Mcu& clock, const ParamValues& params);
+    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "thermistor"; }
 
     const NtcCurve& curve() const { return curve_; }
-    int adc_channel() const { return channel_; }
     // The divider's output for a bead temperature, without noise or faults.
     double divider_volts(double degC) const;
     double divider_volts_for_resistance(double ohm) const;
@@ -67,9 +69,8 @@ private:
     double gaussian();
     void apply_fault(const std::string& fault) override;
 
-    ThermalPlant& plant_;
+    ThermalPlant* plant_ = nullptr;
     NtcCurve curve_;
-    int channel_;
     bool lower_leg_;
     double fixed_ohm_, reference_v_, noise_v_;
     std::mt19937_64 rng_;
@@ -78,7 +79,7 @@ private:
     Cycle publish_cycles_;
     Cycle last_publish_ = 0;
     bool published_once_ = false;
-    std::size_t sig_temperature_, sig_volts_;
+    std::size_t sig_temperature_ = 0, sig_volts_ = 0;
 };
 
 }  // namespace avrbench

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace avrbench {
@@ -47,6 +48,17 @@ struct WindingDrive {
     }
 };
 
+// Where one winding of a motor is wired on the part that drives it, as the
+// motor's board entry says: a bridge's outputs (`plus`, `minus`: 1..4 on an
+// L293D), a low-side switch's channel (`minus`; the winding's other end is
+// the centre tap at `supply_v`, with `series_ohm` more in the switched path,
+// a sense resistor), or a step/dir driver's phase (`phase`: 0 = A, 1 = B).
+struct WindingTap {
+    int phase = 0;
+    int plus = 0, minus = 0;
+    double supply_v = 0, series_ohm = 0;
+};
+
 // A part whose outputs drive windings. Listeners are called after every
 // change of the drive state, at the cycle of the change; a motor integrates up
 // to that cycle with the drive it had, then asks for the new one.
@@ -62,6 +74,11 @@ public:
     virtual double commanded_electrical_angle() const { return 0; }
     // Outputs switched on (a driver's ENABLE); a bridge or a switch always is.
     virtual bool outputs_enabled() const { return true; }
+
+    // The drive a winding wired at `tap` sees now.
+    virtual WindingDrive winding_at(const WindingTap& tap) const = 0;
+    // Why `tap` names outputs this part does not have ("" when it fits).
+    virtual std::string tap_problem(const WindingTap& tap) const = 0;
 
 protected:
     void notify_drive_change() {

@@ -180,13 +180,17 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: e3d_v6}
-  hotend_heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  hotend_thermistor: {type: thermistor, preset: epcos_b57560g104f, plant: hotend, adc_pin: mega.PK5}
-  part_fan: {type: fan, plant: hotend}
+  hotend_heater: {type: heater, preset: cartridge_40w_12v}
+  hotend_thermistor: {type: thermistor, preset: epcos_b57560g104f}
+  part_fan: {type: fan}
   bed: {type: thermal_plant, preset: heated_bed}
-  bed_heater: {type: heater, preset: bed_12v, plant: bed}
-  bed_thermistor: {type: thermistor, preset: epcos_b57560g104f, plant: bed, adc_pin: mega.PK6}
+  bed_heater: {type: heater, preset: bed_12v}
+  bed_thermistor: {type: thermistor, preset: epcos_b57560g104f}
 nets:
+  hotend_body: [hotend.body, hotend_heater.body, hotend_thermistor.body, part_fan.body]
+  bed_body: [bed.body, bed_heater.body, bed_thermistor.body]
+  hotend_thermistor_adc: [mega.PK5, hotend_thermistor.out]
+  bed_thermistor_adc: [mega.PK6, bed_thermistor.out]
   hotend_heater_gate: [mega.PB4, hotend_heater.gate]
   part_fan_gate: [mega.PH6, part_fan.pwm]
   bed_heater_gate: [mega.PH5, bed_heater.gate]

@@ -17,11 +17,13 @@ const char* const kGood[] = {
     "  uno: {type: atmega328p, clock: 16MHz}",                                            // 2
     "parts:",                                                                             // 3
     "  x_driver: {type: step_dir_driver, preset: a4988}",                                 // 4
-    "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200mm}",        // 5
-    "  x_min: {type: limit_switch, axis: x, position: 0mm}",                              // 6
+    "  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm}",        // 5
+    "  x_min: {type: limit_switch, position: 0mm}",                              // 6
     "nets:",                                                                              // 7
     "  x_step: [uno.PD2, x_driver.step]",                                                 // 8
     "  x_limit: [uno.PB1, x_min.out]",                                                    // 9
+    "  x_motion: [x_driver.steps, x.drive]",                                              // 10
+    "  x_carriage: [x.carriage, x_min.axis]",                                             // 11
 };
 
 std::string board_with(int line, const std::string& replacement) {
@@ -78,13 +80,13 @@ INSTANTIATE_TEST_SUITE_P(
              "bad.yaml:8: unknown pin 'PC7': atmega328p has no such pin"},
         Case{"unknown_owner", 9, "  x_limit: [uno.PB1, y_min.out]",
              "bad.yaml:9: 'y_min' is neither an MCU nor a part of this board"},
-        Case{"missing_required", 5, "  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm}",
-             "bad.yaml:5: part 'x': missing required parameter 'driver' (the step_dir_driver part that moves it)"},
-        Case{"unknown_unit", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200furlongs}",
+        Case{"missing_required", 4, "  x_driver: {type: pull_resistor}",
+             "bad.yaml:4: part 'x_driver': missing required parameter 'to' (the rail the resistor goes to)"},
+        Case{"unknown_unit", 5, "  x: {type: linear_axis, steps_per_mm: 80, travel: 200furlongs}",
              "bad.yaml:5: part 'x': travel: unknown unit 'furlongs' in '200furlongs' (expected m, mm, um, cm)"},
         Case{"wrong_unit", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_high_min: 2mm}",
              "bad.yaml:4: part 'x_driver': step_high_min: '2mm' is a length, expected a time (s, ms, us, ns, min, h)"},
-        Case{"missing_unit", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200}",
+        Case{"missing_unit", 5, "  x: {type: linear_axis, steps_per_mm: 80, travel: 200}",
              "bad.yaml:5: part 'x': travel: '200' needs a unit (m, mm, um, cm)"},
         Case{"unknown_parameter", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_hi_min: 2us}",
              "bad.yaml:4: part 'x_driver': unknown parameter 'step_hi_min' (known: preset, step_edge, step_high_min, "
@@ -93,9 +95,17 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"bad_preset", 4, "  x_driver: {type: step_dir_driver, preset: a4989}",
              "bad.yaml:4: part 'x_driver': preset: 'a4989' is not one of a4988, drv8825, tmc2208, generic"},
         Case{"unknown_part_pin", 8, "  x_step: [uno.PD2, x_driver.stp]",
-             "bad.yaml:8: part 'x_driver' (step_dir_driver) has no pin 'stp' (pins: step, dir, enable, ms1, ms2, ms3)"},
-        Case{"wrong_reference_type", 6, "  x_min: {type: limit_switch, axis: x_driver, position: 0mm}",
-             "bad.yaml:6: part 'x_min': axis 'x_driver' is a step_dir_driver, expected linear_axis"},
+             "bad.yaml:8: part 'x_driver' (step_dir_driver) has no pin or port 'stp' (pins: step, dir, enable, ms1, "
+             "ms2, ms3; ports: steps (steps), windings (windings))"},
+        // Ports: one connection mechanism, checked by kind (parts/Part.hpp).
+        Case{"port_not_connected", 10, "  x_dir: [uno.PD5, x_driver.dir]",
+             "bad.yaml:5: part 'x' (linear_axis): port 'drive' is not connected: join it to a step_dir_driver's steps "
+             "in nets:"},
+        Case{"port_kinds_differ", 11, "  x_carriage: [x_driver.windings, x_min.axis]",
+             "bad.yaml:11: net 'x_carriage' joins a windings port (x_driver.windings) and a carriage port (x_min.axis)"},
+        Case{"port_beside_a_pin", 11, "  x_carriage: [uno.PB2, x.carriage, x_min.axis]",
+             "bad.yaml:11: net 'x_carriage' joins the pin uno.PB2 and the carriage port x.carriage: only analog "
+             "outputs share a net with pins"},
         // yaml-cpp reports the line where it noticed the missing ']': the next one.
         Case{"yaml_syntax", 8, "  x_step: [uno.PD2, x_driver.step",
              "bad.yaml:9: YAML syntax error: end of sequence flow not found"},
@@ -105,20 +115,20 @@ INSTANTIATE_TEST_SUITE_P(
              "bad.yaml:7: unknown section 'netz' (expected board, description, extends, mcus, parts, nets, serial, labels)"},
         // Values no board can have (each range is written beside its check).
         // Declared ranges (ParamSpec min/max beside each parameter): steps_per_mm 1e-3..1e6.
-        Case{"steps_per_mm_zero", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 0, travel: 200mm}",
+        Case{"steps_per_mm_zero", 5, "  x: {type: linear_axis, steps_per_mm: 0, travel: 200mm}",
              "bad.yaml:5: part 'x': steps_per_mm: '0' is outside 0.001 .. 1e+06"},
-        Case{"steps_per_mm_negative", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: -80, travel: 200mm}",
+        Case{"steps_per_mm_negative", 5, "  x: {type: linear_axis, steps_per_mm: -80, travel: 200mm}",
              "bad.yaml:5: part 'x': steps_per_mm: '-80' is outside 0.001 .. 1e+06"},
-        Case{"steps_per_mm_huge", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 1e300, travel: 200mm}",
+        Case{"steps_per_mm_huge", 5, "  x: {type: linear_axis, steps_per_mm: 1e300, travel: 200mm}",
              "bad.yaml:5: part 'x': steps_per_mm: '1e300' is outside 0.001 .. 1e+06"},
-        Case{"travel_zero", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 0mm}",
+        Case{"travel_zero", 5, "  x: {type: linear_axis, steps_per_mm: 80, travel: 0mm}",
              "bad.yaml:5: part 'x': travel must be longer than 0 and at most 100 m"},
-        Case{"switch_outside_travel", 6, "  x_min: {type: limit_switch, axis: x, position: 300mm}",
+        Case{"switch_outside_travel", 6, "  x_min: {type: limit_switch, position: 300mm}",
              "bad.yaml:6: part 'x_min': position must lie within the axis' travel (0..200.000000 mm)"},
         // A length is never negative (dimension_range: 0..1000 m).
-        Case{"switch_negative", 6, "  x_min: {type: limit_switch, axis: x, position: -1mm}",
+        Case{"switch_negative", 6, "  x_min: {type: limit_switch, position: -1mm}",
              "bad.yaml:6: part 'x_min': position: '-1mm' is outside 0 .. 1000 m"},
-        Case{"bounce_edges_huge", 6, "  x_min: {type: limit_switch, axis: x, position: 0mm, bounce_edges: 1e99}",
+        Case{"bounce_edges_huge", 6, "  x_min: {type: limit_switch, position: 0mm, bounce_edges: 1e99}",
              "bad.yaml:6: part 'x_min': bounce_edges: '1e99' is outside 0 .. 1000"},
         Case{"microsteps_fraction", 4, "  x_driver: {type: step_dir_driver, preset: a4988, microsteps: 1.5}",
              "bad.yaml:4: part 'x_driver': microsteps: '1.5' is not a whole number"},
@@ -129,9 +139,9 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"current_negative", 4, "  x_driver: {type: step_dir_driver, preset: a4988, current: -1A}",
              "bad.yaml:4: part 'x_driver': current: '-1A' is outside 0 .. 1000 A"},
         // yaml-cpp would keep one of the two silently.
-        Case{"duplicate_parameter", 5, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, steps_per_mm: 8, travel: 200mm}",
+        Case{"duplicate_parameter", 5, "  x: {type: linear_axis, steps_per_mm: 80, steps_per_mm: 8, travel: 200mm}",
              "bad.yaml:5: duplicate key 'steps_per_mm'"},
-        Case{"duplicate_part", 6, "  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200mm}",
+        Case{"duplicate_part", 6, "  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm}",
              "bad.yaml:6: duplicate key 'x'"},
         Case{"mcu_mismatch", 2, "  uno: {type: atmega2560, clock: 16MHz}",
              "{elf}: built for atmega328p, but bad.yaml:2 declares MCU 'uno' as atmega2560"}),
@@ -140,10 +150,10 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(BoardFileErrors, TwoOutputsOnOneNet) {
     std::string text = board_with(0, "");
     text += "  y_limit: [uno.PB2, x_min.out]\n";  // x_min.out is already on x_limit
-    EXPECT_EQ(error_of(text), "bad.yaml:10: 'x_min.out' is already on another net");
+    EXPECT_EQ(error_of(text), "bad.yaml:12: 'x_min.out' is already on another net");
     // Two distinct switch outputs on one net.
     std::string two = board_with(9, "  x_limit: [uno.PB1, x_min.out, x_max.out]");
-    two.insert(two.find("nets:"), "  x_max: {type: limit_switch, axis: x, side: max}\n");
+    two.insert(two.find("nets:"), "  x_max: {type: limit_switch, side: max}\n");
     EXPECT_EQ(error_of(two), "bad.yaml:10: net 'x_limit' is driven by two outputs: x_min.out and x_max.out");
 }
 

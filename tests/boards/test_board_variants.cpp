@@ -31,9 +31,11 @@ mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   x_driver: {type: step_dir_driver, preset: a4988}
-  x: {type: linear_axis, driver: x_driver, steps_per_mm: 80, travel: 200mm}
-  x_min: {type: limit_switch, axis: x, position: 0mm}
+  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm}
+  x_min: {type: limit_switch, position: 0mm}
 nets:
+  x_driver_steps: [x_driver.steps, x.drive]
+  x_carriage: [x.carriage, x_min.axis]
   x_step: [uno.PD2, x_driver.step]
   x_limit: [uno.PB1, x_min.out]
 )";
@@ -53,7 +55,7 @@ TEST(BoardVariants, ReplaceByNameAndAdd) {
     const std::string variant = dir.write("variant.yaml", R"(board: variant
 extends: base.yaml
 parts:
-  x_min: {type: limit_switch, axis: x, position: 2mm, pull: push_pull}
+  x_min: {type: limit_switch, position: 2mm, pull: push_pull}
   probe_pull: {type: pull_resistor, to: vcc}
 nets:
   probe: [uno.PC5, probe_pull.pin]
@@ -66,10 +68,10 @@ nets:
     const PartDecl* sw = spec.find_part("x_min");
     ASSERT_NE(sw, nullptr);
     // Replaced whole: the variant's parameters, none of the base's leftovers.
-    ASSERT_EQ(sw->params.size(), 3u);
-    EXPECT_EQ(sw->params[1].value, "2mm");
+    ASSERT_EQ(sw->params.size(), 2u);
+    EXPECT_EQ(sw->params[0].value, "2mm");
     EXPECT_NE(sw->location.find("variant.yaml:4"), std::string::npos) << sw->location;
-    EXPECT_EQ(spec.nets.size(), 3u);  // x_step, x_limit from the base, probe added
+    EXPECT_EQ(spec.nets.size(), 5u);  // x_driver_steps, x_carriage, x_step, x_limit from the base, probe added
     Board board(spec, {{"uno", test::firmware("sleep_idle")}});
     EXPECT_EQ(board.part_as<LimitSwitch>("x_min").name(), "x_min");
 }

@@ -20,7 +20,7 @@ namespace {
 // a board file may not name a key twice.
 std::string board_text(const std::string& switch_extra) {
     std::vector<std::pair<std::string, std::string>> params = {
-        {"type", "limit_switch"}, {"axis", "x"}, {"side", "min"}, {"position", "0.5mm"}, {"hysteresis", "0.05mm"},
+        {"type", "limit_switch"}, {"side", "min"}, {"position", "0.5mm"}, {"hysteresis", "0.05mm"},
         {"contact", "NO"}, {"switched_to", "gnd"}, {"pull", "internal_up"}};
     std::stringstream extras(switch_extra);
     std::string item;
@@ -49,9 +49,11 @@ mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   x_driver: {type: step_dir_driver, preset: a4988, microsteps: 16}
-  x: {type: linear_axis, driver: x_driver, steps_per_mm: 250, travel: 200mm, start_position: 1mm}
+  x: {type: linear_axis, steps_per_mm: 250, travel: 200mm, start_position: 1mm}
   x_limit: {)" + limit + R"(}
 nets:
+  x_driver_steps: [x_driver.steps, x.drive]
+  x_carriage: [x.carriage, x_limit.axis]
   x_step: [uno.PD2, x_driver.step]
   x_dir: [uno.PD5, x_driver.dir]
   enable: [uno.PB0, x_driver.enable]

@@ -23,8 +23,9 @@ mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   x_driver: {type: step_dir_driver, preset: drv8825, microsteps: 16, current: 0.4A, motor_supply: 12V}
-  motor: {type: hybrid_stepper, preset: 42byghw208, driver: x_driver, load_inertia: 1.405e-4kg*m^2}
+  motor: {type: hybrid_stepper, preset: 42byghw208, load_inertia: 1.405e-4kg*m^2}
 nets:
+  x_driver_windings: [x_driver.windings, motor.windings]
   x_step: [uno.PD2, x_driver.step]
   x_dir: [uno.PD5, x_driver.dir]
   enable: [uno.PB0, x_driver.enable]
@@ -111,25 +112,31 @@ parts:
     return "";
 }
 
-TEST(MotorBoard, BridgeAndDriverTogetherIsAnError) {
-    const auto e = motor_board_error("  m: {type: hybrid_stepper, bridge: ic, driver: x_driver}");
-    EXPECT_NE(e.find("motor.yaml:7"), std::string::npos) << e;
-    EXPECT_NE(e.find("either bridge"), std::string::npos) << e;
+TEST(MotorBoard, OneNetGivesTheWindingsOneSource) {
+    const auto e = motor_board_error("  m: {type: hybrid_stepper}\nnets:\n  w: [ic.windings, x_driver.windings, m.windings]");
+    EXPECT_EQ(e, "motor.yaml:9: net 'w' has two windings providers: ic.windings and x_driver.windings");
+}
+
+TEST(MotorBoard, UnconnectedWindingsNameThePort) {
+    EXPECT_EQ(motor_board_error("  m: {type: hybrid_stepper}"),
+              "motor.yaml:7: part 'm' (hybrid_stepper): port 'windings' is not connected: join it to an l293d's or a "
+              "step_dir_driver's windings in nets:");
 }
 
 TEST(MotorBoard, BadPhaseOutputsNameThePart) {
-    const auto e = motor_board_error("  m: {type: hybrid_stepper, bridge: ic, phase_a: \"1-2\"}");
+    const auto e = motor_board_error("  m: {type: hybrid_stepper, phase_a: \"1-2\"}");
     EXPECT_NE(e.find("part 'm'"), std::string::npos) << e;
     EXPECT_NE(e.find("phase_a"), std::string::npos) << e;
 }
 
-TEST(MotorBoard, BridgeMustBeAnL293d) {
-    const auto e = motor_board_error("  m: {type: hybrid_stepper, bridge: x_driver}");
-    EXPECT_NE(e.find("expected l293d"), std::string::npos) << e;
+TEST(MotorBoard, PhaseOutputsMustBeOutputsOfTheBridge) {
+    // The L293D has outputs 1Y..4Y (TI SLRS008C).
+    EXPECT_EQ(motor_board_error("  m: {type: hybrid_stepper, phase_b: \"3,5\"}\nnets:\n  w: [ic.windings, m.windings]"),
+              "motor.yaml:7: part 'm': L293D outputs are 1..4, not 5");
 }
 
 TEST(MotorBoard, UnitsAreChecked) {
-    const auto e = motor_board_error("  m: {type: hybrid_stepper, bridge: ic, rotor_inertia: 35g}");
+    const auto e = motor_board_error("  m: {type: hybrid_stepper, rotor_inertia: 35g}");
     EXPECT_NE(e.find("rotor_inertia"), std::string::npos) << e;
 }
 

@@ -45,9 +45,11 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: custom, heat_capacity: 16.7J/K, ambient_conductance: 0.068W/K, sensor_time_constant: 0s}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  t0: {type: thermistor, preset: epcos_b57560g104f, plant: hotend, adc_pin: mega.PK5}
+  heater: {type: heater, preset: cartridge_40w_12v}
+  t0: {type: thermistor, preset: epcos_b57560g104f}
 nets:
+  hotend_body: [hotend.body, heater.body, t0.body]
+  t0_adc: [mega.PK5, t0.out]
   gate: [mega.PB4, heater.gate]
 )";
 

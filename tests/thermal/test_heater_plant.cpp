@@ -65,8 +65,9 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: custom, heat_capacity: 2J/K, ambient_conductance: 0.068W/K, sensor_time_constant: 0s}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
+  heater: {type: heater, preset: cartridge_40w_12v}
 nets:
+  hotend_body: [hotend.body, heater.body]
   gate: [mega.PB4, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_quarter");
@@ -90,9 +91,10 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: custom, heat_capacity: 2J/K, ambient_conductance: 0.068W/K, ambient_conductance_fan: 0.097W/K, sensor_time_constant: 0s}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  fan: {type: fan, plant: hotend}
+  heater: {type: heater, preset: cartridge_40w_12v}
+  fan: {type: fan}
 nets:
+  hotend_body: [hotend.body, heater.body, fan.body]
   gate: [mega.PB4, heater.gate]
   fan: [mega.PH6, fan.pwm]
 )";
@@ -112,8 +114,9 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: e3d_v6}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
+  heater: {type: heater, preset: cartridge_40w_12v}
 nets:
+  hotend_body: [hotend.body, heater.body]
   gate: [mega.PB4, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_quarter");
@@ -146,11 +149,13 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   plant: {type: thermal_plant, preset: heated_bed}
-  h12: {type: heater, preset: cartridge_40w_12v, plant: plant}
-  h24: {type: heater, preset: cartridge_40w_24v, plant: plant}
-  bed: {type: heater, preset: bed_12v, plant: plant}
-  lossy: {type: heater, preset: cartridge_40w_12v, plant: plant, series_resistance: 0.4ohm}
-  low: {type: heater, preset: custom, supply: 24V, resistance: 4.8ohm, plant: plant, gate_active: low}
+  h12: {type: heater, preset: cartridge_40w_12v}
+  h24: {type: heater, preset: cartridge_40w_24v}
+  bed: {type: heater, preset: bed_12v}
+  lossy: {type: heater, preset: cartridge_40w_12v, series_resistance: 0.4ohm}
+  low: {type: heater, preset: custom, supply: 24V, resistance: 4.8ohm, gate_active: low}
+nets:
+  plant_body: [plant.body, h12.body, h24.body, bed.body, lossy.body, low.body]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_off");
     EXPECT_NEAR(board->part_as<Heater>("h12").power_on_W(), 40.0, 1e-9);
@@ -168,7 +173,9 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   plant: {type: thermal_plant, preset: heated_bed}
-  h: {type: heater, preset: custom, supply: -12V, resistance: 4.8ohm, plant: plant}
+  h: {type: heater, preset: custom, supply: -12V, resistance: 4.8ohm}
+nets:
+  plant_body: [plant.body, h.body]
 )";
     try {
         test::thermal_board(yaml, "thermal_pwm_off");
@@ -188,8 +195,9 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: e3d_v6}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend, gate_active: low}
+  heater: {type: heater, preset: cartridge_40w_12v, gate_active: low}
 nets:
+  hotend_body: [hotend.body, heater.body]
   gate: [mega.PB4, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_quarter");
@@ -218,12 +226,20 @@ parts:
   hotend: {type: thermal_plant, preset: e3d_v6}
   x_driver: {type: step_dir_driver}
 )";
-    EXPECT_EQ(board_error(head + "  heater: {type: heater, plant: x_driver}\n"),
-              "thermal-test.yaml:7: part 'heater': plant 'x_driver' is a step_dir_driver, expected thermal_plant");
-    EXPECT_EQ(board_error(head + "  t0: {type: thermistor, plant: hotend}\n"),
-              "thermal-test.yaml:7: part 't0': missing required parameter 'adc_pin' (the MCU's analog input: mega.PK5 "
-              "(or PK5))");
-    EXPECT_EQ(board_error(head + "  heater: {type: heater, plant: hotend, node: surface}\n"),
+    EXPECT_EQ(board_error(head + "  heater: {type: heater}\nnets:\n  body: [x_driver.steps, heater.body]\n"),
+              "thermal-test.yaml:9: net 'body' joins a steps port (x_driver.steps) and a thermal port (heater.body)");
+    EXPECT_EQ(board_error(head + "  heater: {type: heater}\n"),
+              "thermal-test.yaml:7: part 'heater' (heater): port 'body' is not connected: join it to the thermal_plant "
+              "it heats in nets:");
+    EXPECT_EQ(board_error(head + "  heater: {type: heater}\n  t0: {type: thermistor}\nnets:\n  body: [heater.body, t0.body]\n"),
+              "thermal-test.yaml:10: net 'body' has no part providing its thermal port (heater.body needs one, e.g. a "
+              "thermal_plant's body)");
+    // An analog output shares its net with the MCU pins whose ADC samples it, nothing else.
+    EXPECT_EQ(board_error(head + "  t0: {type: thermistor}\nnets:\n  body: [hotend.body, t0.body]\n"
+                                 "  adc: [t0.out, x_driver.step]\n"),
+              "thermal-test.yaml:10: net 'adc' joins the analog output t0.out and the digital pin x_driver.step: an "
+              "analog net holds MCU pins only");
+    EXPECT_EQ(board_error(head + "  heater: {type: heater, node: surface}\nnets:\n  body: [hotend.body, heater.body]\n"),
               "thermal-test.yaml:7: part 'heater': plant 'hotend' has no node 'surface' to heat (block)");
     EXPECT_EQ(board_error(head + "  plant2: {type: thermal_plant, preset: custom, heat_capacity: 5J/K}\n"),
               "thermal-test.yaml:7: part 'plant2': a custom plant needs ambient_conductance");

@@ -50,9 +50,11 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: e3d_v6}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  t0: {type: thermistor, preset: epcos_b57560g104f, plant: hotend, adc_pin: mega.PK5}
+  heater: {type: heater, preset: cartridge_40w_12v}
+  t0: {type: thermistor, preset: epcos_b57560g104f}
 nets:
+  hotend_body: [hotend.body, heater.body, t0.body]
+  t0_adc: [mega.PK5, t0.out]
   gate: [mega.PB4, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_full");
@@ -138,9 +140,10 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: custom, heat_capacity: 2J/K, ambient_conductance: 0.068W/K, ambient_conductance_fan: 0.097W/K, sensor_time_constant: 0s}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  fan: {type: fan, plant: hotend, spin_time_constant: 0.5s}
+  heater: {type: heater, preset: cartridge_40w_12v}
+  fan: {type: fan, spin_time_constant: 0.5s}
 nets:
+  hotend_body: [hotend.body, heater.body, fan.body]
   gate: [mega.PB4, heater.gate]
   fan: [mega.PH6, fan.pwm]
 )";

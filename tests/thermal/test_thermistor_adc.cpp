@@ -27,7 +27,10 @@ parts:
   plant: {type: thermal_plant, preset: e3d_v6, ambient: )" +
            degC + ", initial: " + degC + R"(}
   t0: {type: thermistor, preset: )" +
-           thermistor + R"(, plant: plant, adc_pin: mega.PK5)" + extra + R"(}
+           thermistor + R"()" + extra + R"(}
+nets:
+  plant_body: [plant.body, t0.body]
+  t0_adc: [mega.PK5, t0.out]
 )";
 }
 
@@ -102,7 +105,10 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   plant: {type: thermal_plant, preset: e3d_v6, ambient: 25degC}
-  t0: {type: thermistor, preset: epcos_b57560g104f, plant: plant, adc_pin: mega.PK5}
+  t0: {type: thermistor, preset: epcos_b57560g104f}
+nets:
+  plant_body: [plant.body, t0.body]
+  t0_adc: [mega.PK5, t0.out]
 )";
     auto board = test::thermal_board(yaml, "thermal_adc_probe_m2560");
     Adc& adc = board->mcu().adc();
@@ -126,7 +132,10 @@ mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   plant: {type: thermal_plant, preset: e3d_v6, ambient: 25degC}
-  t0: {type: thermistor, preset: ntc_100k_3950, plant: plant, adc_pin: uno.PC0}
+  t0: {type: thermistor, preset: ntc_100k_3950}
+nets:
+  plant_body: [plant.body, t0.body]
+  t0_adc: [uno.PC0, t0.out]
 )";
     auto board = test::thermal_board(yaml, "thermal_adc_probe_m328p", "uno");
     board->mcu().adc().set_voltage(5, 3.3);  // 3.3 * 1024 / 5 = 675.84 -> 675
@@ -149,9 +158,11 @@ mcus:
   drive: {type: atmega32, clock: 16MHz}
 parts:
   hotend: {type: thermal_plant, preset: e3d_v6, ambient: 25degC}
-  heater: {type: heater, preset: cartridge_40w_12v, plant: hotend}
-  sensor: {type: thermistor, preset: ntc_100k_3950, plant: hotend, adc_pin: drive.PA2, pullup: 891.7ohm, leg: lower}
+  heater: {type: heater, preset: cartridge_40w_12v}
+  sensor: {type: thermistor, preset: ntc_100k_3950, pullup: 891.7ohm, leg: lower}
 nets:
+  hotend_body: [hotend.body, heater.body, sensor.body]
+  sensor_adc: [drive.PA2, sensor.out]
   heater: [drive.PD7, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_adc_probe_m32", "drive");
@@ -219,14 +230,17 @@ mcus:
   mega: {type: atmega2560, clock: 16MHz}
 parts:
   plant: {type: thermal_plant, preset: e3d_v6}
-  t0: {type: thermistor, plant: plant, adc_pin: mega.PB4}
+  t0: {type: thermistor}
+nets:
+  plant_body: [plant.body, t0.body]
+  t0_adc: [mega.PB4, t0.out]
 )";
     try {
         test::thermal_board(yaml, "thermal_adc_probe_m2560");
         FAIL() << "PB4 accepted as an analog input";
     } catch (const BadInput& e) {
         const std::string what = e.what();
-        EXPECT_NE(what.find("thermal-test.yaml:6"), std::string::npos) << what;
+        EXPECT_NE(what.find("thermal-test.yaml:9"), std::string::npos) << what;
         EXPECT_NE(what.find("PB4"), std::string::npos) << what;
         EXPECT_NE(what.find("PK0..PK7 = ADC8..15"), std::string::npos) << what;
     }
