@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 
 extern "C" {
 #include <avr_ioport.h>
@@ -20,6 +21,7 @@ extern "C" {
 #include "core/McuPins.hpp"
 #include "core/IdleLoopSkip.hpp"
 #include "core/Twi.hpp"
+#include "core/UserStop.hpp"
 #include "core/fixes/Fix.hpp"
 #include "core/fixes/Interrupts.hpp"
 
@@ -185,6 +187,24 @@ bool Mcu::step() {
     ++steps_;
     check_after_step(state, pc_before);
     return !halted_;
+}
+
+StopReason Mcu::run_sliced(Cycle end_cycle, const std::function<void()>& after_slice) {
+    // 10 ms slices answer Ctrl-C promptly; each advances to a later cycle.
+    const Cycle slice = std::clamp<Cycle>(end_cycle / 100, 1, frequency_hz() / 100 + 1);
+    StopReason reason = StopReason::ReachedTarget;
+    while (cycle() < end_cycle && !user_stop_requested()) {
+        reason = run_until(std::min(end_cycle, cycle() + slice));
+        if (after_slice) after_slice();
+        if (reason == StopReason::Halted) break;
+    }
+    return reason;
+}
+
+bool Mcu::run_until_sleep(Cycle end_cycle) {
+    while (cycle() < end_cycle && !sleeping() && !user_stop_requested() && step()) {
+    }
+    return sleeping();
 }
 
 StopReason Mcu::run_until(Cycle target_cycle) {

@@ -81,6 +81,12 @@ public:
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
+    // The command line's runs: to `end_cycle` in slices of at most 10 ms
+    // simulated, calling `after_slice` after each (progress, streaming a VCD),
+    // until halted or SIGINT/SIGTERM (core/UserStop.hpp); or instruction by
+    // instruction until the firmware executes SLEEP (true) or the end comes.
+    StopReason run_sliced(Cycle end_cycle, const std::function<void()>& after_slice);
+    bool run_until_sleep(Cycle end_cycle);
 
     // "PB5" (also "B5"). Throws BadInput for a port the MCU does not have.
     Pin& pin(std::string_view name);

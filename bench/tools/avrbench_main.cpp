@@ -269,7 +269,15 @@ void print_idle_skip(const Mcu& mcu, bool name_it) {
                 static_cast<double>(mcu.idle_cycles_skipped()) / mcu.frequency_hz());
 }
 
-int run_board_command(const RunArgs& args) {
+// What `run --board` sets up from its arguments, all checked before anything runs.
+struct BoardRun {
+    std::unique_ptr<Bench> bench;
+    UartHost* host = nullptr;  // --gcode's
+    std::vector<PortFile> uart_out;
+    Picoseconds duration_ps = 0, settle_ps = 0;
+};
+
+BoardRun prepare_board_run(const RunArgs& args) {
     if (!args.mcu.empty() || !args.freq.empty()) {
         throw BadInput("--mcu/--freq do not apply with --board: the board file gives each MCU's type and clock");
     }
@@ -281,13 +289,13 @@ int run_board_command(const RunArgs& args) {
         if (eq == std::string::npos) throw BadInput("--firmware '" + item + "': expected MCU=ELF");
         firmware[item.substr(0, eq)] = item.substr(eq + 1);
     }
+    BoardRun run;
     // With a job, --for is the limit for finishing it (default 60 s).
-    const Picoseconds duration_ps = parse_duration_ps(args.duration_given || args.gcode.empty() ? args.duration : "60s", "--for");
-    const double duration_s = seconds_from_ps(duration_ps);
-    const Picoseconds settle_ps = parse_duration_ps(args.settle, "--settle");
+    run.duration_ps = parse_duration_ps(args.duration_given || args.gcode.empty() ? args.duration : "60s", "--for");
+    run.settle_ps = parse_duration_ps(args.settle, "--settle");
     const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
-    const std::vector<PortFile> uart_out = port_files(args.uart_out, "--uart-out");
-    check_run_outputs(args, uart_out);
+    run.uart_out = port_files(args.uart_out, "--uart-out");
+    check_run_outputs(args, run.uart_out);
     std::vector<std::pair<std::string, std::string>> uart_in_bytes;  // port -> bytes
     for (const auto& pf : uart_in) uart_in_bytes.emplace_back(pf.port, read_file(pf.path, "--uart-in"));
     if (!args.gcode.empty()) {
@@ -295,20 +303,20 @@ int run_board_command(const RunArgs& args) {
         if (!std::filesystem::is_regular_file(args.gcode, ec)) throw BadInput("--gcode: " + args.gcode + ": no such file");
     }
 
-    Bench bench(std::move(spec), firmware);
+    run.bench = std::make_unique<Bench>(std::move(spec), firmware);
+    Bench& bench = *run.bench;
     Board& board = bench.board();
     for (Mcu* m : board.mcus()) m->set_skip_idle_loops(!args.no_idle_skip);
-    if (board.spec().serial.empty() && (!uart_in.empty() || !uart_out.empty() || !args.gcode.empty())) {
+    if (board.spec().serial.empty() && (!uart_in.empty() || !run.uart_out.empty() || !args.gcode.empty())) {
         throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --uart-in, --uart-out)");
     }
     // Resolve every named port now, so a typo fails before the run.
     for (const auto& pf : uart_in) bench.serial_decl(pf.port);
-    for (const auto& pf : uart_out) bench.serial_decl(pf.port);
+    for (const auto& pf : run.uart_out) bench.serial_decl(pf.port);
     if (!args.host.empty()) bench.serial_decl(args.host);
 
     std::vector<std::pair<Picoseconds, std::string>> realtime_bytes;
     for (const auto& item : args.realtime) realtime_bytes.push_back(parse_realtime(item));
-    UartHost* host = nullptr;
     if (!args.gcode.empty()) {
         const SerialDecl& decl = bench.serial_decl(args.host);
         for (const auto& pf : uart_in) {
@@ -322,11 +330,10 @@ int run_board_command(const RunArgs& args) {
         if (!args.line_timeout.empty()) o.line_timeout_s = seconds_from_ps(parse_duration_ps(args.line_timeout, "--line-timeout"));
         if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
         if (args.wait_banner) o.startup = Startup::WaitForBanner;
-        const std::optional<UartHostOptions> options = o;
-        host = &bench.host(decl.name, options);
-        host->load_file(args.gcode);
+        run.host = &bench.host(decl.name, o);
+        run.host->load_file(args.gcode);
         for (const auto& [at_ps, bytes] : realtime_bytes) {
-            host->send_bytes_at(bytes, board.mcu(decl.mcu).cycles_from_seconds(seconds_from_ps(at_ps)));
+            run.host->send_bytes_at(bytes, board.mcu(decl.mcu).cycles_from_seconds(seconds_from_ps(at_ps)));
         }
     } else if (!realtime_bytes.empty()) {
         throw BadInput("--realtime needs --gcode (the bytes go to its host's port)");
@@ -339,45 +346,13 @@ int run_board_command(const RunArgs& args) {
             bench.trace_board();
         }
     }
+    return run;
+}
 
-    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty());
-    waveforms.start();
-    ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
-    const auto wall_start = std::chrono::steady_clock::now();
-    IdleResult outcome = IdleResult::TimeLimit;
-    const Picoseconds end_ps = duration_ps;
-    // Slices of at most 10 ms simulated, so Ctrl-C is answered promptly.
-    const Picoseconds chunk_ps = std::clamp<Picoseconds>(duration_ps / 100, 1'000'000, 10 * kPsPerMs);
-    // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
-    while (bench.now_ps() < end_ps) {
-        if (user_stop_requested()) {
-            outcome = IdleResult::Interrupted;
-            break;
-        }
-        const Picoseconds target = std::min(end_ps, add_ps(bench.now_ps(), chunk_ps));
-        if (host != nullptr) {
-            outcome = bench.run_until_idle_ps(target - bench.now_ps(), settle_ps);
-            if (outcome != IdleResult::TimeLimit) break;
-        } else if (board.run_until_ps(target) == StopReason::Halted) {
-            outcome = IdleResult::Halted;
-            break;
-        }
-        waveforms.drain(bench.now_ps());
-        progress.show(static_cast<double>(bench.now_ps()) / static_cast<double>(end_ps), bench.now_seconds());
-    }
-    progress.finish();
-    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-
-    const Timeline& timeline = bench.timeline();
-    if (timeline.overflowed()) throw BadInput(timeline.overflow_message());
-    const std::string gtkw_path = waveforms.finish(board.mcu());
-    for (const auto& pf : uart_out) write_output_file(pf.path, bench.serial(pf.port).transmitted_text(), "--uart-out");
-    const auto findings = bench.findings();
-    if (!args.report.empty()) {
-        write_html_report(bench.make_report(std::string(board.mcu().elf().path()) + " on " + board.spec().name),
-                          args.report);
-    }
-
+void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome, double wall_s,
+                         const std::vector<Finding>& findings, const std::string& gtkw_path) {
+    Bench& bench = *run.bench;
+    Board& board = bench.board();
     const double simulated_s = bench.now_seconds();
     std::printf("avrbench run: board %s (%s)\n", board.spec().name.c_str(), args.board.c_str());
     for (Mcu* m : board.mcus()) {
@@ -387,20 +362,21 @@ int run_board_command(const RunArgs& args) {
     std::printf("  simulated  %.6f s\n", simulated_s);
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
     for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);
-    if (host != nullptr) {
+    if (run.host != nullptr) {
         std::printf("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s\n", args.gcode.c_str(),
-                    host->lines_acknowledged(), host->lines().size(), host->oks(), host->errors(), to_string(outcome));
+                    run.host->lines_acknowledged(), run.host->lines().size(), run.host->oks(), run.host->errors(),
+                    to_string(outcome));
     }
     for (Part* part : board.parts()) {
         if (const std::string line = part->summary(); !line.empty()) std::printf("  %s\n", line.c_str());
     }
     print_findings(findings);
-    if (host != nullptr) {
+    if (run.host != nullptr) {
         std::printf("  transcript (last lines):\n");
-        print_text_tail(host->tail(10), 10);
+        print_text_tail(run.host->tail(10), 10);
     }
     for (const auto& decl : board.spec().serial) {
-        if (host != nullptr && bench.serial_decl(args.host).name == decl.name) continue;
+        if (run.host != nullptr && bench.serial_decl(args.host).name == decl.name) continue;
         const Uart& u = bench.serial(decl.name);
         std::printf("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s\n", decl.name.c_str(),
                     u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
@@ -408,31 +384,36 @@ int run_board_command(const RunArgs& args) {
         print_text_tail(u.transmitted_text(), 10);
     }
     if (!args.vcd.empty()) {
+        const Timeline& timeline = bench.timeline();
         std::printf("  vcd        %s (%zu signals, %llu events), gtkwave save file %s\n", args.vcd.c_str(),
                     timeline.signals().size(), static_cast<unsigned long long>(timeline.recorded_count()),
                     gtkw_path.c_str());
     }
     if (!args.report.empty()) std::printf("  report     %s\n", args.report.c_str());
+}
 
+// The exit code (docs/CLI.md), with the one-line reason on stderr.
+int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome, const std::vector<Finding>& findings) {
     for (const auto& f : findings) {
         if (is_mcu_finding(f) || (args.strict && f.kind != FindingKind::HostProtocol)) return kExitFinding;
     }
     if (outcome == IdleResult::Interrupted) {
-        std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n", bench.now_seconds());
+        std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n",
+                     run.bench->now_seconds());
         return kExitInterrupted;
     }
-    if (host != nullptr && outcome == IdleResult::HostFailed) {
-        std::fprintf(stderr, "avrbench: %s\n", host->failure_message().c_str());
+    if (run.host != nullptr && outcome == IdleResult::HostFailed) {
+        std::fprintf(stderr, "avrbench: %s\n", run.host->failure_message().c_str());
         // A host that got no answer is a timeout; error/ALARM/!! are findings.
         bool timed_out = false;
-        for (const auto& e : host->events()) {
+        for (const auto& e : run.host->events()) {
             timed_out = timed_out || e.kind == HostEventKind::Timeout || e.kind == HostEventKind::BannerTimeout;
         }
         return timed_out ? kExitTimeout : kExitFinding;
     }
-    if (host != nullptr && outcome == IdleResult::TimeLimit) {
+    if (run.host != nullptr && outcome == IdleResult::TimeLimit) {
         std::fprintf(stderr, "avrbench: timeout: the job was not finished within %g s (%zu of %zu lines acknowledged)\n",
-                     duration_s, host->lines_acknowledged(), host->lines().size());
+                     seconds_from_ps(run.duration_ps), run.host->lines_acknowledged(), run.host->lines().size());
         return kExitTimeout;
     }
     if (args.strict) {
@@ -441,6 +422,36 @@ int run_board_command(const RunArgs& args) {
         }
     }
     return kExitOk;
+}
+
+int run_board_command(const RunArgs& args) {
+    BoardRun run = prepare_board_run(args);
+    Bench& bench = *run.bench;
+    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty());
+    waveforms.start();
+    ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
+    const auto wall_start = std::chrono::steady_clock::now();
+    Bench::RunSlices how;
+    how.until_idle = run.host != nullptr;
+    how.settle_ps = run.settle_ps;
+    how.after_slice = [&] {
+        waveforms.drain(bench.now_ps());
+        progress.show(static_cast<double>(bench.now_ps()) / static_cast<double>(run.duration_ps), bench.now_seconds());
+    };
+    const IdleResult outcome = bench.run_to_ps(run.duration_ps, how);
+    progress.finish();
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+    if (bench.timeline().overflowed()) throw BadInput(bench.timeline().overflow_message());
+    const std::string gtkw_path = waveforms.finish(bench.mcu());
+    for (const auto& pf : run.uart_out) write_output_file(pf.path, bench.serial(pf.port).transmitted_text(), "--uart-out");
+    const auto findings = bench.findings();
+    if (!args.report.empty()) {
+        write_html_report(bench.make_report(std::string(bench.mcu().elf().path()) + " on " + bench.board().spec().name),
+                          args.report);
+    }
+    print_board_summary(args, run, outcome, wall_s, findings, gtkw_path);
+    return board_exit_code(args, run, outcome, findings);
 }
 
 int run_command(const RunArgs& args) {
@@ -491,17 +502,12 @@ int run_command(const RunArgs& args) {
     const auto wall_start = std::chrono::steady_clock::now();
     bool slept = false;
     if (args.until_sleep) {
-        while (mcu.cycle() < end_cycle && !mcu.sleeping() && !user_stop_requested() && mcu.step()) {
-        }
-        slept = mcu.sleeping();
+        slept = mcu.run_until_sleep(end_cycle);
     } else {
-        // Slices of at most 10 ms simulated, so Ctrl-C is answered promptly.
-        const Cycle chunk = std::clamp<Cycle>(end_cycle / 100, 1, mcu.frequency_hz() / 100 + 1);
-        while (mcu.cycle() < end_cycle && !user_stop_requested()) {
-            if (mcu.run_until(std::min(end_cycle, mcu.cycle() + chunk)) == StopReason::Halted) break;
+        mcu.run_sliced(end_cycle, [&] {
             waveforms.drain(ps_at_cycle(mcu, mcu.cycle()));
             progress.show(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
-        }
+        });
     }
     progress.finish();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

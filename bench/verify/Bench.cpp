@@ -189,6 +189,23 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
     }
 }
 
+IdleResult Bench::run_to_ps(Picoseconds end_ps, const RunSlices& how) {
+    const Picoseconds slice_ps = std::clamp<Picoseconds>(end_ps / 100, 1'000'000, 10 * kPsPerMs);
+    // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
+    while (now_ps() < end_ps) {
+        if (user_stop_requested()) return IdleResult::Interrupted;
+        const Picoseconds target = std::min(end_ps, add_ps(now_ps(), slice_ps));
+        if (how.until_idle) {
+            const IdleResult r = run_until_idle_ps(target - now_ps(), how.settle_ps);
+            if (r != IdleResult::TimeLimit) return r;
+        } else if (board_->run_until_ps(target) == StopReason::Halted) {
+            return IdleResult::Halted;
+        }
+        if (how.after_slice) how.after_slice();
+    }
+    return IdleResult::TimeLimit;
+}
+
 std::vector<Finding> Bench::findings() const {
     std::vector<Finding> out = board_->findings();
     for (const auto& [name, host] : hosts_) {

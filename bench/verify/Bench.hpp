@@ -9,6 +9,7 @@
 //   EXPECT_EQ(bench.axis("x").steps(), 1600u);
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -79,6 +80,16 @@ public:
     // from now has passed. Every pass of its loop advances simulated time.
     IdleResult run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps = 50 * kPsPerMs);
     IdleResult run_until_idle(double max_seconds, double settle_seconds = 0.05);
+    // Runs to `end_ps` (simulated, from power-on) in slices of at most
+    // 10 ms, calling `after_slice` after each (progress, streaming a VCD).
+    // With `until_idle` it ends when the run is idle as run_until_idle_ps
+    // says (settle `settle_ps`); it always ends at a halt or SIGINT/SIGTERM.
+    struct RunSlices {
+        bool until_idle = false;
+        Picoseconds settle_ps = 50 * kPsPerMs;
+        std::function<void()> after_slice;
+    };
+    IdleResult run_to_ps(Picoseconds end_ps, const RunSlices& how);
     Picoseconds now_ps() const { return board_->now_ps(); }
     double now_seconds() const { return board_->now_seconds(); }
     // Simulated time of the last STEP edge any driver counted, or -1.

@@ -79,10 +79,7 @@ private:
     }
     std::string operator()(const DelayStep& s) {
         const Picoseconds end = std::min(deadline_, add_ps(bench_.now_ps(), s.duration_ps));
-        while (bench_.now_ps() < end && !user_stop_requested()) {
-            if (bench_.board().run_until_ps(std::min(end, add_ps(bench_.now_ps(), kSlicePs * 100))) == StopReason::Halted) break;
-        }
-        return user_stop_requested() ? "interrupted (SIGINT/SIGTERM)" : "";
+        return bench_.run_to_ps(end, {}) == IdleResult::Interrupted ? "interrupted (SIGINT/SIGTERM)" : "";
     }
     std::string operator()(const WaitIdleStep& s) {
         const Picoseconds now = bench_.now_ps();
@@ -226,6 +223,73 @@ TimelineHeader golden_header(const ScenarioSpec& spec, const Mcu& first) {
     return header;
 }
 
+// Compares the run with the golden timeline (or writes it), adding what
+// differs to result.failures; returns the golden for the report.
+std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, const ScenarioRunOptions& options,
+                                                  Bench& bench, ScenarioResult& result) {
+    if (spec.golden_path.empty()) return std::nullopt;
+    const TimelineHeader header = golden_header(spec, bench.mcu());
+    const Timeline actual = golden_view(bench.timeline(), spec.golden_signals);
+    if (options.update_golden) {
+        if (!result.expectation_failures.empty() && !options.force) {
+            result.failures.push_back("golden: not updated, because the run failed its steps or expectations "
+                                      "(use --force to write it anyway)");
+        } else {
+            write_timeline_text(actual, header, spec.golden_path);
+        }
+        return std::nullopt;
+    }
+    if (!fs::exists(spec.golden_path)) {
+        result.failures.push_back("golden: no golden timeline at " + spec.golden_path +
+                                  " (create it with: avrbench golden update " + spec.path + ")");
+        return std::nullopt;
+    }
+    ParsedTimeline golden = read_timeline_text(spec.golden_path);
+    CompareOptions compare;
+    compare.rules = spec.tolerances;
+    compare.golden_end_cycle = golden.header.end_cycle;
+    compare.actual_end_cycle = header.end_cycle;
+    result.comparison = compare_timelines(golden.timeline, actual, compare);
+    if (!result.comparison->passed) {
+        const ChannelResult* d = result.comparison->first_divergence();
+        char at[96] = "";
+        if (d != nullptr) {
+            std::snprintf(at, sizeof at, " diverges at %.6f s (cycle %llu): ", d->seconds(),
+                          static_cast<unsigned long long>(d->divergence_cycle));
+        }
+        result.failures.push_back("golden: " + (d ? d->signal + at + d->detail : std::string("channels differ")));
+    }
+    return golden;
+}
+
+// The HTML report of a scenario: the run, its verdict and failures, and the
+// comparison with its golden.
+std::string write_scenario_report(const ScenarioSpec& spec, const std::string& report_dir, const Bench& bench,
+                                  const ScenarioResult& result, const std::optional<ParsedTimeline>& golden) {
+    RunReport report = bench.make_report(spec.name);
+    report.facts.push_back("scenario: " + spec.path);
+    report.facts.push_back(std::string("verdict: ") + (result.passed ? "PASS" : "FAIL"));
+    for (const auto& f : result.failures) report.facts.push_back(f);
+    if (result.comparison && golden) {
+        ComparisonView view;
+        view.passed = result.comparison->passed;
+        view.golden = golden->timeline;
+        if (const ChannelResult* d = result.comparison->first_divergence()) {
+            view.first_divergence_signal = d->signal;
+            view.first_divergence_cycle = d->divergence_cycle;
+            view.first_divergence_clock_hz = d->clock_hz;
+        }
+        view.summary = result.comparison->report();
+        for (const auto& c : result.comparison->channels) view.channels.push_back({c.signal, c.verdict, c.detail});
+        report.comparison = std::move(view);
+    }
+    // The name was checked when the file loaded: no separators, so the
+    // report stays inside report_dir.
+    const std::string path = (fs::path(report_dir) / (spec.name + ".html")).string();
+    write_html_report(report, path);
+    return path;
+}
+
 }  // namespace
 
 ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& options) {
@@ -266,64 +330,10 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         if (!why.empty()) fail("expect " + e.kind + " (" + e.location + "): " + why);
     }
 
-    const TimelineHeader header = golden_header(spec, bench.mcu());
-    const Timeline actual = golden_view(bench.timeline(), spec.golden_signals);
-    std::optional<ParsedTimeline> golden;
-    if (!spec.golden_path.empty()) {
-        if (options.update_golden) {
-            if (!result.expectation_failures.empty() && !options.force) {
-                result.failures.push_back("golden: not updated, because the run failed its steps or expectations "
-                                          "(use --force to write it anyway)");
-            } else {
-                write_timeline_text(actual, header, spec.golden_path);
-            }
-        } else if (!fs::exists(spec.golden_path)) {
-            result.failures.push_back("golden: no golden timeline at " + spec.golden_path +
-                                      " (create it with: avrbench golden update " + spec.path + ")");
-        } else {
-            golden = read_timeline_text(spec.golden_path);
-            CompareOptions compare;
-            compare.rules = spec.tolerances;
-            compare.golden_end_cycle = golden->header.end_cycle;
-            compare.actual_end_cycle = header.end_cycle;
-            result.comparison = compare_timelines(golden->timeline, actual, compare);
-            if (!result.comparison->passed) {
-                const ChannelResult* d = result.comparison->first_divergence();
-                char at[96] = "";
-                if (d != nullptr) {
-                    std::snprintf(at, sizeof at, " diverges at %.6f s (cycle %llu): ", d->seconds(),
-                                  static_cast<unsigned long long>(d->divergence_cycle));
-                }
-                result.failures.push_back("golden: " + (d ? d->signal + at + d->detail : std::string("channels differ")));
-            }
-        }
-    }
-
+    const std::optional<ParsedTimeline> golden = compare_with_golden(spec, options, bench, result);
     result.simulated_s = bench.now_seconds();
     result.passed = result.failures.empty();
-    if (!options.report_dir.empty()) {
-        RunReport report = bench.make_report(spec.name);
-        report.facts.push_back("scenario: " + spec.path);
-        report.facts.push_back(std::string("verdict: ") + (result.passed ? "PASS" : "FAIL"));
-        for (const auto& f : result.failures) report.facts.push_back(f);
-        if (result.comparison && golden) {
-            ComparisonView view;
-            view.passed = result.comparison->passed;
-            view.golden = golden->timeline;
-            if (const ChannelResult* d = result.comparison->first_divergence()) {
-                view.first_divergence_signal = d->signal;
-                view.first_divergence_cycle = d->divergence_cycle;
-                view.first_divergence_clock_hz = d->clock_hz;
-            }
-            view.summary = result.comparison->report();
-            for (const auto& c : result.comparison->channels) view.channels.push_back({c.signal, c.verdict, c.detail});
-            report.comparison = std::move(view);
-        }
-        // The name was checked when the file loaded: no separators, so the
-        // report stays inside report_dir.
-        result.report_path = (fs::path(options.report_dir) / (spec.name + ".html")).string();
-        write_html_report(report, result.report_path);
-    }
+    if (!options.report_dir.empty()) result.report_path = write_scenario_report(spec, options.report_dir, bench, result, golden);
     result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     return result;
 }
