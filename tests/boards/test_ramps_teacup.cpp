@@ -1,5 +1,5 @@
 // The RAMPS 1.4 firmware in the Teacup/Marlin style
-// (firmware/conformance/peripherals/ramps_teacup): thermistor sampling sees
+// (firmware/boards/ramps_teacup): thermistor sampling sees
 // the fed voltage, the heater PWM duties are as commanded, the step interrupt
 // moves X. The firmware runs unmodified: the bench only drives its pins, ADC
 // input and serial line.

@@ -1,4 +1,4 @@
-// A grbl-style step generator end to end (firmware/conformance/timers/grbl_stepper:
+// A grbl-style step generator end to end (firmware/boards/grbl_stepper:
 // ATmega328P 16 MHz, UNO + CNC shield; X/Y/Z STEP PD2/PD3/PD4, DIR PD5/PD6/PD7,
 // enable PB0 active low, limits PB1/PB2/PB4).
 //
