@@ -7,6 +7,7 @@
 #include "parts/Axis.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "support/Paths.hpp"
+#include "support/PinLog.hpp"
 
 namespace avrbench {
 namespace {
@@ -26,15 +27,10 @@ std::vector<Finding> of_kind(const std::vector<Finding>& all, FindingKind kind) 
 
 struct PatternRun {
     std::unique_ptr<Board> board = uno_with("step_pattern");
-    std::vector<std::pair<Cycle, bool>> step_edges;  // from the MCU pin itself, independent of the driver model
+    test::PinLog step{board->mcu("uno"), "PD2"};
     PatternRun() {
-        Mcu& uno = board->mcu("uno");
-        uno.pin("PD2").on_change([this, &uno](Cycle c, bool level) {
-            (void)uno;
-            step_edges.emplace_back(c, level);
-        });
         board->run_for_seconds(0.05);  // the whole pattern takes < 1 ms
-        EXPECT_EQ(uno.read_ram_u8("phase"), 8) << "the pattern did not finish";
+        EXPECT_EQ(board->mcu("uno").read_ram_u8("phase"), 8) << "the pattern did not finish";
     }
     StepDirDriver& driver() { return board->part_as<StepDirDriver>("x_driver"); }
 };
@@ -44,9 +40,7 @@ TEST(StepDirDriver, CountsStepsAndIgnoresThemWhileDisabled) {
     // step_pattern header: 155 active edges while enabled, 30 while disabled.
     EXPECT_EQ(run.driver().steps_taken(), 155u);
     EXPECT_EQ(run.driver().steps_ignored(), 30u);
-    std::size_t rising = 0;
-    for (const auto& [c, level] : run.step_edges) rising += level ? 1 : 0;
-    EXPECT_EQ(rising, 185u);  // the pin saw every pulse: 155 + 30
+    EXPECT_EQ(run.step.rises().size(), 185u);  // the pin saw every pulse: 155 + 30
     // Net motion: 49 steps with DIR high at 1/16 microstepping (board:
     // microsteps 16). The CNC shield board counts DIR low as + (grbl drives
     // DIR high for negative moves), so that is -49 steps.
@@ -63,11 +57,11 @@ TEST(StepDirDriver, ReportsTheShortPulseAtItsFallingEdge) {
     // The pin trace has the pulse: find the one high interval shorter than
     // 16 cycles (1 us at 16 MHz); the finding carries its falling edge.
     Cycle falling = 0, width = 0;
-    for (std::size_t i = 1; i < run.step_edges.size(); ++i) {
-        if (!run.step_edges[i].second && run.step_edges[i - 1].second &&
-            run.step_edges[i].first - run.step_edges[i - 1].first < 16) {
-            falling = run.step_edges[i].first;
-            width = run.step_edges[i].first - run.step_edges[i - 1].first;
+    const auto& edges = run.step.edges();
+    for (std::size_t i = 1; i < edges.size(); ++i) {
+        if (!edges[i].level && edges[i - 1].level && edges[i].cycle - edges[i - 1].cycle < 16) {
+            falling = edges[i].cycle;
+            width = edges[i].cycle - edges[i - 1].cycle;
         }
     }
     ASSERT_NE(falling, 0u);

@@ -5,17 +5,20 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/ElfImage.hpp"
 #include "core/Mcu.hpp"
+#include "support/McuSuffix.hpp"
 #include "support/Paths.hpp"
+#include "support/PinLog.hpp"
 
 namespace avrbench::test {
 
 struct Part {
-    const char* suffix;    // firmware name suffix
+    const char* mcu;       // what Mcu::mcu_type() reports
     const char* name;      // for test output
     Cycle response;        // interrupt response: §7.7.1 (328P, m32) 4 cycles; 2560 §7.8.1: 5
     Cycle reti;            // RETI: 4 cycles; 5 on the 2560 (same sections)
@@ -29,9 +32,9 @@ struct Part {
     bool int0_edge_wakes_power_down;
 };
 
-inline const Part kAtmega328p{"", "ATmega328P", 4, 4, "PD2", "PD3", 0x01, 0x02, false};
-inline const Part kAtmega2560{"_m2560", "ATmega2560", 5, 5, "PD0", "PD1", 0x01, 0x02, true};
-inline const Part kAtmega32{"_m32", "ATmega32", 4, 4, "PD2", "PD3", 0x40, 0x80, false};
+inline const Part kAtmega328p{"atmega328p", "ATmega328P", 4, 4, "PD2", "PD3", 0x01, 0x02, false};
+inline const Part kAtmega2560{"atmega2560", "ATmega2560", 5, 5, "PD0", "PD1", 0x01, 0x02, true};
+inline const Part kAtmega32{"atmega32", "ATmega32", 4, 4, "PD2", "PD3", 0x40, 0x80, false};
 
 // Every JMP in the vector table takes 3 cycles (AVR Instruction Set Manual; §7.7.1).
 constexpr Cycle kJmp = 3;
@@ -42,33 +45,30 @@ constexpr Cycle kSbi = 2;
 inline std::string part_name(const ::testing::TestParamInfo<const Part*>& info) { return info.param->name; }
 
 inline Mcu load(const std::string& firmware, const Part& part) {
-    return Mcu(ElfImage::load(test::firmware(firmware + part.suffix)));
+    return Mcu(ElfImage::load(test::firmware(firmware + firmware_suffix(part.mcu))));
 }
 
-// Rising and falling edges of PORTB pins, by bit.
+// Rising and falling edges of the eight pins of a port (PORTB by default), by bit.
 class Markers {
 public:
     Markers(Mcu& mcu, const char* port = "PB") {
         for (int bit = 0; bit < 8; ++bit) {
-            const std::string name = std::string(port) + static_cast<char>('0' + bit);
-            mcu.pin(name).on_change([this, bit](Cycle c, bool level) {
-                (level ? rises_[bit] : falls_[bit]).push_back(c);
-            });
+            logs_[bit] = std::make_unique<PinLog>(mcu, std::string(port) + static_cast<char>('0' + bit));
         }
     }
-    const std::vector<Cycle>& rises(int bit) const { return rises_[bit]; }
-    const std::vector<Cycle>& falls(int bit) const { return falls_[bit]; }
+    const std::vector<Cycle>& rises(int bit) const { return logs_[bit]->rises(); }
+    const std::vector<Cycle>& falls(int bit) const { return logs_[bit]->falls(); }
     Cycle rise(int bit, std::size_t n = 0) const {
-        EXPECT_GT(rises_[bit].size(), n) << "marker bit " << bit << " did not rise " << n + 1 << " time(s)";
-        return rises_[bit].size() > n ? rises_[bit][n] : 0;
+        EXPECT_GT(rises(bit).size(), n) << "marker bit " << bit << " did not rise " << n + 1 << " time(s)";
+        return rises(bit).size() > n ? rises(bit)[n] : 0;
     }
     Cycle fall(int bit, std::size_t n = 0) const {
-        EXPECT_GT(falls_[bit].size(), n) << "marker bit " << bit << " did not fall " << n + 1 << " time(s)";
-        return falls_[bit].size() > n ? falls_[bit][n] : 0;
+        EXPECT_GT(falls(bit).size(), n) << "marker bit " << bit << " did not fall " << n + 1 << " time(s)";
+        return falls(bit).size() > n ? falls(bit)[n] : 0;
     }
 
 private:
-    std::array<std::vector<Cycle>, 8> rises_, falls_;
+    std::array<std::unique_ptr<PinLog>, 8> logs_;
 };
 
 // Runs until `bit` of the markers has risen (or `limit` cycles passed).

@@ -12,7 +12,7 @@ using test::Part;
 // Erase-and-write programming time at 16 MHz: 3.4 ms (328P §8.6.3 Table 8-2,
 // 2560 Table 8-1) = 54400 cycles; ATmega32 ("EEPROM Data Memory" Table 1):
 // 8448 cycles of the 1 MHz calibrated RC oscillator = 8.448 ms = 135168 cycles.
-Cycle write_cycles(const Part& part) { return std::string(part.suffix) == "_m32" ? 135168 : 54400; }
+Cycle write_cycles(const Part& part) { return std::string(part.mcu) == "atmega32" ? 135168 : 54400; }
 
 class EepromTiming : public ::testing::TestWithParam<const Part*> {};
 

@@ -12,6 +12,7 @@
 #include "boards/Board.hpp"
 #include "boards/BoardFile.hpp"
 #include "core/Twi.hpp"
+#include "support/McuSuffix.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {
@@ -29,7 +30,8 @@ std::string pair_board(const std::string& mcu_type) {
 
 std::vector<int> as_ints(const std::vector<std::uint8_t>& bytes) { return {bytes.begin(), bytes.end()}; }
 
-void expect_pair_talks(const std::string& mcu_type, const std::string& suffix) {
+void expect_pair_talks(const std::string& mcu_type) {
+    const std::string suffix = test::firmware_suffix(mcu_type);
     Board board(parse_board_text(pair_board(mcu_type), "twi-pair.yaml"),
                 {{"master", test::firmware("twi_master" + suffix)}, {"slave", test::firmware("twi_slave" + suffix)}});
     ASSERT_EQ(board.twi_buses().size(), 1u);
@@ -94,9 +96,9 @@ void expect_pair_talks(const std::string& mcu_type, const std::string& suffix) {
     EXPECT_FALSE(events[1].acked);
 }
 
-TEST(TwiPair, StatusCodesAndStretchingAtmega328p) { expect_pair_talks("atmega328p", ""); }
-TEST(TwiPair, StatusCodesAndStretchingAtmega2560) { expect_pair_talks("atmega2560", "_m2560"); }
-TEST(TwiPair, StatusCodesAndStretchingAtmega32) { expect_pair_talks("atmega32", "_m32"); }
+TEST(TwiPair, StatusCodesAndStretchingAtmega328p) { expect_pair_talks("atmega328p"); }
+TEST(TwiPair, StatusCodesAndStretchingAtmega2560) { expect_pair_talks("atmega2560"); }
+TEST(TwiPair, StatusCodesAndStretchingAtmega32) { expect_pair_talks("atmega32"); }
 
 TEST(TwiPair, SdaSharedWithoutSclIsAWiringError) {
     const std::string text = R"(mcus:

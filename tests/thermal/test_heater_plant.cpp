@@ -9,6 +9,7 @@
 #include "parts/Fan.hpp"
 #include "parts/Heater.hpp"
 #include "parts/ThermalPlant.hpp"
+#include "support/PinLog.hpp"
 #include "thermal/ThermalTestSupport.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/VcdReader.hpp"
@@ -17,33 +18,16 @@
 namespace avrbench {
 namespace {
 
-// Edges of the heater gate as the MCU pin shows them (independent of the heater part).
-struct GateLog {
-    std::vector<std::pair<Cycle, bool>> edges;
-    explicit GateLog(Board& board) {
-        board.mcu().pin("PB4").on_change([this](Cycle c, bool level) { edges.emplace_back(c, level); });
-    }
-    Cycle on_cycles_until(Cycle end) const {
-        Cycle total = 0;
-        for (std::size_t i = 0; i < edges.size(); ++i) {
-            if (!edges[i].second) continue;
-            const Cycle off = i + 1 < edges.size() ? std::min(edges[i + 1].first, end) : end;
-            if (edges[i].first < off) total += off - edges[i].first;
-        }
-        return total;
-    }
-};
-
 TEST(ThermalPlant, SingleNodeStepResponseMatchesTheClosedForm) {
     // 40 W (12 V across 3.6 ohm) into C = 16.7 J/K with R_th = 1/0.068 = 14.706 K/W:
     // T = 25 + P R_th (1 - e^{-t/tau}), tau = R_th C = 245.59 s, P R_th = 588.24 K.
     auto board = test::thermal_board(test::kSingleNodeBoard, "thermal_pwm_full");
-    GateLog gate(*board);
+    test::PinLog gate(board->mcu(), "PB4");  // the heater gate as the MCU pin shows it
     auto& plant = board->part_as<ThermalPlant>("hotend");
     board->run_for_seconds(0.01);
-    ASSERT_EQ(gate.edges.size(), 1u);  // switched on once, never off
-    ASSERT_TRUE(gate.edges[0].second);
-    const Cycle on_at = gate.edges[0].first;
+    ASSERT_EQ(gate.edges().size(), 1u);  // switched on once, never off
+    ASSERT_TRUE(gate.edges()[0].level);
+    const Cycle on_at = gate.edges()[0].cycle;
     const double f = board->mcu().frequency_hz();
     for (double t : {5.0, 30.0, 100.0, 245.59}) {
         board->run_until_seconds(static_cast<double>(on_at) / f + t);
@@ -120,13 +104,13 @@ nets:
   gate: [mega.PB4, heater.gate]
 )";
     auto board = test::thermal_board(yaml, "thermal_pwm_quarter");
-    GateLog gate(*board);
+    test::PinLog gate(board->mcu(), "PB4");  // the heater gate as the MCU pin shows it
     auto& plant = board->part_as<ThermalPlant>("hotend");
     auto& heater = board->part_as<Heater>("heater");
     board->run_for_seconds(300);
     const double in = heater.energy_J();
     // Independent of the heater: on-time from the MCU pin's own edges, times 40 W.
-    const double from_pin = static_cast<double>(gate.on_cycles_until(board->mcu().cycle())) / 16e6 * 40.0;
+    const double from_pin = static_cast<double>(gate.high_cycles_until(board->mcu().cycle())) / 16e6 * 40.0;
     EXPECT_NEAR(in, from_pin, 1e-9 * in);
     // About 300 s * 10 W = 3000 J.
     EXPECT_NEAR(in, 3000.0, 15.0);
