@@ -10,15 +10,16 @@ namespace avrbench {
 std::vector<ParamSpec> Axis::param_specs() {
     using PT = ParamType;
     return {
-        {"kind", PT::Choice, Dimension::Dimensionless, false, "linear", {"linear", "rotary"}, "", ""},
+        {.name = "kind", .type = PT::Choice, .default_value = "linear", .choices = {"linear", "rotary"}},
         // 1e-3..1e6: a 1 mm lead screw at 1/256 of 200 steps is 51 200 steps/mm.
-        {"steps_per_mm", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
-         "STEP pulses per mm at the driver's configured microsteps (linear)", 1e-3, 1e6},
-        {"steps_per_rev", PT::Quantity, Dimension::Dimensionless, false, "", {}, "",
-         "STEP pulses per revolution at the driver's configured microsteps (rotary)", 1, 1e7},
-        {"travel", PT::Quantity, Dimension::Length, false, "", {}, "", "length of travel (linear), from 0"},
-        {"start_position", PT::Quantity, Dimension::Length, false, "0mm", {}, "assumed: the carriage starts at 0",
-         "carriage position at power-on"},
+        {.name = "steps_per_mm", .type = PT::Quantity,
+         .help = "STEP pulses per mm at the driver's configured microsteps (linear)", .min = 1e-3, .max = 1e6},
+        {.name = "steps_per_rev", .type = PT::Quantity,
+         .help = "STEP pulses per revolution at the driver's configured microsteps (rotary)", .min = 1, .max = 1e7},
+        {.name = "travel", .type = PT::Quantity, .dimension = Dimension::Length,
+         .help = "length of travel (linear), from 0"},
+        {.name = "start_position", .type = PT::Quantity, .dimension = Dimension::Length, .default_value = "0mm",
+         .source = "assumed: the carriage starts at 0", .help = "carriage position at power-on"},
     };
 }
 

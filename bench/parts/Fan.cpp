@@ -12,13 +12,14 @@ std::vector<ParamSpec> Fan::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     return {
-        {"active", PT::Choice, D::Dimensionless, false, "high", {"high", "low"},
-         "RAMPS 1.4 schematic: D9 drives the fan MOSFET gate, high = on", "drive level that runs the fan"},
-        {"spin_time_constant", PT::Quantity, D::Time, false, "0.5s", {},
-         "assumed: a 40 mm / 50 mm blower reaches 63 % of full speed in about half a second",
-         "first-order lag of the speed behind the drive"},
-        {"sample_interval", PT::Quantity, D::Time, false, "50ms", {}, "assumed",
-         "how often the plant gets the current speed"},
+        {.name = "active", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
+         .source = "RAMPS 1.4 schematic: D9 drives the fan MOSFET gate, high = on",
+         .help = "drive level that runs the fan"},
+        {.name = "spin_time_constant", .type = PT::Quantity, .dimension = D::Time, .default_value = "0.5s",
+         .source = "assumed: a 40 mm / 50 mm blower reaches 63 % of full speed in about half a second",
+         .help = "first-order lag of the speed behind the drive"},
+        {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "50ms",
+         .source = "assumed", .help = "how often the plant gets the current speed"},
     };
 }
 

@@ -11,17 +11,21 @@ std::vector<ParamSpec> Heater::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     return {
-        {"preset", PT::Choice, D::Dimensionless, false, "cartridge_40w_12v",
-         {"cartridge_40w_12v", "cartridge_40w_24v", "bed_12v", "custom"}, "", "heater element"},
-        {"node", PT::Choice, D::Dimensionless, false, "block", {"block", "surface"}, "", "the plant node it heats"},
-        {"supply", PT::Quantity, D::Voltage, false, "", {}, "preset", "heater supply voltage"},
-        {"resistance", PT::Quantity, D::Resistance, false, "", {}, "preset", "heater element resistance"},
-        {"series_resistance", PT::Quantity, D::Resistance, false, "0ohm", {}, "assumed: negligible",
-         "MOSFET on-resistance plus wiring"},
-        {"gate_active", PT::Choice, D::Dimensionless, false, "high", {"high", "low"},
-         "RAMPS 1.4 schematic: the MCU pin drives the N-MOSFET gate directly, high = on",
-         "gate level that turns the heater on"},
-        {"sample_interval", PT::Quantity, D::Time, false, "100ms", {}, "assumed", "period of the duty trace"},
+        {.name = "preset", .type = PT::Choice, .default_value = "cartridge_40w_12v",
+         .choices = {"cartridge_40w_12v", "cartridge_40w_24v", "bed_12v", "custom"}, .help = "heater element"},
+        {.name = "node", .type = PT::Choice, .default_value = "block", .choices = {"block", "surface"},
+         .help = "the plant node it heats"},
+        {.name = "supply", .type = PT::Quantity, .dimension = D::Voltage, .source = "preset",
+         .help = "heater supply voltage"},
+        {.name = "resistance", .type = PT::Quantity, .dimension = D::Resistance, .source = "preset",
+         .help = "heater element resistance"},
+        {.name = "series_resistance", .type = PT::Quantity, .dimension = D::Resistance, .default_value = "0ohm",
+         .source = "assumed: negligible", .help = "MOSFET on-resistance plus wiring"},
+        {.name = "gate_active", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
+         .source = "RAMPS 1.4 schematic: the MCU pin drives the N-MOSFET gate directly, high = on",
+         .help = "gate level that turns the heater on"},
+        {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "100ms",
+         .source = "assumed", .help = "period of the duty trace"},
     };
 }
 

@@ -68,46 +68,56 @@ std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
     using PT = ParamType;
     using D = Dimension;
     std::vector<ParamSpec> specs = {
-        {"preset", PT::Choice, D::Dimensionless, false, unipolar ? "unipolar-42-generic" : "sm-42byg011-25",
-         {"sm-42byg011-25", "42byghw208", "unipolar-42-generic", "none"}, "", "motor data preset (see presets())"},
-        {"step_angle", PT::Quantity, D::Angle, false, "1.8deg", {}, "", "full step angle (90 deg / rotor teeth)"},
-        {"resistance", PT::Quantity, D::Resistance, false, "", {}, "", "resistance per winding (half-winding: unipolar)"},
-        {"inductance", PT::Quantity, D::Inductance, false, "", {}, "", "inductance per winding"},
-        {"torque_constant", PT::Quantity, D::TorqueConstant, false, "", {}, "",
-         "torque constant = back-EMF constant, per winding"},
-        {"detent_torque", PT::Quantity, D::Torque, false, "", {}, "", "detent torque amplitude (unexcited)"},
-        {"rotor_inertia", PT::Quantity, D::Inertia, false, "", {}, "", "rotor inertia"},
-        {"load_inertia", PT::Quantity, D::Inertia, false, "0kg*m^2", {}, "no load unless given", "inertia on the shaft"},
-        {"viscous_damping", PT::Quantity, D::RotaryDamping, false, "", {}, "", "viscous friction and iron losses"},
-        {"coulomb_friction", PT::Quantity, D::Torque, false, "", {}, "", "bearing (Coulomb) friction"},
-        {"load_torque", PT::Quantity, D::Torque, false, "0N*m", {}, "no load unless given",
-         "constant load torque, acting against forward rotation"},
-        {"max_step", PT::Quantity, D::Time, false, "20us", {},
-         "docs/MOTOR.md: figures unchanged from 2 us to 40 us", "integration step bound (RK4)"},
-        {"sample_period", PT::Quantity, D::Time, false, "100us", {}, "",
-         "how often a moving motor is advanced without pin events (stall checks, traces)"},
-        {"chopper_tau", PT::Quantity, D::Time, false, "20us", {},
-         "assumed: about one PWM period of an A4988/DRV8825 chopper", "current tracking time constant (driver-driven)"},
-        {"release_delay", PT::Quantity, D::Time, false, "1ms", {}, "assumed",
-         "a winding switched off alone counts as released (not chopped) after this long"},
-        {"stall_quiet", PT::Quantity, D::Time, false, "100ms", {}, "assumed",
-         "a stall event ends after this long without another pole slip"},
+        {.name = "preset", .type = PT::Choice, .default_value = unipolar ? "unipolar-42-generic" : "sm-42byg011-25",
+         .choices = {"sm-42byg011-25", "42byghw208", "unipolar-42-generic", "none"},
+         .help = "motor data preset (see presets())"},
+        {.name = "step_angle", .type = PT::Quantity, .dimension = D::Angle, .default_value = "1.8deg",
+         .help = "full step angle (90 deg / rotor teeth)"},
+        {.name = "resistance", .type = PT::Quantity, .dimension = D::Resistance,
+         .help = "resistance per winding (half-winding: unipolar)"},
+        {.name = "inductance", .type = PT::Quantity, .dimension = D::Inductance, .help = "inductance per winding"},
+        {.name = "torque_constant", .type = PT::Quantity, .dimension = D::TorqueConstant,
+         .help = "torque constant = back-EMF constant, per winding"},
+        {.name = "detent_torque", .type = PT::Quantity, .dimension = D::Torque,
+         .help = "detent torque amplitude (unexcited)"},
+        {.name = "rotor_inertia", .type = PT::Quantity, .dimension = D::Inertia, .help = "rotor inertia"},
+        {.name = "load_inertia", .type = PT::Quantity, .dimension = D::Inertia, .default_value = "0kg*m^2",
+         .source = "no load unless given", .help = "inertia on the shaft"},
+        {.name = "viscous_damping", .type = PT::Quantity, .dimension = D::RotaryDamping,
+         .help = "viscous friction and iron losses"},
+        {.name = "coulomb_friction", .type = PT::Quantity, .dimension = D::Torque,
+         .help = "bearing (Coulomb) friction"},
+        {.name = "load_torque", .type = PT::Quantity, .dimension = D::Torque, .default_value = "0N*m",
+         .source = "no load unless given", .help = "constant load torque, acting against forward rotation"},
+        {.name = "max_step", .type = PT::Quantity, .dimension = D::Time, .default_value = "20us",
+         .source = "docs/MOTOR.md: figures unchanged from 2 us to 40 us", .help = "integration step bound (RK4)"},
+        {.name = "sample_period", .type = PT::Quantity, .dimension = D::Time, .default_value = "100us",
+         .help = "how often a moving motor is advanced without pin events (stall checks, traces)"},
+        {.name = "chopper_tau", .type = PT::Quantity, .dimension = D::Time, .default_value = "20us",
+         .source = "assumed: about one PWM period of an A4988/DRV8825 chopper",
+         .help = "current tracking time constant (driver-driven)"},
+        {.name = "release_delay", .type = PT::Quantity, .dimension = D::Time, .default_value = "1ms",
+         .source = "assumed", .help = "a winding switched off alone counts as released (not chopped) after this long"},
+        {.name = "stall_quiet", .type = PT::Quantity, .dimension = D::Time, .default_value = "100ms",
+         .source = "assumed", .help = "a stall event ends after this long without another pole slip"},
     };
     if (unipolar) {
         for (const char* c : {"a", "b", "c", "d"}) {
-            specs.push_back({std::string("coil_") + c, PT::Integer, D::Dimensionless, false,
-                             std::to_string(1 + (c[0] - 'a')), {}, "",
-                             std::string("switch channel of half-winding ") + static_cast<char>(c[0] - 32), 1, 8});
+            specs.push_back({.name = std::string("coil_") + c, .type = PT::Integer,
+                             .default_value = std::to_string(1 + (c[0] - 'a')),
+                             .help = std::string("switch channel of half-winding ") + static_cast<char>(c[0] - 32),
+                             .min = 1, .max = 8});
         }
-        specs.push_back({"supply", PT::Quantity, D::Voltage, false, "12V", {}, "assumed (seed 001 gives none)",
-                         "supply at the centre taps"});
-        specs.push_back({"sense_resistor", PT::Quantity, D::Resistance, false, "0ohm", {},
-                         "seed 001 §3.2: value absent", "R_sense per coil pair (A/C, B/D), 0 = none"});
+        specs.push_back({.name = "supply", .type = PT::Quantity, .dimension = D::Voltage, .default_value = "12V",
+                         .source = "assumed (seed 001 gives none)", .help = "supply at the centre taps"});
+        specs.push_back({.name = "sense_resistor", .type = PT::Quantity, .dimension = D::Resistance,
+                         .default_value = "0ohm", .source = "seed 001 §3.2: value absent",
+                         .help = "R_sense per coil pair (A/C, B/D), 0 = none"});
     } else {
-        specs.push_back({"phase_a", PT::Text, D::Dimensionless, false, "1,2", {}, "",
-                         "bridge outputs of winding A: plus,minus (a step/dir driver: ignored)"});
-        specs.push_back({"phase_b", PT::Text, D::Dimensionless, false, "3,4", {}, "",
-                         "bridge outputs of winding B: plus,minus (a step/dir driver: ignored)"});
+        specs.push_back({.name = "phase_a", .type = PT::Text, .default_value = "1,2",
+                         .help = "bridge outputs of winding A: plus,minus (a step/dir driver: ignored)"});
+        specs.push_back({.name = "phase_b", .type = PT::Text, .default_value = "3,4",
+                         .help = "bridge outputs of winding B: plus,minus (a step/dir driver: ignored)"});
     }
     return specs;
 }

@@ -7,20 +7,21 @@ namespace avrbench {
 std::vector<ParamSpec> L293D::param_specs() {
     using PT = ParamType;
     return {
-        {"supply", PT::Quantity, Dimension::Voltage, false, "12V", {},
-         "seed 003 §2.1: motor supply V_CC2 = 12 VDC", "V_CC2, the motor supply"},
-        {"v_drop_high", PT::Quantity, Dimension::Voltage, false, "1.4V", {},
-         "TI SLRS008C electrical characteristics: V_OH = V_CC2 - 1.4 V typ at -0.6 A",
-         "drop of a high output sourcing current"},
-        {"v_drop_low", PT::Quantity, Dimension::Voltage, false, "1.2V", {},
-         "TI SLRS008C: V_OL = 1.2 V typ at 0.6 A", "drop of a low output sinking current"},
-        {"v_clamp", PT::Quantity, Dimension::Voltage, false, "1.3V", {},
-         "TI SLRS008C: V_OKH = V_CC2 + 1.3 V, V_OKL = 1.3 V typ at 0.6 A", "clamp diode forward voltage"},
-        {"r_out", PT::Quantity, Dimension::Resistance, false, "0ohm", {},
-         "assumed: drops taken as constant (the datasheet gives them at 0.6 A only)",
-         "extra resistance per conducting output"},
-        {"enable_unconnected", PT::Choice, Dimension::Dimensionless, false, "high", {"high", "low"}, "",
-         "level of an EN input with no net (boards often tie EN to 5 V)"},
+        {.name = "supply", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "12V",
+         .source = "seed 003 §2.1: motor supply V_CC2 = 12 VDC", .help = "V_CC2, the motor supply"},
+        {.name = "v_drop_high", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "1.4V",
+         .source = "TI SLRS008C electrical characteristics: V_OH = V_CC2 - 1.4 V typ at -0.6 A",
+         .help = "drop of a high output sourcing current"},
+        {.name = "v_drop_low", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "1.2V",
+         .source = "TI SLRS008C: V_OL = 1.2 V typ at 0.6 A", .help = "drop of a low output sinking current"},
+        {.name = "v_clamp", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "1.3V",
+         .source = "TI SLRS008C: V_OKH = V_CC2 + 1.3 V, V_OKL = 1.3 V typ at 0.6 A",
+         .help = "clamp diode forward voltage"},
+        {.name = "r_out", .type = PT::Quantity, .dimension = Dimension::Resistance, .default_value = "0ohm",
+         .source = "assumed: drops taken as constant (the datasheet gives them at 0.6 A only)",
+         .help = "extra resistance per conducting output"},
+        {.name = "enable_unconnected", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
+         .help = "level of an EN input with no net (boards often tie EN to 5 V)"},
     };
 }
 

@@ -7,17 +7,19 @@ namespace avrbench {
 std::vector<ParamSpec> LowSideSwitch::param_specs() {
     using PT = ParamType;
     return {
-        {"channels", PT::Integer, Dimension::Dimensionless, false, "4", {},
-         "seed 001 §3.2: four half-windings A, B, C, D", "number of switches (1..8), inputs in1..inN", 1, 8},
-        {"active", PT::Choice, Dimension::Dimensionless, false, "high", {"high", "low"},
-         "seed 001 Fig. 3.1: NPN with a base resistor (input high = on)", "input level that turns a switch on"},
-        {"v_sat", PT::Quantity, Dimension::Voltage, false, "0.3V", {},
-         "assumed: a small-signal NPN's V_CE(sat) at a few hundred mA (seed 001 names no part)",
-         "saturation voltage of a conducting switch"},
-        {"r_on", PT::Quantity, Dimension::Resistance, false, "0ohm", {}, "assumed (use it for a MOSFET's R_DS(on))",
-         "on resistance"},
-        {"v_flyback", PT::Quantity, Dimension::Voltage, false, "0.8V", {},
-         "assumed: a 1N400x's forward voltage at a few hundred mA", "flyback diode forward voltage"},
+        {.name = "channels", .type = PT::Integer, .default_value = "4",
+         .source = "seed 001 §3.2: four half-windings A, B, C, D",
+         .help = "number of switches (1..8), inputs in1..inN", .min = 1, .max = 8},
+        {.name = "active", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
+         .source = "seed 001 Fig. 3.1: NPN with a base resistor (input high = on)",
+         .help = "input level that turns a switch on"},
+        {.name = "v_sat", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "0.3V",
+         .source = "assumed: a small-signal NPN's V_CE(sat) at a few hundred mA (seed 001 names no part)",
+         .help = "saturation voltage of a conducting switch"},
+        {.name = "r_on", .type = PT::Quantity, .dimension = Dimension::Resistance, .default_value = "0ohm",
+         .source = "assumed (use it for a MOSFET's R_DS(on))", .help = "on resistance"},
+        {.name = "v_flyback", .type = PT::Quantity, .dimension = Dimension::Voltage, .default_value = "0.8V",
+         .source = "assumed: a 1N400x's forward voltage at a few hundred mA", .help = "flyback diode forward voltage"},
     };
 }
 

@@ -9,9 +9,10 @@ namespace avrbench {
 std::vector<ParamSpec> PullResistor::param_specs() {
     using PT = ParamType;
     return {
-        {"to", PT::Choice, Dimension::Dimensionless, true, "", {"vcc", "gnd"}, "", "the rail the resistor goes to"},
-        {"resistance", PT::Quantity, Dimension::Resistance, false, "10kohm", {}, "assumed: the usual 10 kohm",
-         "0 ohm ties the net to the rail (a strong driver)"},
+        {.name = "to", .type = PT::Choice, .required = true, .choices = {"vcc", "gnd"},
+         .help = "the rail the resistor goes to"},
+        {.name = "resistance", .type = PT::Quantity, .dimension = Dimension::Resistance, .default_value = "10kohm",
+         .source = "assumed: the usual 10 kohm", .help = "0 ohm ties the net to the rail (a strong driver)"},
     };
 }
 

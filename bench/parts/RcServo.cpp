@@ -18,19 +18,22 @@ std::vector<ParamSpec> RcServo::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     std::vector<ParamSpec> specs = {
-        {"calibration", PT::Text, D::Dimensionless, false, "0:544,180:2400", {},
-         "the Arduino Servo library's default pulse limits (MIN_PULSE_WIDTH 544 us, MAX_PULSE_WIDTH 2400 us for 0..180 deg)",
-         "degrees:microseconds pairs, both ascending, e.g. [T4] Table 4.1's 0:641,45:1032,90:1474,135:1902,180:2305"},
-        {"slew_deg_per_s", PT::Quantity, D::Dimensionless, false, "600", {},
-         "TowerPro SG90 datasheet: 0.1 s/60 deg at 4.8 V", "the horn's top speed ([T4]'s servo: 285)"},
-        {"dead_band", PT::Quantity, D::Time, false, "10us", {}, "TowerPro SG90 datasheet: dead band width 10 us",
-         "a pulse this close to the last accepted one is not a new command"},
-        {"initial_angle", PT::Quantity, D::Angle, false, "90deg", {}, "assumed: centred at power-on",
-         "where the horn is before the first pulse"},
-        {"min_pulse", PT::Quantity, D::Time, false, "400us", {},
-         "assumed: shorter pulses are glitches, not commands", "pulses shorter than this are ignored"},
-        {"max_pulse", PT::Quantity, D::Time, false, "3000us", {},
-         "assumed: longer pulses are not servo frames", "pulses longer than this are ignored"},
+        {.name = "calibration", .type = PT::Text, .default_value = "0:544,180:2400",
+         .source = "the Arduino Servo library's default pulse limits (MIN_PULSE_WIDTH 544 us, MAX_PULSE_WIDTH 2400 us for 0..180 deg)",
+         .help = "degrees:microseconds pairs, both ascending, e.g. [T4] Table 4.1's 0:641,45:1032,90:1474,135:1902,180:2305"},
+        {.name = "slew_deg_per_s", .type = PT::Quantity, .default_value = "600",
+         .source = "TowerPro SG90 datasheet: 0.1 s/60 deg at 4.8 V",
+         .help = "the horn's top speed ([T4]'s servo: 285)"},
+        {.name = "dead_band", .type = PT::Quantity, .dimension = D::Time, .default_value = "10us",
+         .source = "TowerPro SG90 datasheet: dead band width 10 us",
+         .help = "a pulse this close to the last accepted one is not a new command"},
+        {.name = "initial_angle", .type = PT::Quantity, .dimension = D::Angle, .default_value = "90deg",
+         .source = "assumed: centred at power-on", .help = "where the horn is before the first pulse"},
+        {.name = "min_pulse", .type = PT::Quantity, .dimension = D::Time, .default_value = "400us",
+         .source = "assumed: shorter pulses are glitches, not commands",
+         .help = "pulses shorter than this are ignored"},
+        {.name = "max_pulse", .type = PT::Quantity, .dimension = D::Time, .default_value = "3000us",
+         .source = "assumed: longer pulses are not servo frames", .help = "pulses longer than this are ignored"},
     };
     specs[1].min = 1;
     specs[1].max = 100000;

@@ -11,13 +11,14 @@ std::vector<ParamSpec> SerialPeer::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     return {
-        {"baud", PT::Quantity, D::Dimensionless, false, "9600", {}, "SoftwareSerial examples: 9600 baud",
-         "bits per second", 50, 2e6},
-        {"tolerance", PT::Quantity, D::Dimensionless, false, "0.05", {},
-         "ATmega328P §20.8 Table 20-2: 8N1 receiver error budget about +-4.5 %", "edge error allowed, in bits", 1e-6, 0.499},
-        {"send", PT::Text, D::Dimensionless, false, "", {}, "", "bytes to send once the board starts"},
-        {"send_at", PT::Quantity, D::Time, false, "10ms", {}, "assumed: after the sketch's setup()",
-         "when to start sending `send`"},
+        {.name = "baud", .type = PT::Quantity, .default_value = "9600",
+         .source = "SoftwareSerial examples: 9600 baud", .help = "bits per second", .min = 50, .max = 2e6},
+        {.name = "tolerance", .type = PT::Quantity, .default_value = "0.05",
+         .source = "ATmega328P §20.8 Table 20-2: 8N1 receiver error budget about +-4.5 %",
+         .help = "edge error allowed, in bits", .min = 1e-6, .max = 0.499},
+        {.name = "send", .type = PT::Text, .help = "bytes to send once the board starts"},
+        {.name = "send_at", .type = PT::Quantity, .dimension = D::Time, .default_value = "10ms",
+         .source = "assumed: after the sketch's setup()", .help = "when to start sending `send`"},
     };
 }
 

@@ -5,10 +5,10 @@ namespace avrbench {
 std::vector<ParamSpec> ShiftRegister595::param_specs() {
     using PT = ParamType;
     return {
-        {"oe_unconnected", PT::Choice, Dimension::Dimensionless, false, "low", {"low", "high"}, "",
-         "level of OE with no net (low: outputs enabled)"},
-        {"srclr_unconnected", PT::Choice, Dimension::Dimensionless, false, "high", {"high", "low"},
-         "boards usually tie MR to V_CC", "level of SRCLR with no net"},
+        {.name = "oe_unconnected", .type = PT::Choice, .default_value = "low", .choices = {"low", "high"},
+         .help = "level of OE with no net (low: outputs enabled)"},
+        {.name = "srclr_unconnected", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
+         .source = "boards usually tie MR to V_CC", .help = "level of SRCLR with no net"},
     };
 }
 

@@ -9,10 +9,11 @@ namespace avrbench {
 namespace {
 
 const std::vector<ParamSpec> kSpecs = {
-    {"pulse", ParamType::Quantity, Dimension::Time, false, "2us", {}, "assumed", "pulse width"},
-    {"count", ParamType::Integer, Dimension::Dimensionless, false, "4", {}, "", "", 1, 16},
-    {"mode", ParamType::Choice, Dimension::Dimensionless, false, "fast", {"fast", "slow"}, "", ""},
-    {"to", ParamType::Choice, Dimension::Dimensionless, true, "", {"vcc", "gnd"}, "", "the rail"},
+    {.name = "pulse", .type = ParamType::Quantity, .dimension = Dimension::Time, .default_value = "2us",
+     .source = "assumed", .help = "pulse width"},
+    {.name = "count", .type = ParamType::Integer, .default_value = "4", .min = 1, .max = 16},
+    {.name = "mode", .type = ParamType::Choice, .default_value = "fast", .choices = {"fast", "slow"}},
+    {.name = "to", .type = ParamType::Choice, .required = true, .choices = {"vcc", "gnd"}, .help = "the rail"},
 };
 
 std::string error_of(const std::vector<RawParam>& given) {
