@@ -38,6 +38,8 @@
 #include <string.h>
 
 #include "avrbench_mcu.h"
+#include "fw_line.h"
+#include "fw_uart.h"
 
 AVRBENCH_MCU_SECTION();
 
@@ -50,43 +52,7 @@ volatile int16_t x_position;
 volatile uint16_t steps_left;
 volatile uint8_t soft_pwm_amount;
 
-static volatile char line[32];
-static volatile uint8_t line_len;
-static volatile uint8_t line_ready;
-
-/* --- serial ---------------------------------------------------------------- */
-static void serial_put(char c)
-{
-    while (!(UCSR0A & (1 << UDRE0))) {
-    }
-    UDR0 = (uint8_t)c;
-}
-
-static void serial_print(const char* s)
-{
-    while (*s) serial_put(*s++);
-}
-
-static void serial_print_u16(uint16_t v)
-{
-    char buf[6];
-    utoa(v, buf, 10);
-    serial_print(buf);
-}
-
-ISR(USART0_RX_vect)
-{
-    const char c = (char)UDR0;
-    if (line_ready) return;
-    if (c == '\n' || c == '\r') {
-        if (line_len) {
-            line[line_len] = 0;
-            line_ready = 1;
-        }
-    } else if (line_len < sizeof line - 1) {
-        line[line_len++] = c;
-    }
-}
+static fw_line_t line; /* FW_LINE_MAX 31 */
 
 /* --- temperature + soft PWM interrupt (Timer0 COMPB) ------------------------ */
 ISR(TIMER0_COMPB_vect)
@@ -189,13 +155,13 @@ static void execute(const char* cmd)
         } else if (m == 106 && (arg = find(cmd, 'S'))) {
             soft_pwm_amount = (uint8_t)atoi(arg);
         } else if (m == 105) {
-            serial_print("ok T:");
-            serial_print_u16(current_raw);
-            serial_print("\n");
+            fw_uart_puts("ok T:");
+            fw_uart_put_u32(current_raw);
+            fw_uart_puts("\n");
             return;
         }
     }
-    serial_print("ok\n");
+    fw_uart_puts("ok\n");
 }
 
 int main(void)
@@ -206,11 +172,7 @@ int main(void)
     DDRB |= (1 << PB4);
     DDRH |= (1 << PH6);
 
-    UCSR0A = (1 << U2X0);
-    UCSR0C = (1 << UCSZ01) | (1 << UCSZ00);
-    UBRR0H = 0;
-    UBRR0L = 16;
-    UCSR0B = (1 << RXEN0) | (1 << TXEN0) | (1 << RXCIE0);
+    fw_uart_init(16, 1); /* 115200 baud with U2X */
 
     ADCSRA = (1 << ADEN) | (1 << ADPS2) | (1 << ADPS1) | (1 << ADPS0); /* /128: 125 kHz */
     DIDR2 = (1 << ADC13D);
@@ -228,14 +190,14 @@ int main(void)
     TCCR2B = (1 << CS22);
 
     sei();
-    serial_print("start\n");
+    fw_uart_puts("start\n");
     for (;;) {
-        if (line_ready) {
-            char cmd[sizeof line];
-            for (uint8_t i = 0; i < sizeof line; ++i) cmd[i] = line[i];
-            line_len = 0;
-            line_ready = 0;
-            execute(cmd);
+        const int16_t c = fw_uart_getc();
+        if (c < 0) {
+            fw_uart_idle(); /* until a byte or a timer interrupt */
+        } else if (fw_line_feed(&line, (char)c)) {
+            if (line.overflow) fw_uart_puts("error: line too long\n");
+            else execute(line.text);
         }
     }
 }

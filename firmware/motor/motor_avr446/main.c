@@ -5,7 +5,7 @@
  * phases on (DOUBLE), a 400-step move at 100 rad/s^2 acceleration and
  * deceleration up to 200 rpm (20.94 rad/s, the measured pull-out speed).
  *
- * AVR446's integer algorithm, unchanged but for the timer clock: Timer1 runs
+ * AVR446's integer algorithm (firmware/lib/fw_avr446), unchanged but for the timer clock: Timer1 runs
  * at T1_FREQ = 16 MHz / 8 = 2 MHz (the note's 1 MHz example, seed 003 §4.2,
  * gives every delay in 1 us; here they are 0.5 us ticks, so each c_n is twice
  * the thesis table's). Speeds in 0.01 rad/s, accelerations in 0.01 rad/s^2:
@@ -24,61 +24,29 @@
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <avr/sleep.h>
-#include <math.h>
 #include <stdint.h>
 
 #include "afstepper.h"
 #include "avrbench_mcu.h"
+#include "fw_avr446.h"
 
 AVRBENCH_MCU_SECTION();
-
-#define SPR 200
-#define T1_FREQ 2000000
-#define ALPHA (2 * 3.14159 / SPR)
-#define A_T_x100 ((long)(ALPHA * T1_FREQ * 100))
-#define T1_FREQ_148 ((int)((T1_FREQ * 0.676) / 100))
-#define A_SQ (long)(ALPHA * 2 * 10000000000)
-#define A_x20000 (int)(ALPHA * 20000)
 
 #define MOVE_STEPS 400
 #define ACCEL 10000 /* 100 rad/s^2 */
 #define DECEL 10000
 #define SPEED 2094  /* 20.94 rad/s = 200 rpm */
 
-enum { STOP, ACCEL_STATE, RUN, DECEL_STATE };
-
-static volatile uint8_t run_state;
-static volatile unsigned int step_delay;
-static int decel_val;
-static unsigned int decel_start;
-static unsigned int min_delay;
-static int accel_count;
+static fw_avr446_t ramp; /* FW_AVR446_STEPS_PER_REV 200, FW_AVR446_TIMER_HZ 2 MHz (CMakeLists.txt) */
 
 volatile unsigned int step_count;
 volatile uint8_t running;
 volatile uint8_t done;
 volatile unsigned int min_delay_used = 0xFFFF;
 
-static void move(signed int step, unsigned int accel, unsigned int decel, unsigned int speed)
+static void move(unsigned int steps, unsigned int accel, unsigned int decel, unsigned int speed)
 {
-    unsigned int max_s_lim, accel_lim;
-    min_delay = A_T_x100 / speed;
-    step_delay = (T1_FREQ_148 * sqrt(A_SQ / accel)) / 100;
-    max_s_lim = (long)speed * speed / (long)(((long)A_x20000 * accel) / 100);
-    if (max_s_lim == 0) max_s_lim = 1;
-    accel_lim = ((long)step * decel) / (accel + decel);
-    if (accel_lim == 0) accel_lim = 1;
-    if (accel_lim <= max_s_lim) decel_val = accel_lim - step;
-    else decel_val = -((long)max_s_lim * accel) / decel;
-    if (decel_val == 0) decel_val = -1;
-    decel_start = step + decel_val;
-    if (step_delay <= min_delay) {
-        step_delay = min_delay;
-        run_state = RUN;
-    } else {
-        run_state = ACCEL_STATE;
-    }
-    accel_count = 0;
+    fw_avr446_plan(&ramp, steps, accel, decel, speed);
     running = 1;
     OCR1A = 10;
     TCNT1 = 0;
@@ -87,60 +55,19 @@ static void move(signed int step, unsigned int accel, unsigned int decel, unsign
     TCCR1B = _BV(WGM12) | _BV(CS11); /* CTC, clk/8 */
 }
 
-static void take_step(void)
-{
-    afstepper_onestep(FORWARD, DOUBLE);
-    step_count++;
-}
-
 ISR(TIMER1_COMPA_vect)
 {
-    unsigned int new_step_delay = step_delay;
-    static int last_accel_delay;
-    static unsigned int rest = 0;
-
-    OCR1A = step_delay;
-    if (run_state != STOP && step_delay < min_delay_used) min_delay_used = step_delay;
-    switch (run_state) {
-        case STOP:
-            rest = 0;
-            TCCR1B = 0;
-            running = 0;
-            done = 1;
-            break;
-        case ACCEL_STATE:
-            take_step();
-            accel_count++;
-            new_step_delay = step_delay - (((2 * (long)step_delay) + rest) / (4 * accel_count + 1));
-            rest = ((2 * (long)step_delay) + rest) % (4 * accel_count + 1);
-            if (step_count >= decel_start) {
-                accel_count = decel_val;
-                run_state = DECEL_STATE;
-            } else if (new_step_delay <= min_delay) {
-                last_accel_delay = new_step_delay;
-                new_step_delay = min_delay;
-                rest = 0;
-                run_state = RUN;
-            }
-            break;
-        case RUN:
-            take_step();
-            new_step_delay = min_delay;
-            if (step_count >= decel_start) {
-                accel_count = decel_val;
-                new_step_delay = last_accel_delay;
-                run_state = DECEL_STATE;
-            }
-            break;
-        case DECEL_STATE:
-            take_step();
-            accel_count++;
-            new_step_delay = step_delay - (((2 * (long)step_delay) + rest) / (4 * accel_count + 1));
-            rest = ((2 * (long)step_delay) + rest) % (4 * accel_count + 1);
-            if (accel_count >= 0) run_state = STOP;
-            break;
+    OCR1A = ramp.step_delay;
+    if (!fw_avr446_stepping(&ramp)) {
+        TCCR1B = 0;
+        running = 0;
+        done = 1;
+        return;
     }
-    step_delay = new_step_delay;
+    if (ramp.step_delay < min_delay_used) min_delay_used = ramp.step_delay;
+    afstepper_onestep(FORWARD, DOUBLE);
+    step_count++;
+    fw_avr446_next(&ramp);
 }
 
 int main(void)

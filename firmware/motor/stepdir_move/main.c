@@ -13,20 +13,12 @@
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <avr/sleep.h>
-#include <math.h>
 #include <stdint.h>
 
 #include "avrbench_mcu.h"
+#include "fw_avr446.h"
 
 AVRBENCH_MCU_SECTION();
-
-#define SPR 3200 /* 200 full steps x 16 */
-#define T1_FREQ 2000000
-#define ALPHA (2 * 3.14159 / SPR)
-#define A_T_x100 ((long)(ALPHA * T1_FREQ * 100))
-#define T1_FREQ_148 ((int)((T1_FREQ * 0.676) / 100))
-#define A_SQ (long)(ALPHA * 2 * 10000000000)
-#define A_x20000 (int)(ALPHA * 20000)
 
 #ifndef MOVE
 #define MOVE 6400 /* two revolutions */
@@ -38,14 +30,7 @@ AVRBENCH_MCU_SECTION();
 #define SPEED 2094 /* 20.94 rad/s = 200 rpm */
 #endif
 
-enum { STOP, ACCEL_STATE, RUN, DECEL_STATE };
-
-static volatile uint8_t run_state;
-static volatile unsigned int step_delay;
-static int decel_val;
-static unsigned int decel_start;
-static unsigned int min_delay;
-static int accel_count;
+static fw_avr446_t ramp; /* FW_AVR446_STEPS_PER_REV 3200 (200 full steps x 16), 2 MHz (CMakeLists.txt) */
 
 volatile unsigned int step_count;
 volatile uint8_t done;
@@ -58,37 +43,15 @@ static void pulse(void)
     step_count++;
 }
 
-static void move(unsigned int step, unsigned int accel, unsigned int decel, unsigned int speed)
+static void move(unsigned int steps, unsigned int accel, unsigned int decel, unsigned int speed)
 {
-    unsigned int max_s_lim, accel_lim;
-    min_delay = A_T_x100 / speed;
 #ifdef NO_RAMP
     (void)accel;
     (void)decel;
-    (void)max_s_lim;
-    (void)accel_lim;
-    step_delay = min_delay;
-    decel_start = step; /* never decelerate: stop dead after the last step */
-    decel_val = 0;
-    run_state = RUN;
+    fw_avr446_plan_constant(&ramp, steps, speed);
 #else
-    step_delay = (T1_FREQ_148 * sqrt(A_SQ / accel)) / 100;
-    max_s_lim = (long)speed * speed / (long)(((long)A_x20000 * accel) / 100);
-    if (max_s_lim == 0) max_s_lim = 1;
-    accel_lim = ((long)step * decel) / (accel + decel);
-    if (accel_lim == 0) accel_lim = 1;
-    if (accel_lim <= max_s_lim) decel_val = accel_lim - step;
-    else decel_val = -((long)max_s_lim * accel) / decel;
-    if (decel_val == 0) decel_val = -1;
-    decel_start = step + decel_val;
-    if (step_delay <= min_delay) {
-        step_delay = min_delay;
-        run_state = RUN;
-    } else {
-        run_state = ACCEL_STATE;
-    }
+    fw_avr446_plan(&ramp, steps, accel, decel, speed);
 #endif
-    accel_count = 0;
     OCR1A = 10;
     TCNT1 = 0;
     TIMSK1 = _BV(OCIE1A);
@@ -98,53 +61,14 @@ static void move(unsigned int step, unsigned int accel, unsigned int decel, unsi
 
 ISR(TIMER1_COMPA_vect)
 {
-    unsigned int new_step_delay = step_delay;
-    static unsigned int last_accel_delay __attribute__((unused));
-    static unsigned int rest = 0;
-
-    OCR1A = step_delay;
-    switch (run_state) {
-        case STOP:
-            TCCR1B = 0;
-            done = 1;
-            break;
-        case ACCEL_STATE:
-            pulse();
-            accel_count++;
-            new_step_delay = step_delay - (((2 * (long)step_delay) + rest) / (4 * accel_count + 1));
-            rest = ((2 * (long)step_delay) + rest) % (4 * accel_count + 1);
-            if (step_count >= decel_start) {
-                accel_count = decel_val;
-                run_state = DECEL_STATE;
-            } else if (new_step_delay <= min_delay) {
-                last_accel_delay = new_step_delay;
-                new_step_delay = min_delay;
-                rest = 0;
-                run_state = RUN;
-            }
-            break;
-        case RUN:
-            pulse();
-            new_step_delay = min_delay;
-            if (step_count >= decel_start) {
-#ifdef NO_RAMP
-                run_state = STOP;
-#else
-                accel_count = decel_val;
-                new_step_delay = last_accel_delay;
-                run_state = DECEL_STATE;
-#endif
-            }
-            break;
-        case DECEL_STATE:
-            pulse();
-            accel_count++;
-            new_step_delay = step_delay - (((2 * (long)step_delay) + rest) / (4 * accel_count + 1));
-            rest = ((2 * (long)step_delay) + rest) % (4 * accel_count + 1);
-            if (accel_count >= 0) run_state = STOP;
-            break;
+    OCR1A = ramp.step_delay;
+    if (!fw_avr446_stepping(&ramp)) {
+        TCCR1B = 0;
+        done = 1;
+        return;
     }
-    step_delay = new_step_delay;
+    pulse();
+    fw_avr446_next(&ramp);
 }
 
 int main(void)
