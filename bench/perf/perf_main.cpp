@@ -269,7 +269,7 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
 void run_motor_overhead(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 
-int main(int argc, char** argv) {
+int perf_main(int argc, char** argv) {
     CLI::App app{"avrbench_perf: bench vs bare simavr on the same ELFs"};
     int repeats = 3;
     double scale = 1.0;
@@ -402,4 +402,14 @@ int main(int argc, char** argv) {
                 cpu_without, cpu_with, cpu_with / cpu_without);
     if (!only_thermal) run_motor_overhead(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
     return 0;
+}
+
+int main(int argc, char** argv) {
+    try {
+        return perf_main(argc, argv);
+    } catch (const std::exception& e) {
+        // A bad ELF or board is one line and exit code 2, as in the CLI.
+        std::fprintf(stderr, "avrbench_perf: error: %s\n", e.what());
+        return 2;
+    }
 }

@@ -35,6 +35,15 @@ avrbench::BoardSpec shield(const std::string& source_dir, bool with_motor) {
         spec.parts.erase(std::remove_if(spec.parts.begin(), spec.parts.end(),
                                         [](const avrbench::PartDecl& p) { return p.name == "motor"; }),
                          spec.parts.end());
+        // and the net that joins its windings to the bridge
+        spec.nets.erase(std::remove_if(spec.nets.begin(), spec.nets.end(),
+                                       [](const avrbench::NetDecl& n) {
+                                           for (const auto& e : n.endpoints) {
+                                               if (e.owner == "motor") return true;
+                                           }
+                                           return false;
+                                       }),
+                        spec.nets.end());
     }
     return spec;
 }

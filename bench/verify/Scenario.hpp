@@ -27,23 +27,10 @@
 #include <vector>
 
 #include "core/Time.hpp"
+#include "stimulus/BenchSteps.hpp"
 #include "verify/TimelineCompare.hpp"
 
 namespace avrbench {
-
-// --- steps: what a person does at the bench, in order ----------------------
-struct SendStep { std::string line; };                 // one line through the serial host
-struct SendFileStep { std::string path; };             // a job, with the port's flow control
-struct DelayStep { Picoseconds duration_ps = 0; };
-struct WaitIdleStep { Picoseconds settle_ps = 0; };    // hosts finished, no STEP edge for settle
-struct WaitForTextStep { std::string text; };          // a firmware line containing it
-struct WaitPinStep { std::string pin; bool level = false; };
-struct SetInputStep { std::string pin; bool level = false; };
-struct ReleaseInputStep { std::string pin; };
-struct InjectFaultStep { std::string part; std::string fault; };
-
-using StepAction = std::variant<SendStep, SendFileStep, DelayStep, WaitIdleStep, WaitForTextStep, WaitPinStep,
-                                SetInputStep, ReleaseInputStep, InjectFaultStep>;
 
 struct ScenarioStep {
     StepAction action;
