@@ -239,6 +239,14 @@ void HybridStepper::connect_port(std::size_t, Part& provider) {
     listen(source);
 }
 
+std::string HybridStepper::summary() {
+    sync();
+    char line[200];
+    std::snprintf(line, sizeof line, "motor      %s: at %.2f deg (commanded %.2f), %ld steps lost, %u stalls", name().c_str(),
+                  angle_deg(), commanded_deg(), lost_steps(), stalls());
+    return line;
+}
+
 void HybridStepper::start() {
     // A driver with its ENABLE unwired energizes the windings at power-on.
     on_drive_change();

@@ -45,6 +45,7 @@ public:
     HybridStepper(std::string name, Mcu& clock, const ParamValues& params, bool unipolar);
     std::string_view type() const override { return unipolar_ ? "unipolar_stepper" : "hybrid_stepper"; }
     void start() override;
+    std::string summary() override;
 
     // Port `windings` requires what drives the windings (a DriveSource: the
     // motor knows the interface, not the parts); per winding (A, B; unipolar:

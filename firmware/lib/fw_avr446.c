@@ -2,7 +2,7 @@
 
 #include <math.h>
 
-#define ALPHA (2 * 3.14159 / FW_AVR446_STEPS_PER_REV)
+#define ALPHA FW_AVR446_ALPHA
 #define A_T_x100 ((long)(ALPHA * FW_AVR446_TIMER_HZ * 100))
 #define T1_FREQ_148 ((int)((FW_AVR446_TIMER_HZ * 0.676) / 100))
 #define A_SQ (long)(ALPHA * 2 * 10000000000)

@@ -7,8 +7,8 @@
  *   c_n = c_{n-1} - (2 c_{n-1} + rest) / (4 n + 1)    (remainder carried)
  *   accelerate -> run at min_delay = alpha f_t / speed -> decelerate
  *
- * alpha = 2 pi / FW_AVR446_STEPS_PER_REV, f_t = FW_AVR446_TIMER_HZ (the step
- * timer's clock); both compile-time, so the constants fold as in the note.
+ * alpha = FW_AVR446_ALPHA (2 pi / FW_AVR446_STEPS_PER_REV unless given),
+ * f_t = FW_AVR446_TIMER_HZ (the step timer's clock); all compile-time, so the constants fold as in the note.
  * Speeds in 0.01 rad/s, accelerations in 0.01 rad/s^2, delays in timer ticks.
  *
  * Use from the step timer's compare ISR:
@@ -25,6 +25,10 @@
 #endif
 #ifndef FW_AVR446_TIMER_HZ
 #define FW_AVR446_TIMER_HZ 2000000
+#endif
+/* The step angle in rad; seed 003 §4.2 rounds 2 pi / 200 to 0.0314. */
+#ifndef FW_AVR446_ALPHA
+#define FW_AVR446_ALPHA (2 * 3.14159 / FW_AVR446_STEPS_PER_REV)
 #endif
 
 enum { FW_AVR446_STOP, FW_AVR446_ACCEL, FW_AVR446_RUN, FW_AVR446_DECEL };

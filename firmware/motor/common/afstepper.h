@@ -36,6 +36,7 @@
 #define SINGLE 1
 #define DOUBLE 2
 #define INTERLEAVE 3
+#define MICROSTEP 4 /* with AFSTEPPER_MICROSTEP defined: PWM on the bridge enables */
 
 #define MICROSTEPS 16
 
@@ -114,6 +115,54 @@ static inline void afstepper_release(void)
     latch_state &= (uint8_t)(~_BV(MOTOR3_A) & ~_BV(MOTOR3_B) & ~_BV(MOTOR4_A) & ~_BV(MOTOR4_B));
     latch_tx();
 }
+
+#ifdef AFSTEPPER_MICROSTEP
+/* AFMotor's microstep duty curve (digest §2.5), MICROSTEPS + 1 entries. */
+static const uint8_t microstep_curve[MICROSTEPS + 1] = {0,   25,  50,  74,  98,  120, 141, 162, 180,
+                                                        197, 212, 225, 236, 244, 250, 253, 255};
+
+/* Port 2's bridge enables as Timer0 PWM (OC0A = PD6 -> phase A's 1,2EN,
+ * OC0B = PD5 -> phase B's 3,4EN), fast PWM at clk/64 (976.6 Hz: AFMotor
+ * leaves Timer0's prescaler at the Arduino default for port 2, digest §2.5),
+ * or constantly high for the full-step styles (setPWM(255)). */
+static inline void afstepper_pwm(uint8_t on)
+{
+    if (on) {
+        TCCR0A = _BV(COM0A1) | _BV(COM0B1) | _BV(WGM01) | _BV(WGM00);
+        TCCR0B = _BV(CS01) | _BV(CS00);
+    } else {
+        TCCR0A = 0;
+        TCCR0B = 0;
+        PORTD |= _BV(PD5) | _BV(PD6);
+    }
+}
+
+/* One microstep: currentstep moves by 1 of 64 per electrical cycle. In
+ * quadrant q (16 microsteps each) the coil pair a|b, b|c, c|d, d|a carries
+ * current; within it the duties follow the curve, one phase falling as the
+ * other rises (duty_A = curve[16 - k], duty_B = curve[k] in the first). */
+static inline void afstepper_microstep(uint8_t dir)
+{
+    const uint8_t a = _BV(MOTOR3_A), b = _BV(MOTOR4_A), c = _BV(MOTOR3_B), d = _BV(MOTOR4_B);
+    if (dir == FORWARD) currentstep++;
+    else currentstep--;
+    currentstep += MICROSTEPS * 4;
+    currentstep %= MICROSTEPS * 4;
+    const uint8_t quadrant = currentstep / MICROSTEPS, k = currentstep % MICROSTEPS;
+    /* Phase A's duty rises in odd quadrants and falls in even ones; B the reverse. */
+    const uint8_t rising = microstep_curve[k], falling = microstep_curve[MICROSTEPS - k];
+    OCR0A = (quadrant % 2) ? rising : falling;
+    OCR0B = (quadrant % 2) ? falling : rising;
+    latch_state &= (uint8_t)(~a & ~b & ~c & ~d);
+    switch (quadrant) {
+        case 0: latch_state |= a | b; break;
+        case 1: latch_state |= b | c; break;
+        case 2: latch_state |= c | d; break;
+        default: latch_state |= d | a; break;
+    }
+    latch_tx();
+}
+#endif
 
 static inline uint8_t afstepper_onestep(uint8_t dir, uint8_t style)
 {
