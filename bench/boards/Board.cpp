@@ -201,6 +201,8 @@ void Board::build_nets() {
                                                   : first.kind == PortKind::Steps   ? "a step_dir_driver's steps"
                                                   : first.kind == PortKind::Carriage ? "a linear axis' carriage"
                                                   : first.kind == PortKind::Windings ? "an l293d's windings"
+                                                  : first.kind == PortKind::Horn     ? "an rc_servo's horn"
+                                                  : first.kind == PortKind::Effector ? "a delta_robot's effector"
                                                                                      : "an analog output") +
                            ")");
         }

@@ -1,11 +1,14 @@
 #include "boards/PartRegistry.hpp"
 
 #include "parts/Axis.hpp"
+#include "parts/DeltaRobot.hpp"
+#include "parts/Electromagnet.hpp"
 #include "parts/Fan.hpp"
 #include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
 #include "parts/PullResistor.hpp"
 #include "parts/RcServo.hpp"
+#include "parts/Relay.hpp"
 #include "parts/SerialPeer.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
@@ -29,7 +32,9 @@ const std::map<std::string, PartType>& part_types() {
                            simple_part_type<LimitSwitch>("limit_switch"), simple_part_type<PullResistor>("pull_resistor"),
                            simple_part_type<SerialPeer>("serial_peer"), simple_part_type<RcServo>("rc_servo"),
                            simple_part_type<ThermalPlant>("thermal_plant"), simple_part_type<Heater>("heater"),
-                           simple_part_type<Thermistor>("thermistor"), simple_part_type<Fan>("fan")}) {
+                           simple_part_type<Thermistor>("thermistor"), simple_part_type<Fan>("fan"),
+                           simple_part_type<DeltaRobot>("delta_robot"), simple_part_type<Relay>("relay"),
+                           simple_part_type<Electromagnet>("electromagnet")}) {
             m.emplace(t.name, std::move(t));
         }
         for (PartType t : motor_part_types()) m.emplace(t.name, std::move(t));

@@ -45,6 +45,8 @@ std::string_view port_kind_name(PortKind kind) {
         case PortKind::Carriage: return "carriage";
         case PortKind::Thermal: return "thermal";
         case PortKind::Windings: return "windings";
+        case PortKind::Horn: return "horn";
+        case PortKind::Effector: return "effector";
     }
     return "?";
 }

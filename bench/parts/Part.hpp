@@ -68,6 +68,8 @@ enum class PortKind : std::uint8_t {
     Carriage, // a linear axis' carriage position (provider: Axis)
     Thermal,  // a thermal body heaters, sensors and fans couple to (ThermalPlant)
     Windings, // motor winding drives (provider: DriveSource)
+    Horn,     // an RC servo's output shaft angle (provider: RcServo)
+    Effector, // a mechanism's tool point in space (provider: DeltaRobot)
 };
 std::string_view port_kind_name(PortKind kind);
 

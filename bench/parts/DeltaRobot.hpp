@@ -1,0 +1,56 @@
+// A rotary delta robot driven by three RC servos (seed 004): ports horn1..3
+// require the servos' horns; the arm angle is theta_k = offset_k - horn_k
+// (the servo angle at which the upper arm is horizontal, minus the horn's),
+// theta > 0 below the base plane. The effector centre follows by forward
+// kinematics (parts/DeltaKinematics) and is traced as x_mm, y_mm, z_mm;
+// port `effector` provides it to tools (an electromagnet).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "parts/DeltaKinematics.hpp"
+#include "parts/Params.hpp"
+#include "parts/Part.hpp"
+
+namespace avrbench {
+
+class RcServo;
+
+class DeltaRobot final : public Part {
+public:
+    static std::vector<ParamSpec> param_specs();
+
+    DeltaRobot(std::string name, Mcu& clock, const ParamValues& params);
+    std::string_view type() const override { return "delta_robot"; }
+    void connect_port(std::size_t port, Part& provider) override;
+    void start() override;
+    std::string summary() override;
+
+    const DeltaGeometry& geometry() const { return geometry_; }
+    // The effector centre as of the last sample (mm), and whether the arms' angles reach one.
+    const Eigen::Vector3d& effector_mm() const { return effector_mm_; }
+    bool reachable() const { return reachable_; }
+    std::array<double, 3> arm_angles_deg() const;
+    void on_move(std::function<void(const Eigen::Vector3d&)> fn) { move_listeners_.push_back(std::move(fn)); }
+
+private:
+    void tick();
+    void sample();
+
+    DeltaGeometry geometry_;
+    std::array<double, 3> offset_deg_{};
+    std::array<RcServo*, 3> horns_{};
+    std::array<std::size_t, 3> horn_ports_{};
+    Cycle sample_cycles_;
+    Eigen::Vector3d effector_mm_ = Eigen::Vector3d::Zero();
+    bool reachable_ = false;
+    bool sampled_ = false;
+    std::size_t sig_x_, sig_y_, sig_z_, sig_reachable_;
+    std::vector<std::function<void(const Eigen::Vector3d&)>> move_listeners_;
+};
+
+}  // namespace avrbench
