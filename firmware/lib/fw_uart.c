@@ -11,8 +11,30 @@
 
 #if defined(USART0_RX_vect)
 #define FW_UART_RX_VECT USART0_RX_vect /* ATmega2560 */
+#define FW_UART_UDRE_VECT USART0_UDRE_vect
 #else
 #define FW_UART_RX_VECT USART_RX_vect /* ATmega328P */
+#define FW_UART_UDRE_VECT USART_UDRE_vect
+#endif
+
+#ifdef FW_UART_TX_SIZE
+#if (FW_UART_TX_SIZE & (FW_UART_TX_SIZE - 1)) != 0 || FW_UART_TX_SIZE > 128
+#error "FW_UART_TX_SIZE must be a power of two, at most 128"
+#endif
+static volatile uint8_t tx_ring[FW_UART_TX_SIZE];
+static volatile uint8_t tx_head; /* written by fw_uart_putc only */
+static volatile uint8_t tx_tail; /* written by the UDRE ISR only */
+
+ISR(FW_UART_UDRE_VECT)
+{
+    const uint8_t tail = tx_tail;
+    if (tx_head == tail) {
+        UCSR0B &= (uint8_t)~(1 << UDRIE0); /* drained: no more UDRE interrupts */
+        return;
+    }
+    UDR0 = tx_ring[tail & (FW_UART_TX_SIZE - 1)];
+    tx_tail = (uint8_t)(tail + 1);
+}
 #endif
 
 static volatile uint8_t rx_ring[FW_UART_RX_SIZE];
@@ -66,9 +88,18 @@ void fw_uart_idle(void)
 
 void fw_uart_putc(char c)
 {
+#ifdef FW_UART_TX_SIZE
+    const uint8_t head = tx_head;
+    while ((uint8_t)(head - tx_tail) >= FW_UART_TX_SIZE) { /* full: the ISR makes room */
+    }
+    tx_ring[head & (FW_UART_TX_SIZE - 1)] = (uint8_t)c;
+    tx_head = (uint8_t)(head + 1);
+    UCSR0B |= (1 << UDRIE0);
+#else
     while (!(UCSR0A & (1 << UDRE0))) { /* UDRE0: UDR0 can take a byte */
     }
     UDR0 = (uint8_t)c;
+#endif
 }
 
 void fw_uart_puts(const char *s)

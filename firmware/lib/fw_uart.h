@@ -1,8 +1,11 @@
 /*
  * The USART0 (ATmega328P, ATmega2560) as the firmware of this repository
- * uses it: interrupt-driven receive into a ring buffer, polled transmit and
+ * uses it: interrupt-driven receive into a ring buffer; transmit polled or
+ * (with FW_UART_TX_SIZE defined, a power of two up to 128) through a ring the
+ * data-register-empty interrupt drains, as the Arduino core's Serial does;
  * a few print helpers. FW_UART_RX_SIZE (a power of two, at most 128; default
- * 64) sizes the ring; a byte that finds it full is dropped and counted.
+ * 64) sizes the receive ring; a byte that finds it full is dropped and
+ * counted. fw_uart_putc blocks only while the transmit ring is full.
  */
 #ifndef FW_UART_H
 #define FW_UART_H
