@@ -6,6 +6,7 @@
 #include "parts/Fan.hpp"
 #include "parts/Heater.hpp"
 #include "parts/LimitSwitch.hpp"
+#include "parts/PenLift.hpp"
 #include "parts/PullResistor.hpp"
 #include "parts/RcServo.hpp"
 #include "parts/Relay.hpp"
@@ -34,7 +35,7 @@ const std::map<std::string, PartType>& part_types() {
                            simple_part_type<ThermalPlant>("thermal_plant"), simple_part_type<Heater>("heater"),
                            simple_part_type<Thermistor>("thermistor"), simple_part_type<Fan>("fan"),
                            simple_part_type<DeltaRobot>("delta_robot"), simple_part_type<Relay>("relay"),
-                           simple_part_type<Electromagnet>("electromagnet")}) {
+                           simple_part_type<Electromagnet>("electromagnet"), simple_part_type<PenLift>("pen_lift")}) {
             m.emplace(t.name, std::move(t));
         }
         for (PartType t : motor_part_types()) m.emplace(t.name, std::move(t));
