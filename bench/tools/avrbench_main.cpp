@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "boards/Board.hpp"
+#include "cam/Chain.hpp"
+#include "cam/DxfReader.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
 #include "core/Mcu.hpp"
@@ -546,6 +548,35 @@ int run_command(const RunArgs& args) {
     return kExitOk;
 }
 
+struct CamArgs {
+    std::string dxf;
+    std::string out;            // .nc file ("" = beside the DXF)
+    std::string tolerance = "0.01mm";
+    std::string feed = "600";   // mm/min
+};
+
+// DXF -> aligned segments -> G-code (seed 002's CAD2G, docs/CNC.md).
+int cam_command(const CamArgs& args) {
+    DxfReadResult read = read_dxf(args.dxf);
+    const double tolerance_mm = parse_quantity(args.tolerance, Dimension::Length, "--tolerance") * 1e3;
+    if (!(tolerance_mm >= 0 && tolerance_mm <= 10)) throw BadInput("--tolerance: must be from 0 to 10 mm");
+    const double feed = parse_quantity(args.feed, Dimension::Dimensionless, "--feed");
+    if (!(feed > 0 && feed <= 1e5)) throw BadInput("--feed: mm/min above 0 and at most 100000");
+    const GcodeProgram before = emit_gcode(read.drawing, tolerance_mm, feed);
+    const ChainStats stats = align_segments(read.drawing, tolerance_mm);
+    const GcodeProgram after = emit_gcode(read.drawing, tolerance_mm, feed);
+    const std::string out = args.out.empty() ? with_extension(args.dxf, ".nc") : args.out;
+    check_output_path(out, "-o");
+    write_output_file(out, after.text, "-o");
+    std::printf("avrbench cam: %s\n", args.dxf.c_str());
+    std::printf("  entities   %zu (lines, arcs, circles); %u others skipped\n", read.drawing.segments.size(),
+                read.skipped_entities);
+    std::printf("  aligned    %u passes, tolerance %g mm\n", stats.revisions, tolerance_mm);
+    std::printf("  commands   %u -> %u (rapids %u -> %u)\n", before.commands, after.commands, before.rapids, after.rapids);
+    std::printf("  g-code     %s\n", out.c_str());
+    return kExitOk;
+}
+
 // build/avrbench -> build/firmware, where the build puts our firmware ELFs.
 std::string default_firmware_dir() {
     if (const char* env = std::getenv("AVRBENCH_FIRMWARE_DIR")) return env;
@@ -705,6 +736,13 @@ int main(int argc, char** argv) {
     update_cmd->add_option("--firmware-dir", golden.firmware_dir, "where bare firmware names resolve");
     update_cmd->add_flag("--force", golden.force, "write the golden even when the run fails its steps or expectations");
 
+    CamArgs cam;
+    CLI::App* cam_cmd = app.add_subcommand("cam", "seed 002's CAM: a DXF drawing (lines, arcs, circles) to G-code");
+    cam_cmd->add_option("dxf", cam.dxf, "the drawing, machine millimetres from home")->required();
+    cam_cmd->add_option("-o,--output", cam.out, "the .nc file to write (default: beside the DXF)");
+    cam_cmd->add_option("--tolerance", cam.tolerance, "endpoints closer than this are one point (default 0.01mm)");
+    cam_cmd->add_option("--feed", cam.feed, "drawing feed in mm/min (default 600)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -723,6 +761,7 @@ int main(int argc, char** argv) {
         if (run_cmd->parsed()) code = run_command(run);
         if (check_cmd->parsed()) code = check_command(check, false);
         if (update_cmd->parsed()) code = check_command(golden, true);
+        if (cam_cmd->parsed()) code = cam_command(cam);
     } catch (const BadInput& e) {
         std::fflush(stdout);
         std::fprintf(stderr, "avrbench: error: %s\n", e.what());
