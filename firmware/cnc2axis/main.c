@@ -22,12 +22,13 @@
  *   0x01 G01  COUNT stepx, [IMPROVED: COUNT stepy,] OCR0A, OCR2A, START   pen down;
  *             X counted by polling OCF0A; Y runs open loop until X is done
  *             (IMPROVED: Y counted by the Timer2 interrupt)
- *   0x02 / 0x03 G02 / G03: then arc records DX, V_X (OCR0A), V_Y (OCR2A),
- *             DIR (START), one per chord; while one chord runs the next is
- *             received; the Timer0 interrupt counts DX X steps and then stops
- *             counting (the motors keep turning until the next chord loads);
- *             a record with both EN bits set ends the arc. ACK when a record
- *             is loaded.
+ *   0x02 / 0x03 G02 / G03: then arc records DX, [IMPROVED: DY,] V_X (OCR0A),
+ *             V_Y (OCR2A), DIR (START), one per chord; while one chord runs
+ *             the next is received; the Timer0 interrupt counts DX X steps
+ *             and then stops counting (the motors keep turning until the next
+ *             chord loads; IMPROVED: X and Y both counted, each switched off
+ *             at its count); a record with both EN bits set ends the arc.
+ *             ACK when a record is loaded.
  *   0x3B M30  pen up, both drivers off, ACK, sleep with interrupts off.
  * After every G00/G01 both EN bits are 1.
  *
@@ -43,7 +44,8 @@
  *
  * The thesis-faithful build (default) keeps 16-bit step counters (a move of
  * more than 65535 microsteps, 409.6 mm at 1/32, wraps) and Y open loop in
- * G01; IMPROVED has 24-bit counters and counts Y.
+ * G01 and arcs; IMPROVED has 24-bit counters, counts Y everywhere and lets
+ * the pen settle (200 ms) before moving after it goes up or down.
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
@@ -181,7 +183,18 @@ static void count_x_polled(count_t count)
 }
 
 /* --- pen servo (Timer1) -------------------------------------------------------- */
-static void pen(uint16_t ocr) { OCR1A = ocr; }
+static void pen(uint16_t ocr)
+{
+    if (OCR1A == ocr) return;
+    OCR1A = ocr;
+#ifdef IMPROVED
+    /* Let the pen land or lift before the carriage moves: an SG90 turns 90
+     * deg in 0.15 s (0.1 s / 60 deg at 4.8 V), and the new width starts at
+     * the next 20 ms frame. The thesis moves at once, so the pen touches down
+     * late on a line's start and drags into the next rapid. */
+    _delay_ms(200);
+#endif
+}
 
 static void pen_init(void)
 {
@@ -252,12 +265,26 @@ static void g01(void)
 static void arc(void)
 {
     pen(PEN_DOWN_OCR);
-    x_end_disables = 0;
+#ifdef IMPROVED
+    x_end_disables = 1; /* each axis stops at its count: no run-on between chords */
+#else
+    x_end_disables = 0; /* the thesis: the motors turn on until the next chord loads */
+#endif
     timers_run();
     for (;;) {
-        const uint8_t dx = rx(), vx = rx(), vy = rx(), dir = rx(); /* received while the last chord runs */
+        /* received while the last chord runs */
+        const uint8_t dx = rx();
+#ifdef IMPROVED
+        const uint8_t dy = rx();
+#endif
+        const uint8_t vx = rx(), vy = rx(), dir = rx();
+#ifdef IMPROVED
+        while (x_left != 0 || y_left != 0) {
+        }
+#else
         while (x_left != 0) {
         }
+#endif
         cli();
         x_left = dx;
         x_half = 0;
@@ -266,6 +293,12 @@ static void arc(void)
         apply_start(dir);
         TIFR0 = _BV(OCF0A);
         TIMSK0 = dx != 0 ? _BV(OCIE0A) : 0;
+#ifdef IMPROVED
+        y_left = dy;
+        y_half = 0;
+        TIFR2 = _BV(OCF2A);
+        TIMSK2 = dy != 0 ? _BV(OCIE2A) : 0;
+#endif
         sei();
         tx(ACK);
         if ((dir & (_BV(X_EN) | _BV(Y_EN))) == (_BV(X_EN) | _BV(Y_EN))) return; /* the closing record */

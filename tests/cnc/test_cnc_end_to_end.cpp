@@ -1,0 +1,130 @@
+// Seed 002 end to end: a DXF drawing (a line, an arc and a circle) through
+// the CAM (bench/cam) to G-code, to the firmware's binary records, streamed
+// stop-and-wait to firmware/cnc2axis on its board; the pen's strokes must
+// retrace the drawing. Each test runs under ctest's 300 s wall-clock limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "boards/Board.hpp"
+#include "cam/Chain.hpp"
+#include "cam/DxfReader.hpp"
+#include "cam/Records.hpp"
+#include "core/Errors.hpp"
+#include "core/Uart.hpp"
+#include "parts/PenLift.hpp"
+#include "stimulus/RecordHost.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+// Distance from p to the drawing's nearest segment (lines; arcs as their circle's sector).
+double distance_to(const Drawing& d, const Point2& p) {
+    double best = 1e9;
+    for (const auto& s : d.segments) {
+        if (s.kind == Segment::Kind::Line) {
+            const double vx = s.end.x - s.start.x, vy = s.end.y - s.start.y;
+            const double len2 = vx * vx + vy * vy;
+            const double t = len2 > 0 ? std::clamp(((p.x - s.start.x) * vx + (p.y - s.start.y) * vy) / len2, 0.0, 1.0) : 0.0;
+            best = std::min(best, distance(p, {s.start.x + t * vx, s.start.y + t * vy}));
+        } else {
+            const double r = distance(s.start, s.centre);
+            best = std::min(best, std::abs(distance(p, s.centre) - r));  // the arcs here span their own sector
+        }
+    }
+    return best;
+}
+
+struct Job {
+    Drawing drawing;
+    GcodeProgram gcode;
+    RecordProgram records;
+};
+
+Job prepare(const std::string& dxf, bool improved, double feed_mm_per_min) {
+    Job j;
+    j.drawing = read_dxf(dxf).drawing;
+    align_segments(j.drawing, 0.01);
+    j.gcode = emit_gcode(j.drawing, 0.01, feed_mm_per_min);
+    RecordOptions o;
+    o.improved = improved;
+    j.records = records_from_gcode(j.gcode.text, o, dxf);
+    return j;
+}
+
+TEST(CncEndToEnd, TheImprovedBuildRetracesALineAnArcAndACircle) {
+    const Job job = prepare(test::source_path("tests/fixtures/dxf/line_arc_circle.dxf"), true, 120);
+    // 2 rapids, a line; the 90-degree arc of R 20 in chords short enough for
+    // 8-bit counts (255 microsteps = 1.594 mm: 2 asin(1.594 / 40) = 4.57 deg,
+    // 20 chords), the circle of R 15 in 5-degree chords (72), M30.
+    EXPECT_EQ(job.records.moves, 3u);
+    EXPECT_EQ(job.records.arcs, 2u);
+    EXPECT_EQ(job.records.chords, 20u + 72u);
+    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
+                {{"uno", test::firmware("cnc2axis_improved")}});
+    Mcu& uno = board.mcu("uno");
+    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
+    double t = 0;
+    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
+    host.start();
+    // 145 mm of drawing at 2 mm/s and the rapids: well under 120 s.
+    while (!host.finished() && !host.failed() && t < 120) board.run_until_seconds(t += 0.5);
+    ASSERT_TRUE(host.finished()) << host.failure() << " (" << host.acknowledged() << " of " << host.messages() << ")";
+    board.run_for_seconds(0.5);
+    EXPECT_TRUE(uno.halted());  // M30
+    EXPECT_TRUE(board.findings().empty());
+
+    const auto& strokes = board.part_as<PenLift>("pen").strokes();
+    ASSERT_EQ(strokes.size(), job.gcode.pen_cycles);  // one pen-down spell per path: 2
+    // Where each path starts and ends: to the microstep (1/160 mm), both axes counted.
+    const double microstep = 1.0 / 160.0;
+    EXPECT_NEAR(strokes[0].front().x_mm, 30.0, 2 * microstep);
+    EXPECT_NEAR(strokes[0].front().y_mm, 70.0, 2 * microstep);
+    EXPECT_NEAR(strokes[0].back().x_mm, 70.0, 2 * microstep);
+    EXPECT_NEAR(strokes[0].back().y_mm, 50.0, 2 * microstep);
+    EXPECT_NEAR(strokes[1].front().x_mm, 115.0, 2 * microstep);
+    EXPECT_NEAR(strokes[1].back().x_mm, 115.0, 2 * microstep);
+    // Every pen point near the drawing. The bound: within a move both axes
+    // run at rates quantised by OCR at N = 1024 (at 2 mm/s OCR + 1 >= 24, a
+    // rate error <= 0.5 / 24 = 2.1 %), so an axis may lead the other by up to
+    // 2.1 % of the move (0.42 mm on the 20 mm line, less on the chords of
+    // at most 1.7 mm), plus the chord error R (1 - cos 2.5 deg) < 0.02 mm.
+    double worst = 0;
+    for (const auto& stroke : strokes) {
+        for (const auto& p : stroke) worst = std::max(worst, distance_to(job.drawing, {p.x_mm, p.y_mm}));
+    }
+    EXPECT_LT(worst, 0.45);
+}
+
+TEST(CncEndToEnd, AFirmwareThatNeverAnswersIsAFailureNotAHang) {
+    // The records of the faithful build sent to the improved firmware: the
+    // G01 record is 3 bytes short, so the firmware waits for bytes that never
+    // come and sends no ACK.
+    const Job job = prepare(test::source_path("tests/fixtures/dxf/three_lines.dxf"), false, 600);
+    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
+                {{"uno", test::firmware("cnc2axis_improved")}});
+    Mcu& uno = board.mcu("uno");
+    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
+    double t = 0;
+    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
+    host.start();
+    while (!host.finished() && !host.failed() && t < 30) board.run_until_seconds(t += 0.5);
+    ASSERT_TRUE(host.failed());
+    EXPECT_NE(host.failure().find("no ACK for message"), std::string::npos) << host.failure();
+}
+
+TEST(CncEndToEnd, GcodeTheConverterCannotUseIsALineError) {
+    RecordOptions o;
+    try {
+        records_from_gcode("G21 G90\nG01 X10 Y-5 F600\n", o, "job.nc");
+        FAIL() << "a negative target was accepted";
+    } catch (const BadInput& e) {
+        EXPECT_EQ(std::string(e.what()), "job.nc:2: the target lies outside the machine (negative or beyond 10 m)");
+    }
+    EXPECT_THROW(records_from_gcode("G05 X1\n", o, "job.nc"), BadInput);
+    EXPECT_THROW(records_from_gcode("G01 Xabc\n", o, "job.nc"), BadInput);
+}
+
+}  // namespace
+}  // namespace avrbench
