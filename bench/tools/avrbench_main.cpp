@@ -17,6 +17,7 @@
 #include "boards/Board.hpp"
 #include "cam/Chain.hpp"
 #include "cam/DxfReader.hpp"
+#include "cam/Records.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
 #include "core/Mcu.hpp"
@@ -31,6 +32,7 @@
 #include "trace/Recorder.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/VcdWriter.hpp"
+#include "stimulus/RecordHost.hpp"
 #include "verify/Bench.hpp"
 #include "verify/Scenario.hpp"
 
@@ -60,6 +62,10 @@ struct RunArgs {
     std::vector<std::string> uart_in;   // FILE, or PORT=FILE on a board
     std::vector<std::string> uart_out;  // FILE, or PORT=FILE on a board
     bool quiet = false;
+    std::string dxf;            // seed 002: a drawing to plot through the CAM and binary records
+    std::string records = "faithful";
+    std::string feed = "120";   // mm/min, for --dxf
+    std::string nc;             // --dxf: also write the G-code here
     std::string gcode;
     std::string host;
     std::string flow;
@@ -275,6 +281,7 @@ void print_idle_skip(const Mcu& mcu, bool name_it) {
 struct BoardRun {
     std::unique_ptr<Bench> bench;
     UartHost* host = nullptr;  // --gcode's
+    std::unique_ptr<RecordHost> plot;  // --dxf's
     std::vector<PortFile> uart_out;
     Picoseconds duration_ps = 0, settle_ps = 0;
 };
@@ -292,8 +299,10 @@ BoardRun prepare_board_run(const RunArgs& args) {
         firmware[item.substr(0, eq)] = item.substr(eq + 1);
     }
     BoardRun run;
-    // With a job, --for is the limit for finishing it (default 60 s).
-    run.duration_ps = parse_duration_ps(args.duration_given || args.gcode.empty() ? args.duration : "60s", "--for");
+    // With a job, --for is the limit for finishing it (default 60 s; a plot 600 s).
+    const char* job_default = !args.dxf.empty() ? "600s" : "60s";
+    const bool job = !args.gcode.empty() || !args.dxf.empty();
+    run.duration_ps = parse_duration_ps(args.duration_given || !job ? args.duration : job_default, "--for");
     run.settle_ps = parse_duration_ps(args.settle, "--settle");
     const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
     run.uart_out = port_files(args.uart_out, "--uart-out");
@@ -309,8 +318,8 @@ BoardRun prepare_board_run(const RunArgs& args) {
     Bench& bench = *run.bench;
     Board& board = bench.board();
     for (Mcu* m : board.mcus()) m->set_skip_idle_loops(!args.no_idle_skip);
-    if (board.spec().serial.empty() && (!uart_in.empty() || !run.uart_out.empty() || !args.gcode.empty())) {
-        throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --uart-in, --uart-out)");
+    if (board.spec().serial.empty() && (!uart_in.empty() || !run.uart_out.empty() || job)) {
+        throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --dxf, --uart-in, --uart-out)");
     }
     // Resolve every named port now, so a typo fails before the run.
     for (const auto& pf : uart_in) bench.serial_decl(pf.port);
@@ -340,6 +349,28 @@ BoardRun prepare_board_run(const RunArgs& args) {
     } else if (!realtime_bytes.empty()) {
         throw BadInput("--realtime needs --gcode (the bytes go to its host's port)");
     }
+    if (!args.dxf.empty()) {
+        if (!args.gcode.empty()) throw BadInput("--dxf and --gcode: give one job");
+        if (args.records != "faithful" && args.records != "improved") {
+            throw BadInput("--records: '" + args.records + "' is not faithful or improved");
+        }
+        const double feed = parse_quantity(args.feed, Dimension::Dimensionless, "--feed");
+        if (!(feed > 0 && feed <= 1e5)) throw BadInput("--feed: mm/min above 0 and at most 100000");
+        Drawing drawing = read_dxf(args.dxf).drawing;
+        align_segments(drawing, 0.01);
+        const GcodeProgram gcode = emit_gcode(drawing, 0.01, feed);
+        if (!args.nc.empty()) {
+            check_output_path(args.nc, "--nc");
+            write_output_file(args.nc, gcode.text, "--nc");
+        }
+        RecordOptions options;
+        options.improved = args.records == "improved";
+        const RecordProgram program = records_from_gcode(gcode.text, options, args.dxf);
+        Uart& port = bench.serial(args.host);
+        run.plot = std::make_unique<RecordHost>(board.mcu(bench.serial_decl(args.host).mcu), port, program.messages,
+                                                RecordHost::Options{}, program.busy_seconds);
+        run.plot->start();
+    }
     for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
     if (!args.vcd.empty() || !args.report.empty()) {
         if (!args.trace.empty()) {
@@ -364,6 +395,10 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
     std::printf("  simulated  %.6f s\n", simulated_s);
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
     for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);
+    if (run.plot) {
+        std::printf("  plot       %s: %zu of %zu records acknowledged (%s)%s\n", args.dxf.c_str(), run.plot->acknowledged(),
+                    run.plot->messages(), args.records.c_str(), run.plot->failed() ? ", failed" : "");
+    }
     if (run.host != nullptr) {
         std::printf("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s\n", args.gcode.c_str(),
                     run.host->lines_acknowledged(), run.host->lines().size(), run.host->oks(), run.host->errors(),
@@ -398,6 +433,10 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
 int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome, const std::vector<Finding>& findings) {
     for (const auto& f : findings) {
         if (is_mcu_finding(f) || (args.strict && f.kind != FindingKind::HostProtocol)) return kExitFinding;
+    }
+    if (run.plot && run.plot->failed()) {
+        std::fprintf(stderr, "avrbench: timeout: %s\n", run.plot->failure().c_str());
+        return kExitTimeout;
     }
     if (outcome == IdleResult::Interrupted) {
         std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n",
@@ -435,6 +474,7 @@ int run_board_command(const RunArgs& args) {
     const auto wall_start = std::chrono::steady_clock::now();
     Bench::RunSlices how;
     how.until_idle = run.host != nullptr;
+    if (run.plot) how.stop_when = [&run] { return run.plot->failed(); };
     how.settle_ps = run.settle_ps;
     how.after_slice = [&] {
         waveforms.drain(bench.now_ps());
@@ -459,6 +499,7 @@ int run_board_command(const RunArgs& args) {
 int run_command(const RunArgs& args) {
     if (!args.board.empty()) return run_board_command(args);
     if (!args.gcode.empty()) throw BadInput("--gcode needs --board (the board file names the serial port)");
+    if (!args.dxf.empty()) throw BadInput("--dxf needs --board (the board file names the serial port)");
     if (!args.report.empty()) throw BadInput("--report needs --board");
     if (!args.realtime.empty()) throw BadInput("--realtime needs --board and --gcode");
     const ElfImage elf = ElfImage::load(args.elf);
@@ -701,7 +742,12 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--for", run.duration, "simulated time to run, e.g. 2s, 250ms (default 1s; with --gcode the limit for the job, default 60s)")
         ->each([&run](const std::string&) { run.duration_given = true; });
     run_cmd->add_option("--gcode", run.gcode, "stream this G-code file to the board's serial port (needs --board)");
-    run_cmd->add_option("--host", run.host, "the board's serial port for --gcode (default: the first)");
+    run_cmd->add_option("--host", run.host, "the board's serial port for --gcode or --dxf (default: the first)");
+    run_cmd->add_option("--dxf", run.dxf,
+                        "plot this drawing (seed 002): CAM to G-code, binary records streamed stop-and-wait (needs --board)");
+    run_cmd->add_option("--records", run.records, "--dxf: faithful | improved, as the firmware build expects (default faithful)");
+    run_cmd->add_option("--feed", run.feed, "--dxf: drawing feed in mm/min (default 120)");
+    run_cmd->add_option("--nc", run.nc, "--dxf: also write the G-code to this file");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");
     run_cmd->add_flag("--wait-banner", run.wait_banner, "send the job only after the firmware's first output line");
     run_cmd->add_option("--family", run.family,

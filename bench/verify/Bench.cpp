@@ -202,6 +202,7 @@ IdleResult Bench::run_to_ps(Picoseconds end_ps, const RunSlices& how) {
             return IdleResult::Halted;
         }
         if (how.after_slice) how.after_slice();
+        if (how.stop_when && how.stop_when()) return IdleResult::Idle;
     }
     return IdleResult::TimeLimit;
 }

@@ -88,6 +88,7 @@ public:
         bool until_idle = false;
         Picoseconds settle_ps = 50 * kPsPerMs;
         std::function<void()> after_slice;
+        std::function<bool()> stop_when;  // checked after each slice: true ends the run (Idle)
     };
     IdleResult run_to_ps(Picoseconds end_ps, const RunSlices& how);
     Picoseconds now_ps() const { return board_->now_ps(); }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "boards/Board.hpp"
 #include "cam/Chain.hpp"
@@ -15,6 +16,7 @@
 #include "parts/PenLift.hpp"
 #include "stimulus/RecordHost.hpp"
 #include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
 
 namespace avrbench {
 namespace {
@@ -124,6 +126,24 @@ TEST(CncEndToEnd, GcodeTheConverterCannotUseIsALineError) {
     }
     EXPECT_THROW(records_from_gcode("G05 X1\n", o, "job.nc"), BadInput);
     EXPECT_THROW(records_from_gcode("G01 Xabc\n", o, "job.nc"), BadInput);
+}
+
+TEST(CncEndToEnd, OneCommandPlotsADxfOnTheBoard) {
+    const auto dir = test::scratch_dir("cnc-plot");
+    const std::string cmd = std::string(AVRBENCH_CLI) + " run -q " + test::firmware("cnc2axis_improved") +
+                            " --board " + test::source_path("bench/boards/cnc2axis-seed002.yaml") + " --dxf " +
+                            test::source_path("tests/fixtures/dxf/line_arc_circle.dxf") +
+                            " --records improved --vcd " + (dir / "plot.vcd").string() + " --nc " + (dir / "plot.nc").string();
+    const auto r = test::run_command(cmd, dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("98 of 98 records acknowledged (improved)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("pen        pen: up, 2 strokes"), std::string::npos) << r.out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "plot.vcd"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "plot.nc"));
+    // Without a board there is no serial port to stream to.
+    const auto bad = test::run_command(std::string(AVRBENCH_CLI) + " run " + test::firmware("cnc2axis") + " --dxf x.dxf", dir);
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_EQ(bad.err, "avrbench: error: --dxf needs --board (the board file names the serial port)\n");
 }
 
 }  // namespace
