@@ -1,0 +1,127 @@
+/*
+ * printer3d_drive - seed 001's per-motor drive board (§3.2, digest §1, §4):
+ * an ATmega32 at 16 MHz that takes STEP/DIR/ENABLE from the interpolator and
+ * switches the four half-windings of a unipolar stepper low-side, limiting
+ * the current with a bang-bang chopper on the two sense resistors.
+ *
+ * Pins (the thesis' code comments): STEP PD2 = INT0 (rising edge), DIR PD0
+ * (1 = CW: the sequence forward), ENABLE PD1 (1 = enabled), pull-ups on all
+ * of Port D's inputs (DDRD = 0, PORTD = 0xFF, so open inputs read enabled and
+ * CW); coils a / c / b / d on PB0 / PB1 / PB2 / PB3, stepping two phases on:
+ * 0x05 (a b) -> 0x06 (c b) -> 0x0A (c d) -> 0x09 (a d) and back the other way;
+ * sense a/c on ADC0 (PA0), b/d on ADC1 (PA1).
+ *
+ * Chopper (Code 3.6): on each sample of a pair's sense voltage, ADCH > 100
+ * (1.97 V on the 5 V AVCC reference, 8 bits left-adjusted) switches that
+ * pair off until its next sample; otherwise the pair follows the step state.
+ * Conversions are triggered by Timer1 compare match B every 204 us (CTC at
+ * clk/64, OCR1A = OCR1B = 50: 16 MHz / 64 / 51 = 4901.96 Hz), alternating
+ * ADC0 and ADC1. Safety loop: ENABLE low drops all coils.
+ *
+ * Fixed against the listing (digest §9): the trigger source is Timer1
+ * compare B (ADTS = 101; the thesis' 3 << ADTS0 is Timer0 compare, and
+ * Timer0 never runs: no conversion ever happened), OCIE1B really enabled
+ * (the thesis ORed the bit number 3 into TIMSK) with an interrupt that
+ * clears OCF1B so every match triggers, the ADC clock at 16 MHz / 128 =
+ * 125 kHz (the thesis' ADPS = 0 is 8 MHz), ADCH read as uint8_t (int8_t
+ * wrapped codes >= 128 negative), and the step interrupt no longer nests
+ * (ISR_NOBLOCK let the ADC interrupt's read-modify-write of PORTB interleave
+ * with its own). THESIS_LITERAL builds the listing's drive loop as printed.
+ *
+ * Globals for tests: position (steps, CW positive), motor_state, samples,
+ * chops.
+ */
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <stdint.h>
+
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
+#define COIL_A _BV(PB0)
+#define COIL_C _BV(PB1)
+#define COIL_B _BV(PB2)
+#define COIL_D _BV(PB3)
+#define MASK_AC (COIL_A | COIL_C)
+#define MASK_BD (COIL_B | COIL_D)
+#define CURRENT_LIMIT 100
+#define ADC_PRESCALER 50 /* the thesis' name for the Timer1 compare value */
+
+static const uint8_t sequence[4] = {COIL_A | COIL_B, COIL_C | COIL_B, COIL_C | COIL_D, COIL_A | COIL_D};
+
+volatile int32_t position;
+volatile uint8_t motor_state;
+volatile uint16_t samples;
+volatile uint16_t chops;
+static uint8_t index_;
+static uint8_t channel;
+static uint8_t chopped; /* pairs switched off by their last sample */
+
+#ifdef THESIS_LITERAL
+ISR(INT0_vect, ISR_NOBLOCK)
+#else
+ISR(INT0_vect)
+#endif
+{
+    if (!(PIND & _BV(PD1))) return; /* disabled: steps are ignored */
+    index_ = (uint8_t)((index_ + ((PIND & _BV(PD0)) ? 1 : 3)) & 3);
+    position += (PIND & _BV(PD0)) ? 1 : -1;
+    motor_state = sequence[index_];
+    PORTB = (uint8_t)((PORTB & 0xF0) | (motor_state & (uint8_t)~chopped));
+}
+
+ISR(ADC_vect)
+{
+#ifdef THESIS_LITERAL
+    const int8_t sample = (int8_t)ADCH;
+#else
+    const uint8_t sample = ADCH;
+#endif
+    const uint8_t mask = channel == 0 ? MASK_AC : MASK_BD;
+    ++samples;
+    if (sample > CURRENT_LIMIT) {
+        if (!(chopped & mask)) ++chops;
+        chopped |= mask;
+        PORTB &= (uint8_t)~mask;
+    } else {
+        chopped &= (uint8_t)~mask;
+        PORTB = (uint8_t)((PORTB & (uint8_t)~mask) | (motor_state & mask));
+    }
+    channel ^= 1;
+    ADMUX = (uint8_t)(_BV(REFS0) | _BV(ADLAR) | channel);
+}
+
+#ifndef THESIS_LITERAL
+EMPTY_INTERRUPT(TIMER1_COMPB_vect); /* taking it clears OCF1B, so the next match triggers again */
+#endif
+
+int main(void)
+{
+    DDRD = 0;
+    PORTD = 0xFF; /* pull-ups: open inputs read enabled, CW */
+    DDRB = 0xFF;
+    index_ = 0;
+    motor_state = sequence[0];
+    PORTB = motor_state;
+    MCUCR = _BV(ISC01) | _BV(ISC00); /* INT0 on the rising edge */
+    GICR = _BV(INT0);
+    ADMUX = _BV(REFS0) | _BV(ADLAR); /* AVCC, left adjusted, ADC0 */
+    OCR1A = ADC_PRESCALER;
+    OCR1B = ADC_PRESCALER;
+    TCCR1A = 0;
+    TCCR1B = _BV(WGM12) | _BV(CS11) | _BV(CS10); /* CTC, clk/64 */
+#ifdef THESIS_LITERAL
+    SFIOR = (3 << ADTS0);
+    TIMSK |= OCIE1B;
+    ADCSRA = _BV(ADATE) | _BV(ADEN) | _BV(ADIE) | (128);
+#else
+    SFIOR = (uint8_t)((SFIOR & 0x1F) | _BV(ADTS2) | _BV(ADTS0)); /* Timer1 compare match B */
+    TIMSK |= _BV(OCIE1B);
+    ADCSRA = _BV(ADATE) | _BV(ADEN) | _BV(ADIE) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
+#endif
+    sei();
+    for (;;) {
+        if (!(PIND & _BV(PD1))) PORTB &= 0xF0; /* safety: disabled, coils off */
+    }
+}

@@ -1,0 +1,138 @@
+// Seed 001's drive board firmware (firmware/printer3d_drive) on its board
+// (bench/boards/printer3d-drive-seed001.yaml, the unipolar stepper with sense
+// resistors on ADC0/ADC1), driven through its STEP/DIR/ENABLE pins as the
+// interpolator would. Expected values: the digest's acceptance checks
+// (../shared/seeds/digests/seed_001_3dprinter.md §10) and §9's defects.
+// Each test runs under ctest's 300 s wall-clock limit (tests/CMakeLists.txt).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "boards/Board.hpp"
+#include "core/Adc.hpp"
+#include "parts/HybridStepper.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+struct DriveRun {
+    Board board;
+    Mcu& mcu;
+    HybridStepper& motor;
+    std::vector<Adc::Sample> samples;
+    explicit DriveRun(const std::string& firmware = "printer3d_drive")
+        : board(load_board_file(test::source_path("bench/boards/printer3d-drive-seed001.yaml")),
+                {{"drive", test::firmware(firmware)}}),
+          mcu(board.mcu("drive")),
+          motor(board.part_as<HybridStepper>("motor")) {
+        mcu.adc().on_sample([this](const Adc::Sample& s) { samples.push_back(s); });
+        board.drive_pin("enable", true);
+        board.drive_pin("dir", true);
+        board.drive_pin("step", false);
+        board.run_for_seconds(0.01);
+    }
+    // One STEP pulse: 10 us high, then `gap_s` low.
+    void step(double gap_s = 0.005) {
+        board.drive_pin("step", true);
+        board.run_for_seconds(10e-6);
+        board.drive_pin("step", false);
+        board.run_for_seconds(gap_s);
+    }
+    unsigned coils() { return mcu.pin("PB0").level() | mcu.pin("PB1").level() << 1 | mcu.pin("PB2").level() << 2 | mcu.pin("PB3").level() << 3; }
+    std::int32_t position() const {
+        const auto b = mcu.read_ram("position", 4);
+        return static_cast<std::int32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
+    }
+};
+
+TEST(Printer3dDrive, RisingStepEdgesWalkTheCoilSequenceBothWays) {
+    DriveRun run;
+    // §10.1: 0x05 -> 0x06 -> 0x0A -> 0x09 -> 0x05 with DIR = 1; reversed with DIR = 0.
+    EXPECT_EQ(run.mcu.read_ram_u8("motor_state"), 0x05);
+    std::vector<unsigned> forward, backward;
+    for (int i = 0; i < 4; ++i) {
+        run.step();
+        forward.push_back(run.mcu.read_ram_u8("motor_state"));
+        // The coils never carry a phase the state does not (the chopper only removes).
+        EXPECT_EQ(run.coils() & ~forward.back(), 0u);
+    }
+    EXPECT_EQ(forward, (std::vector<unsigned>{0x06, 0x0A, 0x09, 0x05}));
+    run.board.drive_pin("dir", false);
+    run.board.run_for_seconds(0.001);
+    for (int i = 0; i < 4; ++i) {
+        run.step();
+        backward.push_back(run.mcu.read_ram_u8("motor_state"));
+    }
+    EXPECT_EQ(backward, (std::vector<unsigned>{0x09, 0x0A, 0x06, 0x05}));
+    EXPECT_EQ(run.position(), 0);  // §10.3: net position = CW - CCW
+    // Falling edges do nothing: a step is the rising edge only.
+    run.board.drive_pin("step", true);
+    run.board.run_for_seconds(0.001);
+    const auto before = run.mcu.read_ram_u8("motor_state");
+    run.board.drive_pin("step", false);
+    run.board.run_for_seconds(0.001);
+    EXPECT_EQ(run.mcu.read_ram_u8("motor_state"), before);
+}
+
+TEST(Printer3dDrive, DisabledTheCoilsDropAndStepsAreIgnored) {
+    DriveRun run;
+    run.step();
+    run.board.drive_pin("enable", false);
+    run.board.run_for_seconds(0.001);
+    EXPECT_EQ(run.coils(), 0u);  // §10.2, the safety loop
+    const auto state = run.mcu.read_ram_u8("motor_state");
+    for (int i = 0; i < 3; ++i) run.step();
+    EXPECT_EQ(run.mcu.read_ram_u8("motor_state"), state);
+    EXPECT_EQ(run.coils(), 0u);
+    EXPECT_EQ(run.position(), 1);
+}
+
+TEST(Printer3dDrive, ConversionsEvery204UsAlternateTheSensePairsAndChop) {
+    DriveRun run;
+    for (int i = 0; i < 200; ++i) run.step(0.002);  // 500 steps/s, 150 rpm, 0.4 s
+    // §10.5: Timer1 compare every 16 MHz / 64 / 51 = 204 us = 3264 cycles,
+    // one conversion per compare, ADC0 and ADC1 in turn.
+    ASSERT_GT(run.samples.size(), 1000u);
+    for (std::size_t i = 10; i < 200; ++i) {
+        EXPECT_EQ(run.samples[i].cycle - run.samples[i - 1].cycle, 3264u) << i;
+        EXPECT_NE(run.samples[i].channel, run.samples[i - 1].channel) << i;
+    }
+    // The chopper holds the current near its limit: ADCH 101 = 1.973 V across
+    // 2.2 ohm is 0.897 A; unchopped the half-winding would reach 12 V / (6.8 +
+    // 2.2) ohm = 1.333 A with tau = L / R = 8 mH / 9 ohm = 0.889 ms. A pair is
+    // sampled every 2 * 204 us, and its conversion ends 13 ADC clocks (104 us)
+    // after the sample, so the current may rise for up to 512 us past the
+    // limit: 1.333 - (1.333 - 0.897) * exp(-0.512 / 0.889) = 1.088 A.
+    EXPECT_GT(run.mcu.read_ram_u16("chops"), 0u);
+    double peak_a = 0;
+    run.motor.on_stall([](const HybridStepper::StallEvent&) {});
+    for (int i = 0; i < 40; ++i) {
+        run.board.run_for_seconds(0.0005);
+        run.motor.sync();
+        peak_a = std::max({peak_a, std::abs(run.motor.phase_current(0)), std::abs(run.motor.phase_current(1))});
+    }
+    EXPECT_LT(peak_a, 1.088);
+    EXPECT_GT(peak_a, 0.897);  // it does reach the limit
+    EXPECT_EQ(run.motor.lost_steps(), 0);
+}
+
+TEST(Printer3dDrive, TheListingAsPrintedNeverConverts) {
+    // Digest §9.1-9.3: the trigger is Timer0's compare match, Timer0 never
+    // runs, so no conversion ever starts; with no samples the chopper never
+    // acts and the holding current goes to the unchopped 1.33 A.
+    DriveRun run("printer3d_drive_thesis");
+    run.step();
+    run.board.run_for_seconds(0.5);
+    EXPECT_TRUE(run.samples.empty());
+    EXPECT_EQ(run.mcu.read_ram_u16("samples"), 0u);
+    run.motor.sync();
+    const double i = std::max(std::abs(run.motor.phase_current(0)), std::abs(run.motor.phase_current(1)));
+    EXPECT_NEAR(i, 12.0 / (6.8 + 2.2), 0.05);
+    // The steps themselves still work.
+    EXPECT_EQ(run.mcu.read_ram_u8("motor_state"), 0x06);
+}
+
+}  // namespace
+}  // namespace avrbench
