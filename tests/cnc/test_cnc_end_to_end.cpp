@@ -97,6 +97,15 @@ TEST(CncEndToEnd, TheImprovedBuildRetracesALineAnArcAndACircle) {
         for (const auto& p : stroke) worst = std::max(worst, distance_to(job.drawing, {p.x_mm, p.y_mm}));
     }
     EXPECT_LT(worst, 0.45);
+    // The circle alone (R 15 mm, 72 chords of 5 deg, at most 1.31 mm each):
+    // within its chord error R (1 - cos 2.5 deg) = 0.014 mm, plus an axis
+    // leading the other by 2.1 % of a chord (0.028 mm), plus 2 microsteps of
+    // rounding (0.0125 mm): 0.055 mm.
+    double worst_on_circle = 0;
+    for (const auto& p : strokes[1]) {
+        worst_on_circle = std::max(worst_on_circle, std::abs(distance({p.x_mm, p.y_mm}, {100.0, 50.0}) - 15.0));
+    }
+    EXPECT_LT(worst_on_circle, 0.055);
 }
 
 TEST(CncEndToEnd, AFirmwareThatNeverAnswersIsAFailureNotAHang) {
