@@ -413,7 +413,7 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
         print_text_tail(run.host->tail(10), 10);
     }
     for (const auto& decl : board.spec().serial) {
-        if (run.host != nullptr && bench.serial_decl(args.host).name == decl.name) continue;
+        if ((run.host != nullptr || run.plot) && bench.serial_decl(args.host).name == decl.name) continue;
         const Uart& u = bench.serial(decl.name);
         std::printf("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s\n", decl.name.c_str(),
                     u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),

@@ -85,6 +85,28 @@ volatile count_t y_left;
 static volatile uint8_t y_half;
 #endif
 volatile uint16_t acks;      /* for tests: ACKs sent */
+
+/* Waits, asleep (idle: the timers run), until an interrupt has counted
+ * `*left` down to 0. The count is read with interrupts off: read byte by byte
+ * while an interrupt decrements it, 0x0100 -> 0x00FF can read as 0x0000 and
+ * end a move early. SEI lets exactly the SLEEP after it run before a pending
+ * interrupt is taken (328P §7.7), so the last decrement cannot slip between
+ * the check and the SLEEP. */
+static void wait_zero(volatile count_t *left)
+{
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    for (;;) {
+        cli();
+        if (*left == 0) {
+            sei();
+            return;
+        }
+        sleep_enable();
+        sei();
+        sleep_cpu();
+        sleep_disable();
+    }
+}
 volatile uint8_t homed;
 
 /* --- USART0, polled (the assembly firmware has no receive interrupt) ------ */
@@ -225,8 +247,7 @@ static void g00(void)
     timers_run();
     count_y_polled(sy);
     PORTB |= _BV(Y_EN);
-    while (x_left != 0) {
-    }
+    wait_zero(&x_left);
     PORTB |= _BV(X_EN);
     tx(ACK);
 }
@@ -255,8 +276,7 @@ static void g01(void)
     count_x_polled(sx);
 #ifdef IMPROVED
     PORTB |= _BV(X_EN);
-    while (y_left != 0) {
-    }
+    wait_zero(&y_left);
 #endif
     PORTB |= _BV(X_EN) | _BV(Y_EN); /* faithful: Y stops with X, wherever it is */
     tx(ACK);
@@ -278,12 +298,9 @@ static void arc(void)
         const uint8_t dy = rx();
 #endif
         const uint8_t vx = rx(), vy = rx(), dir = rx();
+        wait_zero(&x_left);
 #ifdef IMPROVED
-        while (x_left != 0 || y_left != 0) {
-        }
-#else
-        while (x_left != 0) {
-        }
+        wait_zero(&y_left);
 #endif
         cli();
         x_left = dx;

@@ -13,6 +13,7 @@
 #include "cam/Records.hpp"
 #include "core/Errors.hpp"
 #include "core/Uart.hpp"
+#include "parts/Axis.hpp"
 #include "parts/PenLift.hpp"
 #include "stimulus/RecordHost.hpp"
 #include "support/Paths.hpp"
@@ -106,6 +107,31 @@ TEST(CncEndToEnd, TheImprovedBuildRetracesALineAnArcAndACircle) {
         worst_on_circle = std::max(worst_on_circle, std::abs(distance({p.x_mm, p.y_mm}, {100.0, 50.0}) - 15.0));
     }
     EXPECT_LT(worst_on_circle, 0.055);
+}
+
+TEST(CncEndToEnd, LongCountedMovesEndWhereTheyShould) {
+    // The demo drawing (examples/drawings/plotter_demo.dxf: a 40 mm square
+    // with one rounded corner, then a circle of R 8 mm about (40, 40)) at
+    // 2 mm/s: its 30 and 40 mm vertical lines count 4800 and 6400 Y steps in
+    // the Timer2 interrupt while the main loop waits for the count to reach
+    // 0. A count read byte by byte with interrupts on can look like 0 after a
+    // borrow (0x1300 -> 0x12FF read as 0x1200 ... or 0x0000) and end the move
+    // early; the firmware reads it whole. The pen must end at the circle's
+    // start, (48, 40), with every step counted.
+    const Job job = prepare(test::source_path("examples/drawings/plotter_demo.dxf"), true, 120);
+    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
+                {{"uno", test::firmware("cnc2axis_improved")}});
+    Mcu& uno = board.mcu("uno");
+    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
+    double t = 0;
+    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
+    host.start();
+    while (!host.finished() && !host.failed() && t < 200) board.run_until_seconds(t += 0.5);
+    ASSERT_TRUE(host.finished()) << host.failure();
+    EXPECT_NEAR(board.part_as<Axis>("x").position_mm(), 48.0, 1.5 / 160.0);
+    EXPECT_NEAR(board.part_as<Axis>("y").position_mm(), 40.0, 1.5 / 160.0);
+    EXPECT_EQ(board.part_as<PenLift>("pen").strokes().size(), 2u);  // the square, the circle
+    EXPECT_TRUE(board.findings().empty());
 }
 
 TEST(CncEndToEnd, AFirmwareThatNeverAnswersIsAFailureNotAHang) {
