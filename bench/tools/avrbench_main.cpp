@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "boards/Board.hpp"
@@ -32,6 +33,7 @@
 #include "trace/Recorder.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/VcdWriter.hpp"
+#include "stimulus/PtyBridge.hpp"
 #include "stimulus/RecordHost.hpp"
 #include "verify/Bench.hpp"
 #include "verify/Scenario.hpp"
@@ -66,6 +68,9 @@ struct RunArgs {
     std::string records = "faithful";
     std::string feed = "120";   // mm/min, for --dxf
     std::string nc;             // --dxf: also write the G-code here
+    std::string pty;            // a serial port bridged to a pseudo-terminal
+    std::string pty_link;       // and a stable symlink to it
+    std::string pace = "free";  // free | realtime
     std::string gcode;
     std::string host;
     std::string flow;
@@ -282,6 +287,7 @@ struct BoardRun {
     std::unique_ptr<Bench> bench;
     UartHost* host = nullptr;  // --gcode's
     std::unique_ptr<RecordHost> plot;  // --dxf's
+    std::unique_ptr<PtyBridge> pty;    // --pty's
     std::vector<PortFile> uart_out;
     Picoseconds duration_ps = 0, settle_ps = 0;
 };
@@ -372,6 +378,18 @@ BoardRun prepare_board_run(const RunArgs& args) {
         run.plot->start();
     }
     for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
+    if (args.pace != "free" && args.pace != "realtime") throw BadInput("--pace: '" + args.pace + "' is not free or realtime");
+    if (!args.pty.empty()) {
+        const SerialDecl& decl = bench.serial_decl(args.pty);
+        if (!args.gcode.empty() || !args.dxf.empty()) {
+            if (bench.serial_decl(args.host).name == decl.name) throw BadInput("--pty: port " + decl.name + " already carries the job");
+        }
+        run.pty = std::make_unique<PtyBridge>(bench.serial(decl.name), args.pty_link);
+        // At once, so a host can connect while the run goes on.
+        std::printf("avrbench run: serial %s on %s%s%s\n", decl.name.c_str(), run.pty->path().c_str(),
+                    args.pty_link.empty() ? "" : " = ", args.pty_link.c_str());
+        std::fflush(stdout);
+    }
     if (!args.vcd.empty() || !args.report.empty()) {
         if (!args.trace.empty()) {
             for (Mcu* m : board.mcus()) trace_pins_for_cli(bench.recorder(), *m, args.trace);
@@ -395,6 +413,12 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
     std::printf("  simulated  %.6f s\n", simulated_s);
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
     for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);
+    if (run.pty) {
+        std::printf("  pty        %s: %llu bytes to the firmware, %llu from it%s\n", run.pty->path().c_str(),
+                    static_cast<unsigned long long>(run.pty->bytes_to_firmware()),
+                    static_cast<unsigned long long>(run.pty->bytes_to_host()),
+                    run.pty->bytes_dropped() != 0 ? " (the host did not read them all)" : "");
+    }
     if (run.plot) {
         std::printf("  plot       %s: %zu of %zu records acknowledged (%s)%s\n", args.dxf.c_str(), run.plot->acknowledged(),
                     run.plot->messages(), args.records.c_str(), run.plot->failed() ? ", failed" : "");
@@ -477,6 +501,14 @@ int run_board_command(const RunArgs& args) {
     if (run.plot) how.stop_when = [&run] { return run.plot->failed(); };
     how.settle_ps = run.settle_ps;
     how.after_slice = [&] {
+        if (run.pty) {
+            run.pty->pump();
+            if (args.pace == "realtime") {
+                // Simulated time no further than wall time (the host's timeouts are in seconds).
+                const auto due = wall_start + std::chrono::nanoseconds(bench.now_ps() / 1000);
+                std::this_thread::sleep_until(due);
+            }
+        }
         waveforms.drain(bench.now_ps());
         progress.show(static_cast<double>(bench.now_ps()) / static_cast<double>(run.duration_ps), bench.now_seconds());
     };
@@ -748,6 +780,11 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--records", run.records, "--dxf: faithful | improved, as the firmware build expects (default faithful)");
     run_cmd->add_option("--feed", run.feed, "--dxf: drawing feed in mm/min (default 120)");
     run_cmd->add_option("--nc", run.nc, "--dxf: also write the G-code to this file");
+    run_cmd->add_option("--pty", run.pty,
+                        "PORT: bridge this serial port of the board to a pseudo-terminal for host software (prints its path)");
+    run_cmd->add_option("--pty-link", run.pty_link, "--pty: also make a symlink to the pty here, e.g. traces/ttyUNO");
+    run_cmd->add_option("--pace", run.pace,
+                        "free (default: as fast as it runs) | realtime (simulated time never ahead of wall time)");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");
     run_cmd->add_flag("--wait-banner", run.wait_banner, "send the job only after the firmware's first output line");
     run_cmd->add_option("--family", run.family,

@@ -1,0 +1,92 @@
+#include "stimulus/PtyBridge.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+namespace {
+
+// Output the host has not read is kept up to this much; beyond it the oldest
+// is dropped (and counted), so a host that never reads cannot grow memory.
+constexpr std::size_t kMaxPendingBytes = 1 << 20;
+
+}  // namespace
+
+PtyBridge::PtyBridge(Uart& uart, const std::string& link_path) : uart_(uart), link_(link_path) {
+    master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (master_ < 0 || ::grantpt(master_) != 0 || ::unlockpt(master_) != 0) {
+        const std::string why = std::strerror(errno);
+        if (master_ >= 0) ::close(master_);
+        throw BadInput("cannot open a pseudo-terminal: " + why);
+    }
+    const char* name = ::ptsname(master_);
+    if (name == nullptr) {
+        ::close(master_);
+        throw BadInput("cannot name the pseudo-terminal");
+    }
+    path_ = name;
+    slave_keepalive_ = ::open(path_.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (slave_keepalive_ >= 0) {
+        termios raw{};
+        if (::tcgetattr(slave_keepalive_, &raw) == 0) {
+            ::cfmakeraw(&raw);
+            ::tcsetattr(slave_keepalive_, TCSANOW, &raw);
+        }
+    }
+    if (!link_.empty()) {
+        ::unlink(link_.c_str());
+        if (::symlink(path_.c_str(), link_.c_str()) != 0) {
+            const std::string why = std::strerror(errno);
+            ::close(master_);
+            if (slave_keepalive_ >= 0) ::close(slave_keepalive_);
+            throw BadInput(link_ + ": cannot link it to " + path_ + ": " + why);
+        }
+    }
+    uart_.on_transmit([this](Cycle, std::uint8_t byte) {
+        ++to_host_;
+        pending_.push_back(static_cast<char>(byte));
+        if (pending_.size() > kMaxPendingBytes) {
+            dropped_ += pending_.size() - kMaxPendingBytes;
+            pending_.erase(0, pending_.size() - kMaxPendingBytes);
+        }
+        flush();
+    });
+}
+
+PtyBridge::~PtyBridge() {
+    if (!link_.empty()) ::unlink(link_.c_str());
+    if (slave_keepalive_ >= 0) ::close(slave_keepalive_);
+    if (master_ >= 0) ::close(master_);
+}
+
+void PtyBridge::flush() {
+    while (!pending_.empty()) {
+        const ssize_t n = ::write(master_, pending_.data(), pending_.size());
+        if (n <= 0) return;  // the pty is full (EAGAIN): later
+        pending_.erase(0, static_cast<std::size_t>(n));
+    }
+}
+
+std::size_t PtyBridge::pump() {
+    flush();
+    std::string in;
+    char buf[4096];
+    for (;;) {
+        const ssize_t n = ::read(master_, buf, sizeof buf);
+        if (n <= 0) break;  // nothing (EAGAIN), or no host (EIO)
+        in.append(buf, static_cast<std::size_t>(n));
+    }
+    if (!in.empty()) {
+        uart_.send(in);
+        to_firmware_ += in.size();
+    }
+    return in.size();
+}
+
+}  // namespace avrbench

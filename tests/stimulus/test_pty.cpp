@@ -1,0 +1,67 @@
+// A board's serial port on a pseudo-terminal (stimulus/PtyBridge): what a
+// host writes to the pty reaches the firmware, and what the firmware sends
+// comes out of it. The host here is this test, on the pty's slave side, as
+// a terminal or avrdude would be.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "core/Uart.hpp"
+#include "stimulus/PtyBridge.hpp"
+#include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
+#include "verify/Bench.hpp"
+
+namespace avrbench {
+namespace {
+
+TEST(Pty, BytesGoBothWaysThroughThePseudoTerminal) {
+    const auto dir = test::scratch_dir("pty");
+    const std::string link = (dir / "ttyUNO").string();
+    Bench bench(test::source_path("bench/boards/arduino-uno.yaml"), test::firmware("uart_echo"));
+    std::string received;
+    {
+        PtyBridge pty(bench.serial("host"), link);
+        EXPECT_EQ(std::filesystem::read_symlink(link).string(), pty.path());
+        const int host = ::open(link.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+        ASSERT_GE(host, 0) << pty.path();
+        ASSERT_EQ(::write(host, "hello pty\n", 10), 10);
+        // uart_echo: a banner, then every byte back; 115200 baud (117647 with
+        // U2X), 85 us per frame: 30 bytes in well under 10 ms.
+        for (int slice = 0; slice < 100 && received.find("hello pty\n") == std::string::npos; ++slice) {
+            bench.board().run_for_seconds(0.001);
+            pty.pump();
+            char buf[256];
+            const ssize_t n = ::read(host, buf, sizeof buf);
+            if (n > 0) received.append(buf, static_cast<std::size_t>(n));
+        }
+        EXPECT_EQ(pty.bytes_to_firmware(), 10u);
+        EXPECT_EQ(pty.bytes_to_host(), 30u);  // 20 banner bytes + 10 echoed
+        ::close(host);
+    }
+    EXPECT_EQ(received, "avrbench uart_echo\r\nhello pty\n");
+    EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(link)));  // removed with the bridge
+    // The firmware's side of it, as the bench records it.
+    EXPECT_EQ(bench.serial("host").transmitted_text(), "avrbench uart_echo\r\nhello pty\n");
+}
+
+TEST(Pty, TheCliPrintsThePathAtOnceAndCountsTheBytes) {
+    const auto dir = test::scratch_dir("pty-cli");
+    const std::string cli = std::string(AVRBENCH_CLI) + " run " + test::firmware("uart_echo") + " --board " +
+                            test::source_path("bench/boards/arduino-uno.yaml");
+    const auto r = test::run_command(cli + " --pty host --for 10ms", dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out.rfind("avrbench run: serial host on /dev/pts/", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find("  pty        /dev/pts/"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("0 bytes to the firmware, 20 from it"), std::string::npos) << r.out;
+    const auto bad = test::run_command(cli + " --pty host --pace slow --for 10ms", dir);
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_EQ(bad.err, "avrbench: error: --pace: 'slow' is not free or realtime\n");
+}
+
+}  // namespace
+}  // namespace avrbench
