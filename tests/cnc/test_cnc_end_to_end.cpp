@@ -56,6 +56,21 @@ Job prepare(const std::string& dxf, bool improved, double feed_mm_per_min) {
     return j;
 }
 
+// The improved firmware on the plotter board, homed, with `job`'s records
+// streamed until they are all acknowledged, the host fails, or `limit_s`.
+struct Plot {
+    Board board{load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
+                {{"uno", test::firmware("cnc2axis_improved")}}};
+    Mcu& uno = board.mcu("uno");
+    RecordHost host;
+    Plot(const Job& job, double limit_s) : host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds) {
+        double t = 0;
+        while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
+        host.start();
+        while (!host.finished() && !host.failed() && t < limit_s) board.run_until_seconds(t += 0.5);
+    }
+};
+
 TEST(CncEndToEnd, TheImprovedBuildRetracesALineAnArcAndACircle) {
     const Job job = prepare(test::source_path("tests/fixtures/dxf/line_arc_circle.dxf"), true, 120);
     // 2 rapids, a line; the 90-degree arc of R 20 in chords short enough for
@@ -64,15 +79,11 @@ TEST(CncEndToEnd, TheImprovedBuildRetracesALineAnArcAndACircle) {
     EXPECT_EQ(job.records.moves, 3u);
     EXPECT_EQ(job.records.arcs, 2u);
     EXPECT_EQ(job.records.chords, 20u + 72u);
-    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
-                {{"uno", test::firmware("cnc2axis_improved")}});
-    Mcu& uno = board.mcu("uno");
-    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
-    double t = 0;
-    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
-    host.start();
     // 145 mm of drawing at 2 mm/s and the rapids: well under 120 s.
-    while (!host.finished() && !host.failed() && t < 120) board.run_until_seconds(t += 0.5);
+    Plot plot(job, 120);
+    Board& board = plot.board;
+    Mcu& uno = plot.uno;
+    const RecordHost& host = plot.host;
     ASSERT_TRUE(host.finished()) << host.failure() << " (" << host.acknowledged() << " of " << host.messages() << ")";
     board.run_for_seconds(0.5);
     EXPECT_TRUE(uno.halted());  // M30
@@ -119,14 +130,9 @@ TEST(CncEndToEnd, LongCountedMovesEndWhereTheyShould) {
     // early; the firmware reads it whole. The pen must end at the circle's
     // start, (48, 40), with every step counted.
     const Job job = prepare(test::source_path("examples/drawings/plotter_demo.dxf"), true, 120);
-    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
-                {{"uno", test::firmware("cnc2axis_improved")}});
-    Mcu& uno = board.mcu("uno");
-    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
-    double t = 0;
-    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
-    host.start();
-    while (!host.finished() && !host.failed() && t < 200) board.run_until_seconds(t += 0.5);
+    Plot plot(job, 200);
+    Board& board = plot.board;
+    const RecordHost& host = plot.host;
     ASSERT_TRUE(host.finished()) << host.failure();
     EXPECT_NEAR(board.part_as<Axis>("x").position_mm(), 48.0, 1.5 / 160.0);
     EXPECT_NEAR(board.part_as<Axis>("y").position_mm(), 40.0, 1.5 / 160.0);
@@ -139,14 +145,8 @@ TEST(CncEndToEnd, AFirmwareThatNeverAnswersIsAFailureNotAHang) {
     // G01 record is 3 bytes short, so the firmware waits for bytes that never
     // come and sends no ACK.
     const Job job = prepare(test::source_path("tests/fixtures/dxf/three_lines.dxf"), false, 600);
-    Board board(load_board_file(test::source_path("bench/boards/cnc2axis-seed002.yaml")),
-                {{"uno", test::firmware("cnc2axis_improved")}});
-    Mcu& uno = board.mcu("uno");
-    RecordHost host(uno, uno.uart(0), job.records.messages, {}, job.records.busy_seconds);
-    double t = 0;
-    while (uno.read_ram_u8("homed") == 0 && t < 5) board.run_until_seconds(t += 0.1);
-    host.start();
-    while (!host.finished() && !host.failed() && t < 30) board.run_until_seconds(t += 0.5);
+    Plot plot(job, 30);
+    const RecordHost& host = plot.host;
     ASSERT_TRUE(host.failed());
     EXPECT_NE(host.failure().find("no ACK for message"), std::string::npos) << host.failure();
 }
