@@ -53,11 +53,11 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
         }
         provide_port("carriage", PortKind::Carriage, "the carriage position limit switches watch");
     }
-    require_port("drive", PortKind::Steps, true, "a step_dir_driver's steps");
+    require_port("drive", PortKind::Steps, true, "a step_dir_driver's steps or a stepper motor's shaft");
 }
 
 void Axis::connect_port(std::size_t, Part& provider) {
-    driver_ = &dynamic_cast<StepDirDriver&>(provider);
+    driver_ = &dynamic_cast<ShaftMotion&>(provider);
     // Steps are counted in 1/256 full steps: one is (256 / microsteps)^-1 of a configured step.
     const double microsteps = driver_->configured_microsteps();
     if (rotary_) {
@@ -73,17 +73,13 @@ void Axis::connect_port(std::size_t, Part& provider) {
 }
 
 std::string Axis::summary() {
-    char line[200];
-    const StepDirDriver& d = *driver_;
+    char line[240];
     if (rotary_) {
-        std::snprintf(line, sizeof line, "axis %-5s %llu steps (%llu ignored while disabled), %.3f deg, peak %.0f steps/s",
-                      name().c_str(), static_cast<unsigned long long>(d.steps_taken()),
-                      static_cast<unsigned long long>(d.steps_ignored()), position_deg(), d.peak_step_rate_hz());
+        std::snprintf(line, sizeof line, "axis %-5s %s, %.3f deg%s", name().c_str(), driver_->motion_summary().c_str(),
+                      position_deg(), driver_->rate_summary().c_str());
     } else {
-        std::snprintf(line, sizeof line,
-                      "axis %-5s %llu steps (%llu ignored while disabled), at %.4f mm, peak %.0f steps/s", name().c_str(),
-                      static_cast<unsigned long long>(d.steps_taken()), static_cast<unsigned long long>(d.steps_ignored()),
-                      position_mm(), d.peak_step_rate_hz());
+        std::snprintf(line, sizeof line, "axis %-5s %s, at %.4f mm%s", name().c_str(), driver_->motion_summary().c_str(),
+                      position_mm(), driver_->rate_summary().c_str());
     }
     return line;
 }

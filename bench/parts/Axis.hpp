@@ -1,5 +1,6 @@
 // A stepper driver on a linear axis (steps/mm, travel) or a rotary axis
-// (steps/rev): port `drive` requires a step_dir_driver's `steps`; a linear
+// (steps/rev): port `drive` requires `steps` (a step_dir_driver's counted
+// steps, or a stepper motor's rotor: any ShaftMotion); a linear
 // axis provides `carriage` for limit switches. Tracks the commanded steps and the carriage position; driving
 // the carriage into either end of travel is a finding (a crash), and the
 // carriage stays at the end it hit, as a real one would.
@@ -10,7 +11,7 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
-#include "parts/StepDirDriver.hpp"
+#include "parts/ShaftMotion.hpp"
 
 namespace avrbench {
 
@@ -23,14 +24,14 @@ public:
     std::string_view type() const override { return rotary_ ? "rotary_axis" : "linear_axis"; }
 
     bool rotary() const { return rotary_; }
-    StepDirDriver& driver() const { return *driver_; }
+    const ShaftMotion& drive() const { return *driver_; }
+    std::uint64_t steps() const { return driver_->steps_taken(); }
     // Net steps at the driver's configured resolution (signed).
     double position_steps() const;
     // Linear: carriage position in mm (0 .. travel). Rotary: degrees.
     double position_mm() const { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
     double position_deg() const;
     double travel_mm() const { return travel_m_ * 1e3; }
-    std::uint64_t steps() const { return driver_->steps_taken(); }
     std::string summary() override;
     unsigned crashes() const { return crashes_; }
 
@@ -39,7 +40,7 @@ public:
 private:
     void on_step(int delta_256);
 
-    StepDirDriver* driver_ = nullptr;
+    ShaftMotion* driver_ = nullptr;
     bool rotary_;
     double steps_per_unit_ = 0;  // STEP pulses per metre (linear) or per revolution (rotary)
     double start_m_ = 0;

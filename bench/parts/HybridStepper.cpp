@@ -210,6 +210,9 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
         }
     }
 
+    shaft_256_ = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (kPi / 2) * 256.0));
+    shaft_full_ = shaft_256_ >= 0 ? shaft_256_ / 256 : -((-shaft_256_ + 255) / 256);
+    provide_port("shaft", PortKind::Steps, "the rotor in full steps, for a linear_axis (a lead screw) to follow");
     sig_angle_ = add_signal("angle_deg", true);
     sig_command_ = add_signal("commanded_deg", true);
     sig_error_ = add_signal("following_error_deg", true);
@@ -434,7 +437,26 @@ void HybridStepper::on_tick() {
     if (!model_.settled() || in_stall_) arm_tick();
 }
 
+std::string HybridStepper::motion_summary() const {
+    char text[80];
+    std::snprintf(text, sizeof text, "%llu full steps of the rotor", static_cast<unsigned long long>(shaft_steps_));
+    return text;
+}
+
+void HybridStepper::update_shaft() {
+    // Electrical angle / (pi/2) full steps; the shaft in 1/256 of one.
+    const auto now_256 = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (kPi / 2) * 256.0));
+    if (now_256 == shaft_256_) return;
+    const std::int64_t delta = now_256 - shaft_256_;
+    shaft_256_ = now_256;
+    const std::int64_t full = now_256 >= 0 ? now_256 / 256 : -((-now_256 + 255) / 256);
+    shaft_steps_ += static_cast<std::uint64_t>(full > shaft_full_ ? full - shaft_full_ : shaft_full_ - full);
+    shaft_full_ = full;
+    for (auto& fn : shaft_listeners_) fn(static_cast<int>(delta));
+}
+
 void HybridStepper::publish_all() {
+    update_shaft();
     publish(sig_angle_, angle_deg());
     publish(sig_command_, commanded_deg());
     publish(sig_error_, following_error_deg());

@@ -26,11 +26,12 @@
 #include "parts/HybridStepperModel.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ShaftMotion.hpp"
 #include "parts/WindingDrive.hpp"
 
 namespace avrbench {
 
-class HybridStepper final : public Part {
+class HybridStepper final : public Part, public ShaftMotion {
 public:
     static std::vector<ParamSpec> param_specs(bool unipolar);
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
@@ -78,6 +79,16 @@ public:
 
     void on_stall(std::function<void(const StallEvent&)> fn) { stall_listeners_.push_back(std::move(fn)); }
 
+    // ShaftMotion (port `shaft`): the rotor, in full steps, for an axis such
+    // as a lead screw's carriage; it follows the rotor (lag, slips and all),
+    // updated at every drive change and sample tick while the rotor moves.
+    unsigned configured_microsteps() const override { return 1; }
+    std::int64_t position_256() const override { return shaft_256_; }
+    void on_step(std::function<void(int delta_256)> fn) override { shaft_listeners_.push_back(std::move(fn)); }
+    std::uint64_t steps_taken() const override { return shaft_steps_; }
+    std::string motion_summary() const override;
+    std::string rate_summary() const override { return ""; }
+
 private:
     void listen(DriveSource& source);
     void on_drive_change();
@@ -88,6 +99,7 @@ private:
     void arm_tick();
     void on_tick();
     void publish_all();
+    void update_shaft();
 
     bool unipolar_;
     HybridStepperModel model_;
@@ -114,6 +126,12 @@ private:
     Cycle last_on_change_ = ~Cycle{0};
     Cycle last_command_change_ = 0, prev_command_change_ = 0;
     double last_command_delta_e_ = 0;
+
+    // The shaft as an axis sees it.
+    std::int64_t shaft_256_ = 0;
+    std::int64_t shaft_full_ = 0;  // whole full steps, for steps_taken
+    std::uint64_t shaft_steps_ = 0;
+    std::vector<std::function<void(int)>> shaft_listeners_;
 
     // Synchronism.
     long slip_count_ = 0;

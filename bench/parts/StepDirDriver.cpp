@@ -282,3 +282,20 @@ WindingDrive StepDirDriver::winding(int k) const {
 }
 
 }  // namespace avrbench
+
+namespace avrbench {
+
+std::string StepDirDriver::motion_summary() const {
+    char text[120];
+    std::snprintf(text, sizeof text, "%llu steps (%llu ignored while disabled)", static_cast<unsigned long long>(steps_taken_),
+                  static_cast<unsigned long long>(steps_ignored_));
+    return text;
+}
+
+std::string StepDirDriver::rate_summary() const {
+    char text[60];
+    std::snprintf(text, sizeof text, ", peak %.0f steps/s", peak_step_rate_hz_);
+    return text;
+}
+
+}  // namespace avrbench

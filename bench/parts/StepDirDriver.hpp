@@ -13,11 +13,12 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ShaftMotion.hpp"
 #include "parts/WindingDrive.hpp"
 
 namespace avrbench {
 
-class StepDirDriver final : public Part, public DriveSource {
+class StepDirDriver final : public Part, public DriveSource, public ShaftMotion {
 public:
     static std::vector<ParamSpec> param_specs();
     // Datasheet timing per preset (name -> parameter -> value with unit).
@@ -28,17 +29,19 @@ public:
 
     // Position in 1/256 full steps (the common denominator of every microstep
     // resolution the presets support), signed; + is DIR at its "forward" level.
-    std::int64_t position_256() const { return position_256_; }
-    std::uint64_t steps_taken() const { return steps_taken_; }        // active edges while enabled
+    std::int64_t position_256() const override { return position_256_; }
+    std::uint64_t steps_taken() const override { return steps_taken_; }        // active edges while enabled
     std::uint64_t steps_ignored() const { return steps_ignored_; }    // active edges while disabled
     double peak_step_rate_hz() const { return peak_step_rate_hz_; }   // from the shortest STEP period
     unsigned microsteps() const { return current_microsteps_; }       // resolution at the last step
-    unsigned configured_microsteps() const { return configured_microsteps_; }
+    unsigned configured_microsteps() const override { return configured_microsteps_; }
     bool enabled() const;
     void start() override;
 
     // Called after every step that moved the position (the axis listens).
-    void on_step(std::function<void(int delta_256)> fn) { step_listeners_.push_back(std::move(fn)); }
+    void on_step(std::function<void(int delta_256)> fn) override { step_listeners_.push_back(std::move(fn)); }
+    std::string motion_summary() const override;
+    std::string rate_summary() const override;
 
     // The winding currents, for a motor part driven by this driver (taken as
     // an ideal chopper at the set current). The A4988's and DRV8825's

@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "core/Errors.hpp"
-#include "parts/StepDirDriver.hpp"
+#include "parts/ShaftMotion.hpp"
 
 namespace avrbench {
 
@@ -117,7 +117,7 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
 }
 
 void ThermalPlant::connect_port(std::size_t, Part& provider) {
-    filament_driver_ = &dynamic_cast<StepDirDriver&>(provider);
+    filament_driver_ = &dynamic_cast<ShaftMotion&>(provider);
     filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
 }
 

@@ -25,7 +25,7 @@
 
 namespace avrbench {
 
-class StepDirDriver;
+class ShaftMotion;
 
 class ThermalPlant final : public Part {
 public:
@@ -93,7 +93,7 @@ private:
     Cycle last_cycle_ = 0;
     Cycle sample_cycles_;
 
-    StepDirDriver* filament_driver_ = nullptr;
+    ShaftMotion* filament_driver_ = nullptr;
     double filament_steps_per_mm_;
     std::int64_t feed_256_ = 0;  // driver steps in 1/256 full steps since the last sample
     double filament_position_mm_ = 0, filament_high_water_mm_ = 0;

@@ -100,7 +100,7 @@ INSTANTIATE_TEST_SUITE_P(
         // Ports: one connection mechanism, checked by kind (parts/Part.hpp).
         Case{"port_not_connected", 10, "  x_dir: [uno.PD5, x_driver.dir]",
              "bad.yaml:5: part 'x' (linear_axis): port 'drive' is not connected: join it to a step_dir_driver's steps "
-             "in nets:"},
+             "or a stepper motor's shaft in nets:"},
         Case{"port_kinds_differ", 11, "  x_carriage: [x_driver.windings, x_min.axis]",
              "bad.yaml:11: net 'x_carriage' joins a windings port (x_driver.windings) and a carriage port (x_min.axis)"},
         Case{"port_beside_a_pin", 11, "  x_carriage: [uno.PB2, x.carriage, x_min.axis]",
