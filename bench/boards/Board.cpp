@@ -62,10 +62,31 @@ void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
 }
 
 void Board::build_parts() {
-    // Each part is clocked by the MCU its nets lead to: directly (a pin or an
-    // analog output on a net with an MCU pin), else through port nets from a
-    // part that is; else by the board's first MCU.
-    std::map<std::string, Mcu*> clock_of;
+    // Parts joined by nets without an MCU pin (ports: a motor's shaft and its
+    // axis, a carriage and its switches, a heater and its block) call each
+    // other directly, so they share one clock: the MCU of the first net (in
+    // the file's order) that joins one of them to an MCU pin (the net's last
+    // MCU pin, when it has several); else the board's first MCU. Across
+    // clocks, parts and MCUs meet only on nets, which the lockstep times
+    // exactly (core/Lockstep.hpp).
+    std::map<std::string, std::string> group_of;  // part -> its group's representative part
+    const auto find = [&group_of](std::string name) {
+        while (group_of.count(name) != 0 && group_of[name] != name) name = group_of[name];
+        return name;
+    };
+    for (const auto& decl : spec_.parts) group_of[decl.name] = decl.name;
+    for (const auto& net : spec_.nets) {
+        bool has_mcu = false;
+        for (const auto& e : net.endpoints) has_mcu = has_mcu || spec_.find_mcu(e.owner) != nullptr;
+        if (has_mcu) continue;
+        std::string first;
+        for (const auto& e : net.endpoints) {
+            if (spec_.find_part(e.owner) == nullptr) continue;
+            if (first.empty()) first = find(e.owner);
+            else group_of[find(e.owner)] = first;
+        }
+    }
+    std::map<std::string, Mcu*> group_clock;
     for (const auto& net : spec_.nets) {
         Mcu* net_mcu = nullptr;
         for (const auto& e : net.endpoints) {
@@ -73,25 +94,13 @@ void Board::build_parts() {
         }
         if (net_mcu == nullptr) continue;
         for (const auto& e : net.endpoints) {
-            if (spec_.find_part(e.owner) != nullptr && clock_of.count(e.owner) == 0) clock_of[e.owner] = net_mcu;
+            if (spec_.find_part(e.owner) != nullptr) group_clock.emplace(find(e.owner), net_mcu);
         }
     }
-    for (bool changed = true; changed;) {
-        changed = false;
-        for (const auto& net : spec_.nets) {
-            Mcu* shared = nullptr;
-            for (const auto& e : net.endpoints) {
-                auto it = clock_of.find(e.owner);
-                if (it != clock_of.end()) {
-                    shared = it->second;
-                    break;
-                }
-            }
-            if (shared == nullptr) continue;
-            for (const auto& e : net.endpoints) {
-                if (spec_.find_part(e.owner) != nullptr && clock_of.emplace(e.owner, shared).second) changed = true;
-            }
-        }
+    std::map<std::string, Mcu*> clock_of;
+    for (const auto& decl : spec_.parts) {
+        auto it = group_clock.find(find(decl.name));
+        if (it != group_clock.end()) clock_of[decl.name] = it->second;
     }
 
     for (const auto& decl : spec_.parts) {

@@ -1,5 +1,6 @@
 #include "core/Lockstep.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace avrbench {
@@ -7,16 +8,18 @@ namespace {
 
 __extension__ using u128 = unsigned __int128;  // exact products of 64-bit cycles and 32-bit clocks
 
-// a.cycle / a.f  <  b.cycle / b.f, exactly.
-bool earlier(const Mcu& a, const Mcu& b) {
-    return static_cast<u128>(a.cycle()) * b.frequency_hz() < static_cast<u128>(b.cycle()) * a.frequency_hz();
+// a_cycle / a.f  <  b_cycle / b.f, exactly.
+bool earlier(const Mcu& a, Cycle a_cycle, const Mcu& b, Cycle b_cycle) {
+    return static_cast<u128>(a_cycle) * b.frequency_hz() < static_cast<u128>(b_cycle) * a.frequency_hz();
 }
 
-// The first cycle of `mcu` at or after the current time of `other`.
-Cycle cycle_at_time_of(const Mcu& mcu, const Mcu& other) {
-    const u128 num = static_cast<u128>(other.cycle()) * mcu.frequency_hz();
+// The first cycle of `mcu` at or after `other_cycle` of `other`.
+Cycle cycle_at_time_of(const Mcu& mcu, const Mcu& other, Cycle other_cycle) {
+    if (other_cycle == ~Cycle{0}) return ~Cycle{0};
+    const u128 num = static_cast<u128>(other_cycle) * mcu.frequency_hz();
     const u128 den = other.frequency_hz();
-    return static_cast<Cycle>((num + den - 1) / den);
+    const u128 c = (num + den - 1) / den;
+    return c > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(c);
 }
 
 }  // namespace
@@ -30,6 +33,26 @@ std::uint64_t ps_at_cycle(const Mcu& mcu, Cycle cycle) {
     return static_cast<std::uint64_t>(static_cast<u128>(cycle) * kPsPerSecond / mcu.frequency_hz());
 }
 
+Lockstep::~Lockstep() {
+    for (Mcu* m : mcus_) m->set_peer_sync(nullptr);
+}
+
+void Lockstep::add(Mcu& mcu) {
+    mcus_.push_back(&mcu);
+    // One MCU needs no synchronising; with two, every MCU reports to us.
+    if (mcus_.size() >= 2) {
+        for (Mcu* m : mcus_) m->set_peer_sync(this);
+    }
+}
+
+void Lockstep::couple(const Mcu& a, const Mcu& b) {
+    if (&a == &b) return;
+    coupled_.insert({&a, &b});
+    coupled_.insert({&b, &a});
+}
+
+bool Lockstep::coupled(const Mcu& a, const Mcu& b) const { return coupled_.count({&a, &b}) != 0; }
+
 std::uint64_t Lockstep::now_ps() const {
     // The running MCU furthest behind; once all have halted, the last to halt.
     std::uint64_t now = std::numeric_limits<std::uint64_t>::max(), halted_at = 0;
@@ -41,28 +64,44 @@ std::uint64_t Lockstep::now_ps() const {
     return now == std::numeric_limits<std::uint64_t>::max() ? halted_at : now;
 }
 
+void Lockstep::reach(Mcu& mcu) {
+    Mcu* const runner = running_;
+    if (runner == nullptr || &mcu == runner) return;
+    // Whatever changes now may wake `mcu` or change its outputs: every
+    // horizon is worked out again after the runner's instruction.
+    runner->request_yield();
+    if (mcu.halted() || mcu.in_run() || !mcu.dormant()) return;
+    const Cycle target = cycle_at_time_of(mcu, *runner, runner->cycle());
+    if (mcu.cycle() >= target) return;
+    ++catch_ups_;
+    running_ = &mcu;
+    if (mcu.run_until(target) == StopReason::Requested) requested_stop_ = true;
+    running_ = runner;
+}
+
 StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
+    requested_stop_ = false;
     for (;;) {
-        // The core furthest behind, and the one just ahead of it.
+        // The core furthest behind, and the earliest horizon of the others.
         Mcu* behind = nullptr;
-        Mcu* next = nullptr;
         for (Mcu* m : mcus_) {
             if (m->halted() || m->cycle() >= cycle_at_ps(*m, end_ps)) continue;
-            if (behind == nullptr || earlier(*m, *behind)) {
-                next = behind;
-                behind = m;
-            } else if (next == nullptr || earlier(*m, *next)) {
-                next = m;
-            }
+            if (behind == nullptr || earlier(*m, m->cycle(), *behind, behind->cycle())) behind = m;
         }
         if (behind == nullptr) break;
         Cycle target = cycle_at_ps(*behind, end_ps);
-        if (next != nullptr) {
-            // At least one instruction, or two cores at the same time would
-            // never move.
-            target = std::min(target, std::max(cycle_at_time_of(*behind, *next), behind->cycle() + 1));
+        for (Mcu* m : mcus_) {
+            if (m == behind || m->halted()) continue;
+            const bool may_pass = lookahead_ && m->dormant() && !coupled(*behind, *m);
+            const Cycle horizon = may_pass ? m->next_event_cycle() : m->cycle();
+            target = std::min(target, cycle_at_time_of(*behind, *m, horizon));
         }
-        if (behind->run_until(target) == StopReason::Requested) return StopReason::Requested;
+        // At least one instruction, or two cores at the same time would never move.
+        target = std::max(target, behind->cycle() + 1);
+        running_ = behind;
+        const StopReason r = behind->run_until(target);
+        running_ = nullptr;
+        if (r == StopReason::Requested || requested_stop_) return StopReason::Requested;
     }
     for (const Mcu* m : mcus_) {
         if (!m->halted()) return StopReason::ReachedTarget;

@@ -13,6 +13,7 @@ extern "C" {
 #include <sim_avr.h>
 #include <sim_cycle_timers.h>
 #include <sim_elf.h>
+#include <sim_interrupts.h>
 #include <sim_io.h>
 }
 
@@ -121,6 +122,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     scheduler_ = std::make_unique<Scheduler>(avr_);
     adc_ = std::make_unique<Adc>(avr_, mcu_type_);
     twi_ = Twi::install(avr_, mcu_type_, *scheduler_, options_.name);
+    if (twi_) twi_->set_sync([this] { before_external_change(); });
     if (options_.skip_idle_loops && !options_.reference_run_loop) skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
@@ -158,7 +160,18 @@ Cycle Mcu::cycle() const { return avr_->cycle; }
 
 void Mcu::request_stop() {
     stop_requested_ = true;
+    real_stop_ = true;
     avr_cycle_timer_register(avr_, 0, &stop_timer, this);
+}
+void Mcu::request_yield() {
+    if (!in_run_ || stop_requested_) return;
+    stop_requested_ = true;
+    avr_cycle_timer_register(avr_, 0, &stop_timer, this);
+}
+bool Mcu::dormant() const { return avr_->state == cpu_Sleeping && !avr_has_pending_interrupts(avr_); }
+Cycle Mcu::next_event_cycle() const {
+    const avr_cycle_timer_slot_p head = avr_->cycle_timers.timer;
+    return head == nullptr ? ~Cycle{0} : head->when;
 }
 void Mcu::set_skip_idle_loops(bool on) {
     options_.skip_idle_loops = on;
@@ -209,7 +222,9 @@ bool Mcu::run_until_sleep(Cycle end_cycle) {
 
 StopReason Mcu::run_until(Cycle target_cycle) {
     stop_requested_ = false;
+    real_stop_ = false;
     if (halted_) return StopReason::Halted;
+    in_run_ = true;
     avr_t* const avr = avr_;
     // A cycle timer at the target: a core that sleeps (now, or when the SLEEP
     // instruction executes inside avr_run) jumps to its next cycle timer, and
@@ -292,10 +307,15 @@ StopReason Mcu::run_until(Cycle target_cycle) {
     }
     avr_cycle_timer_cancel(avr, &horizon_timer, this);
     run_target_ = 0;
+    in_run_ = false;
     if (halted_) return StopReason::Halted;
     if (stop_requested_) {
         stop_requested_ = false;
-        return StopReason::Requested;
+        avr_cycle_timer_cancel(avr, &stop_timer, this);
+        if (real_stop_) {
+            real_stop_ = false;
+            return StopReason::Requested;
+        }
     }
     return StopReason::ReachedTarget;
 }

@@ -26,6 +26,7 @@ namespace avrbench {
 
 class Adc;
 class IdleLoopSkipper;
+class Mcu;
 class Twi;
 
 struct McuOptions {
@@ -45,6 +46,14 @@ enum class StopReason {
     ReachedTarget,   // the requested cycle was reached
     Requested,       // a callback called request_stop()
     Halted,          // the MCU can run no further (finding, crash, sleep with interrupts off)
+};
+
+// What keeps several MCUs of a board in step (core/Lockstep.hpp): told when
+// something outside an MCU is about to change what that MCU sees.
+class PeerSync {
+public:
+    virtual ~PeerSync() = default;
+    virtual void reach(Mcu& mcu) = 0;
 };
 
 class Mcu final : private SimavrLogSink {
@@ -81,6 +90,22 @@ public:
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
+    // Ends the present run_until after this instruction with ReachedTarget
+    // (the lockstep takes its turn again: another MCU's horizon changed).
+    void request_yield();
+    bool in_run() const { return in_run_; }
+    // Asleep with no interrupt on its way: nothing changes until its next
+    // cycle timer, unless something outside wakes it.
+    bool dormant() const;
+    // The first pending cycle timer (simavr's peripherals, the scheduler's
+    // events), or the largest cycle when none is pending.
+    Cycle next_event_cycle() const;
+    // The board's lockstep, told before a net or the TWI bus changes what
+    // this MCU sees (it brings this MCU up to the running one's time).
+    void set_peer_sync(PeerSync* sync) { peer_sync_ = sync; }
+    void before_external_change() {
+        if (peer_sync_ != nullptr) peer_sync_->reach(*this);
+    }
     // The command line's runs: to `end_cycle` in slices of at most 10 ms
     // simulated, calling `after_slice` after each (progress, streaming a VCD),
     // until halted or SIGINT/SIGTERM (core/UserStop.hpp); or instruction by
@@ -137,6 +162,9 @@ private:
     std::unique_ptr<IdleLoopSkipper> skipper_;  // nullptr: never skip
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
+    bool in_run_ = false;
+    bool real_stop_ = false;  // stop_requested_ came from request_stop, not request_yield
+    PeerSync* peer_sync_ = nullptr;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
     std::vector<Finding> findings_;

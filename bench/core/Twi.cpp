@@ -350,6 +350,10 @@ void TwiBus::drop(Twi& twi) {
 bool TwiBus::slave_holds_scl() const { return slave_ != nullptr && slave_->interrupt_flag(); }
 
 void TwiBus::request(Twi& master, Op op, bool then_start) {
+    // The other modules' state (a slave holding SCL) as of the master's time.
+    for (Twi* t : members_) {
+        if (t != &master) t->sync();
+    }
     if (op == Op::Start && master_ != &master) {
         if (master_ != nullptr) {
             master.start_pending_ = true;  // §22.7.5: the START waits for a STOP on the bus
@@ -399,6 +403,9 @@ Twi* TwiBus::find_slave(std::uint8_t address_byte, bool& general_call) const {
 
 void TwiBus::complete(Op op, bool then_start) {
     Twi& m = *master_;
+    for (Twi* t : members_) {
+        if (t != &m) t->sync();
+    }
     const Cycle now = m.avr_->cycle;
     switch (op) {
     case Op::Start: {
@@ -501,6 +508,7 @@ void TwiBus::complete(Op op, bool then_start) {
 }
 
 void TwiBus::slave_released(Twi& slave) {
+    if (master_ != nullptr && master_ != &slave) master_->sync();  // its next step is timed from its clock
     if (slave_ == &slave && !slave.addressed_) slave_ = nullptr;
     if (waiting_ != Op::None && !slave_holds_scl()) {
         const Op op = waiting_;
@@ -513,6 +521,7 @@ void TwiBus::start_waiting_master() {
     if (master_ != nullptr) return;
     for (Twi* t : members_) {
         if (t->start_pending_ && t->control_bit(kTwen)) {
+            t->sync();
             t->start_pending_ = false;
             request(*t, Op::Start);
             return;

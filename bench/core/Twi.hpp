@@ -75,6 +75,12 @@ public:
 
     // Called by Mcu after a reset: registers to their reset values, the bus let go.
     void reset();
+    // Called before the bus changes what this module's MCU sees, while
+    // another MCU runs (Mcu::before_external_change: the lockstep).
+    void set_sync(std::function<void()> fn) { sync_ = std::move(fn); }
+    void sync() {
+        if (sync_) sync_();
+    }
 
 private:
     friend class TwiBus;
@@ -130,6 +136,7 @@ private:
     bool general_call_ = false;
     bool last_byte_ = false;      // slave transmitter loaded TWDR with TWEA = 0
     bool start_pending_ = false;  // TWSTA while the bus belongs to another master
+    std::function<void()> sync_;
     std::uint8_t last_status_ = 0xF8;  // TWSR's status as the firmware last saw it with TWINT
 };
 

@@ -6,6 +6,8 @@
 
 namespace avrbench {
 
+Mcu* PartPin::clock_mcu() const { return &part_.clock(); }
+
 std::string PartPin::label() const { return part_.name() + "." + name_; }
 
 void PartPin::receive(const Resolution& resolution) {

@@ -38,6 +38,7 @@ public:
         : part_(part), index_(index), name_(std::move(name)), role_(role) {}
     std::string label() const override;
     TerminalRole role() const override { return role_; }
+    Mcu* clock_mcu() const override;
     Drive drive_state() const override { return drive_; }
     void receive(const Resolution& resolution) override;
 

@@ -36,6 +36,7 @@ public:
     McuPinTerminal(Mcu& mcu, Pin& pin);
     std::string label() const override { return mcu_.name() + "." + pin_.name(); }
     TerminalRole role() const override { return TerminalRole::Bidirectional; }
+    Mcu* clock_mcu() const override { return &mcu_; }
     Drive drive_state() const override;
     void receive(const Resolution& resolution) override;
 

@@ -57,7 +57,11 @@ void Net::update() {
 
 void Net::deliver() {
     delivering_ = true;
-    for (Terminal* t : terminals_) t->receive(resolution_);
+    for (Terminal* t : terminals_) {
+        // Another MCU's pin or part: brought up to the running MCU's time first.
+        if (Mcu* clock = t->clock_mcu()) clock->before_external_change();
+        t->receive(resolution_);
+    }
     delivering_ = false;
 }
 

@@ -29,6 +29,8 @@ public:
     virtual ~Terminal() = default;
     virtual std::string label() const = 0;  // "uno.PD2", "x_driver.step"
     virtual TerminalRole role() const = 0;
+    // The MCU whose clock the terminal lives on (its own, or its part's), if any.
+    virtual Mcu* clock_mcu() const { return nullptr; }
     // What the terminal puts on the net now.
     virtual Drive drive_state() const = 0;
     // The net settled to `resolution` (delivered to every terminal, the

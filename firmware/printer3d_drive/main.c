@@ -26,13 +26,16 @@
  * 125 kHz (the thesis' ADPS = 0 is 8 MHz), ADCH read as uint8_t (int8_t
  * wrapped codes >= 128 negative), and the step interrupt no longer nests
  * (ISR_NOBLOCK let the ADC interrupt's read-modify-write of PORTB interleave
- * with its own). THESIS_LITERAL builds the listing's drive loop as printed.
+ * with its own), and the main loop sleeps between interrupts instead of
+ * spinning (the safety check runs after each one, at least every 204 us).
+ * THESIS_LITERAL builds the listing's drive loop as printed.
  *
  * Globals for tests: position (steps, CW positive), motor_state, samples,
  * chops.
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
+#include <avr/sleep.h>
 #include <stdint.h>
 
 #include "avrbench_mcu.h"
@@ -86,7 +89,10 @@ ISR(ADC_vect)
         PORTB &= (uint8_t)~mask;
     } else {
         chopped &= (uint8_t)~mask;
-        PORTB = (uint8_t)((PORTB & (uint8_t)~mask) | (motor_state & mask));
+#ifndef THESIS_LITERAL
+        if (PIND & _BV(PD1)) /* disabled coils stay off (the listing relies on its busy loop) */
+#endif
+            PORTB = (uint8_t)((PORTB & (uint8_t)~mask) | (motor_state & mask));
     }
     channel ^= 1;
     ADMUX = (uint8_t)(_BV(REFS0) | _BV(ADLAR) | channel);
@@ -121,7 +127,22 @@ int main(void)
     ADCSRA = _BV(ADATE) | _BV(ADEN) | _BV(ADIE) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
 #endif
     sei();
+#ifdef THESIS_LITERAL
     for (;;) {
         if (!(PIND & _BV(PD1))) PORTB &= 0xF0; /* safety: disabled, coils off */
     }
+#else
+    /* The safety loop runs after every interrupt - at the latest the Timer1
+     * match every 204 us - and sleeps in between (idle mode: the timers, the
+     * ADC and INT0 run on). */
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    for (;;) {
+        cli();
+        if (!(PIND & _BV(PD1))) PORTB &= 0xF0; /* safety: disabled, coils off */
+        sleep_enable();
+        sei();
+        sleep_cpu(); /* SEI lets exactly this SLEEP run before a pending interrupt */
+        sleep_disable();
+    }
+#endif
 }

@@ -23,6 +23,7 @@
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
+#include <avr/sleep.h>
 #include <math.h>
 #include <stdint.h>
 
@@ -159,7 +160,10 @@ int main(void)
     TIMSK = _BV(OCIE1B);
     TWAR = (uint8_t)(TWI_ADDRESS << 1);
     TWCR = _BV(TWEA) | _BV(TWEN) | _BV(TWIE);
+    /* Everything happens in interrupts; sleep in between (idle mode: the
+     * timers, the ADC and the TWI run on). */
+    set_sleep_mode(SLEEP_MODE_IDLE);
+    sleep_enable();
     sei();
-    for (;;) {
-    }
+    for (;;) sleep_cpu();
 }
