@@ -10,12 +10,13 @@ __extension__ using u128 = unsigned __int128;  // exact products of 64-bit cycle
 
 // a_cycle / a.f  <  b_cycle / b.f, exactly.
 bool earlier(const Mcu& a, Cycle a_cycle, const Mcu& b, Cycle b_cycle) {
+    if (a.frequency_hz() == b.frequency_hz()) return a_cycle < b_cycle;  // the usual board: no 128-bit products
     return static_cast<u128>(a_cycle) * b.frequency_hz() < static_cast<u128>(b_cycle) * a.frequency_hz();
 }
 
 // The first cycle of `mcu` at or after `other_cycle` of `other`.
 Cycle cycle_at_time_of(const Mcu& mcu, const Mcu& other, Cycle other_cycle) {
-    if (other_cycle == ~Cycle{0}) return ~Cycle{0};
+    if (other_cycle == ~Cycle{0} || mcu.frequency_hz() == other.frequency_hz()) return other_cycle;
     const u128 num = static_cast<u128>(other_cycle) * mcu.frequency_hz();
     const u128 den = other.frequency_hz();
     const u128 c = (num + den - 1) / den;
@@ -51,7 +52,7 @@ void Lockstep::couple(const Mcu& a, const Mcu& b) {
     coupled_.insert({&b, &a});
 }
 
-bool Lockstep::coupled(const Mcu& a, const Mcu& b) const { return coupled_.count({&a, &b}) != 0; }
+bool Lockstep::coupled(const Mcu& a, const Mcu& b) const { return !coupled_.empty() && coupled_.count({&a, &b}) != 0; }
 
 std::uint64_t Lockstep::now_ps() const {
     // The running MCU furthest behind; once all have halted, the last to halt.
@@ -81,15 +82,22 @@ void Lockstep::reach(Mcu& mcu) {
 
 StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
     requested_stop_ = false;
+    end_cycles_.resize(mcus_.size());
+    for (std::size_t k = 0; k < mcus_.size(); ++k) end_cycles_[k] = cycle_at_ps(*mcus_[k], end_ps);
     for (;;) {
         // The core furthest behind, and the earliest horizon of the others.
         Mcu* behind = nullptr;
-        for (Mcu* m : mcus_) {
-            if (m->halted() || m->cycle() >= cycle_at_ps(*m, end_ps)) continue;
-            if (behind == nullptr || earlier(*m, m->cycle(), *behind, behind->cycle())) behind = m;
+        Cycle behind_end = 0;
+        for (std::size_t k = 0; k < mcus_.size(); ++k) {
+            Mcu* m = mcus_[k];
+            if (m->halted() || m->cycle() >= end_cycles_[k]) continue;
+            if (behind == nullptr || earlier(*m, m->cycle(), *behind, behind->cycle())) {
+                behind = m;
+                behind_end = end_cycles_[k];
+            }
         }
         if (behind == nullptr) break;
-        Cycle target = cycle_at_ps(*behind, end_ps);
+        Cycle target = behind_end;
         for (Mcu* m : mcus_) {
             if (m == behind || m->halted()) continue;
             const bool may_pass = lookahead_ && m->dormant() && !coupled(*behind, *m);

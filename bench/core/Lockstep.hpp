@@ -60,9 +60,8 @@ public:
 
 private:
     bool coupled(const Mcu& a, const Mcu& b) const;
-    // Cycle of `m` up to which another MCU may run without passing `m`'s horizon.
-    // As a time: picoseconds * frequency of the asker are compared exactly.
     std::vector<Mcu*> mcus_;
+    std::vector<Cycle> end_cycles_;  // run_until_ps's end, per MCU
     std::set<std::pair<const Mcu*, const Mcu*>> coupled_;
     bool lookahead_ = true;
     Mcu* running_ = nullptr;
