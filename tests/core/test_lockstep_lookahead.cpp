@@ -10,6 +10,7 @@
 
 #include "boards/Board.hpp"
 #include "core/Lockstep.hpp"
+#include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
 #include "trace/TimelineText.hpp"
 #include "verify/Bench.hpp"
@@ -60,6 +61,17 @@ EndState run_heater_link(bool lookahead) {
 }
 
 TEST(LockstepLookahead, TwiHeaterLinkEndsAsInStrictLockstep) { expect_same(run_heater_link(false), run_heater_link(true)); }
+
+EndState run_printer(bool lookahead) {
+    auto bench = test::printer_bench();
+    bench->board().lockstep().set_lookahead(lookahead);
+    bench->trace_board();
+    bench->host().add_lines("G28 X\nG1 X1 Y0.3 F600\nM3\nG2 X1 Y0.3 I0.5 J0 F300\nM5\nM104 S60\nM105\nM400\n");
+    EXPECT_EQ(bench->run_until_idle(10.0), IdleResult::Idle);
+    return end_state(*bench);
+}
+
+TEST(LockstepLookahead, FiveMcuPrinterEndsAsInStrictLockstep) { expect_same(run_printer(false), run_printer(true)); }
 
 }  // namespace
 }  // namespace avrbench
