@@ -27,9 +27,10 @@
 #define SP_NUM 1
 #define SP_DEN 8
 /* Anti-ooze retract on every extruder disable (§4.7: "by some steps"), and
- * the same steps primed back before the next depositing move; 1 ms apart. */
+ * the same steps primed back before the next depositing move; 2.5 ms apart
+ * (400 steps/s: the unipolar motor starts there without a ramp). */
 #define RETRACT_STEPS 40
-#define BURST_PERIOD_US 1000UL
+#define BURST_PERIOD_US 2500UL
 
 /* Homing (G28): towards the min switches at 300 mm/min, 2 ms per step,
  * giving up after 300 mm of travel. */
@@ -37,9 +38,10 @@
 #define HOMING_MAX_BLU (300L * BLU_PER_MM)
 
 /* Feeds: mm/min (modal F); 600 mm/min until the first F. Feeds are limited to
- * what the drives can follow: at most 1200 mm/min = 2000 steps/s. */
+ * what the drive boards' motors follow (the unipolar preset at 12 V slips
+ * near 450 rpm on the bench): at most 600 mm/min = 1000 full steps/s, 300 rpm. */
 #define DEFAULT_FEED_MM_MIN 600L
-#define MAX_FEED_MM_MIN 1200L
+#define MAX_FEED_MM_MIN 600L
 #define MIN_FEED_MM_MIN 1L
 
 /* Travel: positions outside -1000..+1000 mm are refused (error:range). */
