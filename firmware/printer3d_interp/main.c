@@ -286,7 +286,7 @@ static uint8_t home_axes(uint8_t mask)
         m.dtc_half_us = 2 * HOMING_PERIOD_US;
         home_result = 0;
         motion_push(&m);
-        motion_wait_idle_keepalive(busy);
+        motion_wait_idle();
         if (home_result != 1) return 0;
         motion_set_position(axis, 0);
         plan_position[axis] = 0;
@@ -439,7 +439,7 @@ static void m_code(const words_t *w)
             reply("ok");
             return;
         case 115: reply("FIRMWARE_NAME:avrbench printer3d_interp (seed 001) PROTOCOL_VERSION:1.0"); reply("ok"); return;
-        case 400: motion_wait_idle_keepalive(busy); reply("ok"); return;
+        case 400: motion_wait_idle(); reply("ok"); return;
         default: fail("unknown M code"); return;
     }
 }
@@ -544,6 +544,7 @@ static void handle_line(void)
 int main(void)
 {
     motion_init();
+    motion_keepalive = busy;
     heater_link_init();
     fw_uart_init(16, 1); /* 115200 baud */
     sei();

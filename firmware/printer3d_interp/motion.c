@@ -236,16 +236,24 @@ void motion_init(void)
  * before a pending interrupt (2560 §7.8), so no wake-up is missed. */
 static uint8_t queue_full(void) { return (uint8_t)(head - tail) >= QUEUE_SIZE; }
 
+void (*motion_keepalive)(void);
+
+/* Sleeps while `busy()`, calling motion_keepalive about once a second. */
 static void nap_while(uint8_t (*busy)(void))
 {
+    uint16_t last = TCNT3;
     set_sleep_mode(SLEEP_MODE_IDLE);
     for (;;) {
         cli();
         if (!busy()) break;
         sleep_enable();
         sei();
-        sleep_cpu();
+        sleep_cpu(); /* a tick comes at least every 65 ms while a move runs */
         sleep_disable();
+        if ((uint16_t)(TCNT3 - last) >= 15625U) { /* Timer3: 15625 counts per second */
+            last = TCNT3;
+            if (motion_keepalive) motion_keepalive();
+        }
     }
     sei();
 }
@@ -266,25 +274,6 @@ uint8_t motion_busy(void) { return running || head != tail; }
 void motion_wait_idle(void)
 {
     nap_while(motion_busy);
-}
-
-void motion_wait_idle_keepalive(void (*keepalive)(void))
-{
-    uint16_t last = TCNT3;
-    set_sleep_mode(SLEEP_MODE_IDLE);
-    for (;;) {
-        cli();
-        if (!motion_busy()) break;
-        sleep_enable();
-        sei();
-        sleep_cpu(); /* a tick comes at least every 65 ms while a move runs */
-        sleep_disable();
-        if ((uint16_t)(TCNT3 - last) >= 15625U) {
-            last = TCNT3;
-            keepalive();
-        }
-    }
-    sei();
 }
 
 void motion_set_position(uint8_t axis, int32_t blu)

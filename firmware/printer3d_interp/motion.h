@@ -44,9 +44,10 @@ void motion_init(void);
 void motion_push(const move_t *m);
 /* Sleeps until every queued move has run. */
 void motion_wait_idle(void);
-/* The same, calling `keepalive` about once a second of waiting (Timer3 at
- * clk/1024 runs free as the time base: 15625 counts per second). */
-void motion_wait_idle_keepalive(void (*keepalive)(void));
+/* Called about once a second while motion_push or motion_wait_idle waits
+ * (Timer3 at clk/1024 runs free as the time base), so the host hears a
+ * keep-alive; NULL for none. */
+extern void (*motion_keepalive)(void);
 uint8_t motion_busy(void);
 /* Sets step_position[axis] while idle (G92, homing). */
 void motion_set_position(uint8_t axis, int32_t blu);
