@@ -268,6 +268,7 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
 void run_motor_overhead(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
+void run_printer_lockstep(const std::string& firmware_dir, const std::string& source_dir, int repeats);
 
 int perf_main(int argc, char** argv) {
     CLI::App app{"avrbench_perf: bench vs bare simavr on the same ELFs"};
@@ -289,9 +290,15 @@ int perf_main(int argc, char** argv) {
     app.add_option("--seconds", external_seconds, "its simulated time (default 5)");
     std::size_t compare_edges = 0;
     app.add_option("--compare-edges", compare_edges, "only the comparison rules, on this many edges per signal");
+    bool only_printer = false;
+    app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lockstep with lookahead, strict, one MCU)");
     std::vector<double> rss_seconds;
     app.add_option("--rss", rss_seconds, "peak RSS of the CLI streaming a 1 M events/s VCD for these simulated seconds");
     CLI11_PARSE(app, argc, argv);
+    if (only_printer) {
+        run_printer_lockstep(firmware_dir, AVRBENCH_SOURCE_DIR, repeats);
+        return 0;
+    }
 
     const Workload workloads[] = {
         {"busy_poll (CPU-bound, PORTD counter)", "busy_poll", 5.0},
@@ -401,6 +408,7 @@ int perf_main(int argc, char** argv) {
     std::printf("%-44s %9s %12s %12s %9.3f %9.3f %7.3f\n", "  (thread CPU time, best of each)", "", "", "",
                 cpu_without, cpu_with, cpu_with / cpu_without);
     if (!only_thermal) run_motor_overhead(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
+    if (!only_thermal) run_printer_lockstep(firmware_dir, AVRBENCH_SOURCE_DIR, repeats);
     return 0;
 }
 
