@@ -28,7 +28,10 @@
  * (ISR_NOBLOCK let the ADC interrupt's read-modify-write of PORTB interleave
  * with its own), and the main loop sleeps between interrupts instead of
  * spinning (the safety check runs after each one, at least every 204 us).
- * THESIS_LITERAL builds the listing's drive loop as printed.
+ * THESIS_LITERAL builds the listing as printed, with its hot-end control on
+ * this MCU (Code 3.14-3.15: ADC2 in the round robin, the PID in raw int8_t
+ * counts, OC2/PD7, TEMP_OK on PD6); THESIS_TRIGGER_FIXED on top fixes only
+ * the conversion trigger (digest §9.1-9.3), so the later defects show.
  *
  * Globals for tests: position (steps, CW positive), motor_state, samples,
  * chops.
@@ -74,10 +77,46 @@ ISR(INT0_vect)
     PORTB = (uint8_t)((PORTB & 0xF0) | (motor_state & (uint8_t)~chopped));
 }
 
+#ifdef THESIS_LITERAL
+/* The listing's hot-end control on the same MCU (Code 3.14-3.15, digest §5):
+ * ADC2 joins the round robin AC -> BD -> TEMP, the PID runs on each
+ * temperature sample in raw 8-bit counts read into an int8_t, Timer2 fast PWM
+ * on OC2 = PD7, TEMP_OK on PD6. */
+#define SENSE_TEMPERATURE 2
+#define KP 200
+#define KI 1
+#define KD 500
+#define REFERENCE_TEMP 190
+#define TEMP_ACCEPTABLE_ERR 5
+static int16_t errorSum;
+static int16_t previousError;
+volatile uint16_t temperature_samples;
+
+static void temperature_sample(int8_t currentMeasurement)
+{
+    const int16_t error = (int16_t)(REFERENCE_TEMP - currentMeasurement);
+    int32_t temp = (int32_t)error * KP;
+    errorSum += error;
+    temp += (int32_t)errorSum * KI;
+    temp += (int32_t)(error - previousError) * KD;
+    previousError = error;
+    OCR2 = temp > 255 ? 255 : temp < 0 ? 0 : (uint8_t)temp;
+    if ((error < 0 ? -error : error) < TEMP_ACCEPTABLE_ERR) PORTD |= _BV(PD6);
+    else PORTD &= (uint8_t)~_BV(PD6);
+    ++temperature_samples;
+}
+#endif
+
 ISR(ADC_vect)
 {
 #ifdef THESIS_LITERAL
     const int8_t sample = (int8_t)ADCH;
+    if (channel == SENSE_TEMPERATURE) {
+        temperature_sample(sample);
+        channel = 0;
+        ADMUX = (uint8_t)(_BV(REFS0) | _BV(ADLAR) | channel);
+        return;
+    }
 #else
     const uint8_t sample = ADCH;
 #endif
@@ -94,11 +133,15 @@ ISR(ADC_vect)
 #endif
             PORTB = (uint8_t)((PORTB & (uint8_t)~mask) | (motor_state & mask));
     }
+#ifdef THESIS_LITERAL
+    ++channel; /* AC -> BD -> TEMP */
+#else
     channel ^= 1;
+#endif
     ADMUX = (uint8_t)(_BV(REFS0) | _BV(ADLAR) | channel);
 }
 
-#ifndef THESIS_LITERAL
+#if !defined(THESIS_LITERAL) || defined(THESIS_TRIGGER_FIXED)
 EMPTY_INTERRUPT(TIMER1_COMPB_vect); /* taking it clears OCF1B, so the next match triggers again */
 #endif
 
@@ -118,9 +161,21 @@ int main(void)
     TCCR1A = 0;
     TCCR1B = _BV(WGM12) | _BV(CS11) | _BV(CS10); /* CTC, clk/64 */
 #ifdef THESIS_LITERAL
+    DDRD |= (1 << 7); /* heater */
+    PORTD &= (uint8_t)~(1 << 7);
+    DDRD |= (1 << 6); /* TEMP_OK */
+    TCCR2 = _BV(WGM21) | _BV(WGM20) | _BV(COM21) | _BV(CS22) | _BV(CS20); /* fast PWM, clk/128: 488 Hz */
+#ifdef THESIS_TRIGGER_FIXED
+    /* Only digest §9.1-9.3 fixed (the trigger, OCIE1B, the prescaler), so the
+     * conversions run and §9.4-9.5 show: the int8_t ADCH and the raw counts. */
+    SFIOR = (uint8_t)((SFIOR & 0x1F) | _BV(ADTS2) | _BV(ADTS0));
+    TIMSK |= _BV(OCIE1B);
+    ADCSRA = _BV(ADATE) | _BV(ADEN) | _BV(ADIE) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
+#else
     SFIOR = (3 << ADTS0);
     TIMSK |= OCIE1B;
     ADCSRA = _BV(ADATE) | _BV(ADEN) | _BV(ADIE) | (128);
+#endif
 #else
     SFIOR = (uint8_t)((SFIOR & 0x1F) | _BV(ADTS2) | _BV(ADTS0)); /* Timer1 compare match B */
     TIMSK |= _BV(OCIE1B);

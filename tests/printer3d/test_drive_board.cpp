@@ -13,6 +13,7 @@
 #include "core/Adc.hpp"
 #include "parts/HybridStepper.hpp"
 #include "support/Paths.hpp"
+#include "support/PinLog.hpp"
 
 namespace avrbench {
 namespace {
@@ -132,6 +133,28 @@ TEST(Printer3dDrive, TheListingAsPrintedNeverConverts) {
     EXPECT_NEAR(i, 12.0 / (6.8 + 2.2), 0.05);
     // The steps themselves still work.
     EXPECT_EQ(run.mcu.read_ram_u8("motor_state"), 0x06);
+    // The hot-end control never runs either: no temperature sample, the
+    // heater's OCR2 stays 0 (fast PWM: a 1/256 pulse every 2.048 ms), and
+    // TEMP_OK (PD6) keeps the level PORTD = 0xFF gave it before DDRD made it
+    // an output - high, "temperature OK", from reset on, with no heating.
+    EXPECT_EQ(run.mcu.read_ram_u16("temperature_samples"), 0u);
+    EXPECT_TRUE(run.mcu.pin("PD6").level());
+}
+
+TEST(Printer3dDrive, TheListingWithItsTriggerFixedHoldsTheHeaterFullOn) {
+    // Digest §9.4: with conversions running (only §9.1-9.3 fixed), ADCH read
+    // into an int8_t is at most 127, so the error 190 - ADCH is at least 63
+    // and the PID output 200 e + ... is clamped to 255: the heater is on 100 %
+    // and TEMP_OK (|e| < 5) never goes high, whatever the thermistor reads.
+    DriveRun run("printer3d_drive_thesis_triggered");
+    test::PinLog heater(run.mcu, "PD7"), temp_ok(run.mcu, "PD6");
+    run.board.run_for_seconds(0.1);
+    // Every third conversion of one per 204 us is a temperature sample.
+    EXPECT_NEAR(run.mcu.read_ram_u16("temperature_samples"), run.mcu.seconds() / (3 * 204e-6), 2.0);
+    EXPECT_TRUE(heater.falls().empty());       // OCR2 = 255: constantly high (§10.4)
+    EXPECT_TRUE(run.mcu.pin("PD7").level());
+    EXPECT_FALSE(run.mcu.pin("PD6").level());
+    EXPECT_TRUE(temp_ok.rises().empty());
 }
 
 }  // namespace
