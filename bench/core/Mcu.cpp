@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <algorithm>
+#include <stdexcept>
 
 extern "C" {
 #include <avr_ioport.h>
@@ -320,6 +321,28 @@ StopReason Mcu::run_until(Cycle target_cycle) {
     return StopReason::ReachedTarget;
 }
 
+void Mcu::after_reset() {
+    ++resets_;
+    // avr_reset() drops every cycle timer: put the scheduler's back.
+    scheduler_->rearm();
+    // And the run's horizon: run_until's fast path counts on it.
+    if (avr_->cycle < run_target_) avr_cycle_timer_register(avr_, run_target_ - avr_->cycle, &horizon_timer, this);
+    if (twi_) twi_->reset();
+    for (auto& fn : reset_listeners_) fn();
+}
+
+void Mcu::reset_external() {
+    if (in_run_) throw std::logic_error("Mcu::reset_external during a run");
+    if (halted_) {
+        // A reset brings a halted core back (a SLEEP with interrupts off, a crash).
+        halted_ = false;
+        halt_reason_.clear();
+    }
+    avr_reset(avr_);
+    avr_regbit_set(avr_, avr_->reset_flags.extrf);
+    after_reset();
+}
+
 bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     char detail[160];
     if (state == cpu_Crashed) {
@@ -343,15 +366,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     if (halted_) return false;  // a finding raised from inside the step (invalid opcode)
     const std::uint32_t pc = avr_->pc;
     if (pc == 0) {
-        ++resets_;
-        // avr_reset() drops every cycle timer: put the scheduler's back.
-        scheduler_->rearm();
-        // And the run's horizon: run_until's fast path counts on it.
-        if (avr_->cycle < run_target_) {
-            avr_cycle_timer_register(avr_, run_target_ - avr_->cycle, &horizon_timer, this);
-        }
-        if (twi_) twi_->reset();
-        for (auto& fn : reset_listeners_) fn();
+        after_reset();
         if (watchdog_reset_seen_) {
             watchdog_reset_seen_ = false;
             add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);

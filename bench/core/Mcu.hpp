@@ -133,6 +133,10 @@ public:
     std::uint64_t idle_cycles_skipped() const;
     // How many times the core went through a reset after power-on.
     unsigned resets() const { return resets_; }
+    // A pulse on the RESET pin (an Arduino's auto-reset capacitor when the
+    // host opens the port, a reset button): the MCU restarts at its reset
+    // vector with MCUSR.EXTRF set (328P §10.2). Between runs only.
+    void reset_external();
     // Called after each reset (watchdog, jump to the reset vector), once the
     // I/O registers hold their reset values.
     void on_reset(std::function<void()> fn) { reset_listeners_.push_back(std::move(fn)); }
@@ -146,6 +150,7 @@ public:
 private:
     friend struct WatchdogResetHook;
     bool check_after_step(int state, std::uint32_t pc_before);
+    void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);
     void on_simavr_error(const char* message) override;
     std::uint16_t ram_address_of(const std::string& symbol) const;

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/inotify.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -39,12 +40,19 @@ PtyBridge::PtyBridge(Uart& uart, const std::string& link_path) : uart_(uart), li
             ::tcsetattr(slave_keepalive_, TCSANOW, &raw);
         }
     }
+    // Watched after our own open, so only a host's opens count.
+    inotify_ = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+    if (inotify_ >= 0 && ::inotify_add_watch(inotify_, path_.c_str(), IN_OPEN) < 0) {
+        ::close(inotify_);
+        inotify_ = -1;
+    }
     if (!link_.empty()) {
         ::unlink(link_.c_str());
         if (::symlink(path_.c_str(), link_.c_str()) != 0) {
             const std::string why = std::strerror(errno);
             ::close(master_);
             if (slave_keepalive_ >= 0) ::close(slave_keepalive_);
+            if (inotify_ >= 0) ::close(inotify_);
             throw BadInput(link_ + ": cannot link it to " + path_ + ": " + why);
         }
     }
@@ -63,6 +71,23 @@ PtyBridge::~PtyBridge() {
     if (!link_.empty()) ::unlink(link_.c_str());
     if (slave_keepalive_ >= 0) ::close(slave_keepalive_);
     if (master_ >= 0) ::close(master_);
+    if (inotify_ >= 0) ::close(inotify_);
+}
+
+bool PtyBridge::host_opened() {
+    if (inotify_ < 0) return false;
+    bool opened = false;
+    alignas(inotify_event) char buf[4096];
+    for (;;) {
+        const ssize_t n = ::read(inotify_, buf, sizeof buf);
+        if (n <= 0) break;
+        for (ssize_t at = 0; at < n;) {
+            const auto* e = reinterpret_cast<const inotify_event*>(buf + at);
+            if (e->mask & IN_OPEN) opened = true;
+            at += static_cast<ssize_t>(sizeof(inotify_event) + e->len);
+        }
+    }
+    return opened;
 }
 
 void PtyBridge::flush() {

@@ -30,6 +30,12 @@ public:
     std::uint64_t bytes_to_firmware() const { return to_firmware_; }
     std::uint64_t bytes_to_host() const { return to_host_; }
     std::uint64_t bytes_dropped() const { return dropped_; }
+    // True once for every time host software opened the pty since the last
+    // call (inotify's IN_OPEN on the slave device). A pty carries no DTR or
+    // RTS a host could toggle (Linux pty drivers reject the modem-control
+    // ioctls), so "the host opened the port" stands in for the DTR edge an
+    // Arduino's auto-reset capacitor turns into a RESET pulse.
+    bool host_opened();
 
 private:
     void flush();
@@ -37,6 +43,7 @@ private:
     Uart& uart_;
     int master_ = -1;
     int slave_keepalive_ = -1;  // our own slave fd: reads do not fail while no host has it open
+    int inotify_ = -1;          // IN_OPEN on the slave device, for host_opened()
     std::string path_, link_;
     std::string pending_;       // firmware output the pty could not take yet
     std::uint64_t to_firmware_ = 0, to_host_ = 0, dropped_ = 0;

@@ -71,6 +71,7 @@ struct RunArgs {
     std::string pty;            // a serial port bridged to a pseudo-terminal
     std::string pty_link;       // and a stable symlink to it
     std::string pace = "free";  // free | realtime
+    bool reset_on_open = false; // --pty: a host opening the port resets its MCU
     std::string gcode;
     std::string host;
     std::string flow;
@@ -288,6 +289,8 @@ struct BoardRun {
     UartHost* host = nullptr;  // --gcode's
     std::unique_ptr<RecordHost> plot;  // --dxf's
     std::unique_ptr<PtyBridge> pty;    // --pty's
+    Mcu* pty_mcu = nullptr;            // the MCU behind it
+    unsigned resets_on_open = 0;
     std::vector<PortFile> uart_out;
     Picoseconds duration_ps = 0, settle_ps = 0;
 };
@@ -379,12 +382,14 @@ BoardRun prepare_board_run(const RunArgs& args) {
     }
     for (const auto& [port, bytes] : uart_in_bytes) bench.serial(port).send(bytes);
     if (args.pace != "free" && args.pace != "realtime") throw BadInput("--pace: '" + args.pace + "' is not free or realtime");
+    if (args.reset_on_open && args.pty.empty()) throw BadInput("--reset-on-open: needs --pty PORT (the port whose opening resets its MCU)");
     if (!args.pty.empty()) {
         const SerialDecl& decl = bench.serial_decl(args.pty);
         if (!args.gcode.empty() || !args.dxf.empty()) {
             if (bench.serial_decl(args.host).name == decl.name) throw BadInput("--pty: port " + decl.name + " already carries the job");
         }
         run.pty = std::make_unique<PtyBridge>(bench.serial(decl.name), args.pty_link);
+        run.pty_mcu = &bench.mcu(decl.mcu);
         // At once, so a host can connect while the run goes on.
         std::printf("avrbench run: serial %s on %s%s%s\n", decl.name.c_str(), run.pty->path().c_str(),
                     args.pty_link.empty() ? "" : " = ", args.pty_link.c_str());
@@ -414,10 +419,12 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
     for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);
     if (run.pty) {
-        std::printf("  pty        %s: %llu bytes to the firmware, %llu from it%s\n", run.pty->path().c_str(),
+        std::printf("  pty        %s: %llu bytes to the firmware, %llu from it%s", run.pty->path().c_str(),
                     static_cast<unsigned long long>(run.pty->bytes_to_firmware()),
                     static_cast<unsigned long long>(run.pty->bytes_to_host()),
                     run.pty->bytes_dropped() != 0 ? " (the host did not read them all)" : "");
+        if (args.reset_on_open) std::printf(", %u resets on open", run.resets_on_open);
+        std::printf("\n");
     }
     if (run.plot) {
         std::printf("  plot       %s: %zu of %zu records acknowledged (%s)%s\n", args.dxf.c_str(), run.plot->acknowledged(),
@@ -502,6 +509,11 @@ int run_board_command(const RunArgs& args) {
     how.settle_ps = run.settle_ps;
     how.after_slice = [&] {
         if (run.pty) {
+            if (run.pty->host_opened() && args.reset_on_open) {
+                // What an Arduino's DTR capacitor does when the host opens the port.
+                run.pty_mcu->reset_external();
+                ++run.resets_on_open;
+            }
             run.pty->pump();
             if (args.pace == "realtime") {
                 // Simulated time no further than wall time (the host's timeouts are in seconds).
@@ -783,6 +795,8 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--pty", run.pty,
                         "PORT: bridge this serial port of the board to a pseudo-terminal for host software (prints its path)");
     run_cmd->add_option("--pty-link", run.pty_link, "--pty: also make a symlink to the pty here, e.g. traces/ttyUNO");
+    run_cmd->add_flag("--reset-on-open", run.reset_on_open,
+                      "--pty: reset the port's MCU whenever host software opens the pty, as an Arduino's auto-reset does");
     run_cmd->add_option("--pace", run.pace,
                         "free (default: as fast as it runs) | realtime (simulated time never ahead of wall time)");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");

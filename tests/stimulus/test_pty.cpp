@@ -3,6 +3,7 @@
 // comes out of it. The host here is this test, on the pty's slave side, as
 // a terminal or avrdude would be.
 #include <gtest/gtest.h>
+#include <sim_avr.h>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -61,6 +62,39 @@ TEST(Pty, TheCliPrintsThePathAtOnceAndCountsTheBytes) {
     const auto bad = test::run_command(cli + " --pty host --pace slow --for 10ms", dir);
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(bad.err, "avrbench: error: --pace: 'slow' is not free or realtime\n");
+    const auto lone = test::run_command(cli + " --reset-on-open --for 10ms", dir);
+    EXPECT_EQ(lone.exit_code, 2);
+    EXPECT_EQ(lone.err, "avrbench: error: --reset-on-open: needs --pty PORT (the port whose opening resets its MCU)\n");
+    const auto counted = test::run_command(cli + " --pty host --reset-on-open --for 10ms", dir);
+    EXPECT_NE(counted.out.find("20 from it, 0 resets on open"), std::string::npos) << counted.out;
+}
+
+// An Arduino resets when the host opens its port (DTR through a capacitor to
+// RESET); avrdude's -c arduino relies on it to reach the bootloader. A pty
+// has no DTR, so the bridge reports each open (inotify IN_OPEN) and the run
+// pulses RESET: the firmware starts over, MCUSR.EXTRF set (328P §10.2, §10.9.1).
+TEST(Pty, OpeningThePortCanResetTheMcuAsAnArduinoDoes) {
+    Bench bench(test::source_path("bench/boards/arduino-uno.yaml"), test::firmware("uart_echo"));
+    Mcu& uno = bench.mcu();
+    PtyBridge pty(bench.serial("host"));
+    bench.board().run_for_seconds(0.005);
+    EXPECT_FALSE(pty.host_opened());  // the bridge's own open does not count
+    const int host = ::open(pty.path().c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    ASSERT_GE(host, 0);
+    EXPECT_TRUE(pty.host_opened());
+    EXPECT_FALSE(pty.host_opened());  // once per open
+    uno.reset_external();
+    EXPECT_EQ(uno.pc_bytes(), 0u);
+    // MCUSR (0x54 in data space on the 328P): EXTRF is bit 1.
+    EXPECT_EQ(uno.avr()->data[0x54] & 0x02, 0x02);
+    bench.board().run_for_seconds(0.005);
+    EXPECT_EQ(bench.serial("host").transmitted_text(), "avrbench uart_echo\r\navrbench uart_echo\r\n");
+    EXPECT_EQ(uno.resets(), 1u);
+    EXPECT_TRUE(uno.findings().empty());  // a reset pulse is not a fault of the firmware
+    ::close(host);
+    const int again = ::open(pty.path().c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    EXPECT_TRUE(pty.host_opened());
+    ::close(again);
 }
 
 }  // namespace
