@@ -20,19 +20,7 @@ namespace {
 constexpr double kCyclesPerUs = 16.0;  // 16 MHz
 constexpr int kBluPerMm = 100;         // the board's T8x2 lead screws, full steps
 
-std::int32_t ram_i32(Mcu& mcu, const std::string& symbol) {
-    const auto b = mcu.read_ram(symbol, 4);
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(b[0]) | (static_cast<std::uint32_t>(b[1]) << 8) |
-                                     (static_cast<std::uint32_t>(b[2]) << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
-}
 
-std::int32_t interp_i32(Mcu& mcu, const std::string& symbol, int index) {
-    const auto b = mcu.read_ram(symbol, static_cast<std::size_t>(4 * (index + 1)));
-    const std::size_t o = static_cast<std::size_t>(4 * index);
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(b[o]) | (static_cast<std::uint32_t>(b[o + 1]) << 8) |
-                                     (static_cast<std::uint32_t>(b[o + 2]) << 16) |
-                                     (static_cast<std::uint32_t>(b[o + 3]) << 24));
-}
 
 // 1-based tick number of each edge: how many TICK rises came at or before it.
 std::vector<int> tick_numbers(const std::vector<Cycle>& ticks, const std::vector<Cycle>& edges) {
@@ -43,14 +31,6 @@ std::vector<int> tick_numbers(const std::vector<Cycle>& ticks, const std::vector
     return out;
 }
 
-// Power-on: the drive boards' pull-ups lift the STEP/DIR nets until the
-// interpolator makes its pins outputs (low). Logs start after that.
-std::unique_ptr<Bench> powered_printer(const std::string& interp = "printer3d_interp") {
-    auto bench = test::printer_bench(interp);
-    bench->host();  // listening from power-on, for the "start" banner
-    bench->run_for(0.001);
-    return bench;
-}
 
 void run_job(Bench& bench, const std::string& job, double max_s) {
     bench.host().add_lines(job);
@@ -59,7 +39,7 @@ void run_job(Bench& bench, const std::string& job, double max_s) {
 }
 
 TEST(Printer3dInterpolator, LinearDdaPulsesTheThesisExample) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     Mcu& interp = bench->mcu("interp");
     test::PinLog tick(interp, "PA7"), x(interp, "PA0"), y(interp, "PA1"), x_dir(interp, "PC0"), y_dir(interp, "PC1");
     // §10.9: A = 3, B = 4 BLU -> L = 5 ticks; X on ticks 2, 4, 5 and Y on 2, 3, 4, 5
@@ -73,8 +53,8 @@ TEST(Printer3dInterpolator, LinearDdaPulsesTheThesisExample) {
     EXPECT_LT(x_dir.rises().front(), x.rises().front());
     EXPECT_LT(y_dir.rises().front(), y.rises().front());
     // The drive boards counted what the interpolator sent.
-    EXPECT_EQ(ram_i32(bench->mcu("drive_x"), "position"), 3);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_y"), "position"), 4);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 3);
+    EXPECT_EQ(test::drive_position(*bench, "drive_y"), 4);
     for (const Finding& f : bench->findings()) ADD_FAILURE() << f.detail;
 }
 
@@ -88,7 +68,7 @@ double expected_interval_us(int n, int l, int ramp_n, double dtc_us) {
 }
 
 TEST(Printer3dInterpolator, DynamicDtProfileSpacesTheTicks) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     Mcu& interp = bench->mcu("interp");
     test::PinLog tick(interp, "PA7"), x(interp, "PA0");
     run_job(*bench, "G1 X2 F600\nM400\n", 10.0);  // L = 200 ticks, dT_c = 1000 us
@@ -119,7 +99,7 @@ TEST(Printer3dInterpolator, AppendixAReferenceWithTenRampTicks) {
     for (int k = 1; k <= 10; ++k) h10 += 1.0 / k;
     const double total_dtc = 2 * 10 * h10 + 10;
     ASSERT_NEAR(total_dtc, 68.579, 0.001);
-    auto bench = powered_printer("printer3d_interp_ramp10");
+    auto bench = test::powered_printer("printer3d_interp_ramp10");
     Mcu& interp = bench->mcu("interp");
     test::PinLog tick(interp, "PA7");
     run_job(*bench, "G1 X0.3 F600\nM400\n", 5.0);  // 30 BLU, dT_c = 1 ms
@@ -176,25 +156,25 @@ double max_radial_error(const Path& p, double cx, double cy, double r) {
 }
 
 TEST(Printer3dInterpolator, ArcsEndOnTheirTargetsUpToAFullCircle) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     Mcu& interp = bench->mcu("interp");
     test::PinLog tick(interp, "PA7"), x(interp, "PA0"), y(interp, "PA1"), x_dir(interp, "PC0"), y_dir(interp, "PC1");
     // §10.10: a G02 quarter arc of R = 1000 BLU (10 mm) about (10, 0) mm from
     // the origin: round(2 R asin(AB / 2R)) = round(1000 pi / 2) = 1571 ticks,
     // ending within 1 BLU of (10, 10) mm, within ~1.5 BLU of the radius.
     run_job(*bench, "G2 X10 Y10 I10 J0 F300\nM400\n", 10.0);
-    EXPECT_LE(std::abs(interp_i32(interp, "arc_end_error_x", 0)), 1);
-    EXPECT_LE(std::abs(interp_i32(interp, "arc_end_error_y", 0)), 1);
+    EXPECT_LE(std::abs(test::ram_i32(interp, "arc_end_error_x", 0)), 1);
+    EXPECT_LE(std::abs(test::ram_i32(interp, "arc_end_error_y", 0)), 1);
     const std::size_t arc_ticks = tick.rises().size() - static_cast<std::size_t>(std::max(
-        std::abs(interp_i32(interp, "arc_end_error_x", 0)), std::abs(interp_i32(interp, "arc_end_error_y", 0))));
+        std::abs(test::ram_i32(interp, "arc_end_error_x", 0)), std::abs(test::ram_i32(interp, "arc_end_error_y", 0))));
     EXPECT_EQ(arc_ticks, 1571u);
     const Path quarter = trace_path(x, x_dir, y, y_dir, 0, 0);
     EXPECT_LE(max_radial_error(quarter, 1000, 0, 1000), 1.5);
     EXPECT_EQ(quarter.points.back(), std::make_pair(1000, 1000));  // the fix-up lands it exactly
     // G02 is clockwise: from the left of the centre Y goes up first.
     EXPECT_TRUE(y_dir.rises().size() > 0 && y_dir.rises().front() < y.rises().front());
-    EXPECT_EQ(ram_i32(bench->mcu("drive_x"), "position"), 1000);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_y"), "position"), 1000);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 1000);
+    EXPECT_EQ(test::drive_position(*bench, "drive_y"), 1000);
 
     // A full circle (end = start; the thesis' arcsin length gives 0 ticks)
     // about (10, 5) mm: R = 500 BLU, round(2 pi 500) = 3142 ticks, back at
@@ -202,15 +182,15 @@ TEST(Printer3dInterpolator, ArcsEndOnTheirTargetsUpToAFullCircle) {
     const std::size_t ticks_before = tick.rises().size();
     const std::size_t xs = x.rises().size(), ys = y.rises().size();
     run_job(*bench, "G2 X10 Y10 I0 J-5\nM400\n", 10.0);
-    const int err = std::max(std::abs(interp_i32(interp, "arc_end_error_x", 0)),
-                             std::abs(interp_i32(interp, "arc_end_error_y", 0)));
+    const int err = std::max(std::abs(test::ram_i32(interp, "arc_end_error_x", 0)),
+                             std::abs(test::ram_i32(interp, "arc_end_error_y", 0)));
     EXPECT_LE(err, 1);
     EXPECT_EQ(tick.rises().size() - ticks_before - static_cast<std::size_t>(err), 3142u);
     // Every BLU of the circle: 4 R steps on each axis.
     EXPECT_NEAR(static_cast<double>(x.rises().size() - xs), 2000.0, 2.0);
     EXPECT_NEAR(static_cast<double>(y.rises().size() - ys), 2000.0, 2.0);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_x"), "position"), 1000);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_y"), "position"), 1000);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 1000);
+    EXPECT_EQ(test::drive_position(*bench, "drive_y"), 1000);
     // G03 back to the origin about the same centre: counter-clockwise from
     // the top, X goes left (DIR low) first.
     const std::size_t x_before = x.rises().size();
@@ -222,8 +202,8 @@ TEST(Printer3dInterpolator, ArcsEndOnTheirTargetsUpToAFullCircle) {
         first_x_dir_high = e.level;
     }
     EXPECT_FALSE(first_x_dir_high);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_x"), "position"), 0);
-    EXPECT_EQ(ram_i32(bench->mcu("drive_y"), "position"), 0);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 0);
+    EXPECT_EQ(test::drive_position(*bench, "drive_y"), 0);
 
     for (const Finding& f : bench->findings()) ADD_FAILURE() << f.detail;
 }

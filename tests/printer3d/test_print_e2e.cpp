@@ -13,11 +13,6 @@
 namespace avrbench {
 namespace {
 
-std::int32_t position(Bench& bench, const std::string& drive) {
-    const auto b = bench.mcu(drive).read_ram("position", 4);
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(b[0]) | (static_cast<std::uint32_t>(b[1]) << 8) |
-                                     (static_cast<std::uint32_t>(b[2]) << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
-}
 
 TEST(Printer3dEndToEnd, TheDemoPartEndsWhereItsGcodeSays) {
     auto bench = test::printer_bench();
@@ -28,14 +23,14 @@ TEST(Printer3dEndToEnd, TheDemoPartEndsWhereItsGcodeSays) {
     // round(200 * pi / 2) = 314 + 400 + 600 = 2314; two layers 4628; E steps
     // floor(4628 / 8) = 578, primes and retracts cancelling.
     const int per_layer = 600 + 400 + static_cast<int>(std::lround(200 * M_PI / 2)) + 400 + 600;
-    EXPECT_EQ(position(*bench, "drive_e"), 2 * per_layer / 8);
+    EXPECT_EQ(test::drive_position(*bench, "drive_e"), 2 * per_layer / 8);
     // Parked at X0 Y0 Z2 from the homed corner; homing started 3.5 / 2.5 /
     // 1.5 mm from the stops with the switches at 0.5 mm, and stops on the
     // step that trips the switch (the carriage follows the rotor's lag: a
     // step or two late).
-    EXPECT_NEAR(position(*bench, "drive_x"), -300, 2);
-    EXPECT_NEAR(position(*bench, "drive_y"), -200, 2);
-    EXPECT_NEAR(position(*bench, "drive_z"), -100 + 200, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_x"), -300, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_y"), -200, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_z"), -100 + 200, 2);
     EXPECT_NEAR(bench->axis("x").position_mm(), 0.5, 0.02);
     EXPECT_NEAR(bench->axis("y").position_mm(), 0.5, 0.02);
     EXPECT_NEAR(bench->axis("z").position_mm(), 2.5, 0.02);

@@ -17,18 +17,7 @@
 namespace avrbench {
 namespace {
 
-std::int32_t position(Bench& bench, const std::string& drive) {
-    const auto b = bench.mcu(drive).read_ram("position", 4);
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(b[0]) | (static_cast<std::uint32_t>(b[1]) << 8) |
-                                     (static_cast<std::uint32_t>(b[2]) << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
-}
 
-std::unique_ptr<Bench> powered_printer(const std::string& interp = "printer3d_interp") {
-    auto bench = test::printer_bench(interp);
-    bench->host();
-    bench->run_for(0.001);
-    return bench;
-}
 
 // Edges of `log` inside [from, to].
 std::size_t count_between(const std::vector<Cycle>& edges, Cycle from, Cycle to) {
@@ -36,7 +25,7 @@ std::size_t count_between(const std::vector<Cycle>& edges, Cycle from, Cycle to)
 }
 
 TEST(Printer3dJob, ExtruderFollowsDepositingMovesAndZMovesAlone) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     Mcu& interp = bench->mcu("interp");
     test::PinLog x(interp, "PA0"), y(interp, "PA1"), z(interp, "PA2"), e(interp, "PA3"), e_dir(interp, "PC3");
     bench->host().add_lines("M3\nG1 X1 F500\nM400\nG0 X2\nM400\nG1 Z0.2\nM400\nG1 X1\nM5\nM400\n");
@@ -44,10 +33,10 @@ TEST(Printer3dJob, ExtruderFollowsDepositingMovesAndZMovesAlone) {
     // Ticks: G1 X1 = 100, G0 X2 = 100 (no extrusion), Z0.2 = 20, G1 X1 = 100.
     // E: prime +40, 100 ticks / 8 = 12 (4/8 left over), retract -40 before the
     // G0, prime +40 before the last G1, (4 + 100) / 8 = 13, retract -40 at M5.
-    EXPECT_EQ(position(*bench, "drive_e"), 40 + 12 - 40 + 40 + 13 - 40);
+    EXPECT_EQ(test::drive_position(*bench, "drive_e"), 40 + 12 - 40 + 40 + 13 - 40);
     EXPECT_EQ(e.rises().size(), 40u + 12u + 40u + 40u + 13u + 40u);
-    EXPECT_EQ(position(*bench, "drive_x"), 100);
-    EXPECT_EQ(position(*bench, "drive_z"), 20);  // §10.14: SZ = 0.2 mm * 100 steps/mm
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 100);
+    EXPECT_EQ(test::drive_position(*bench, "drive_z"), 20);  // §10.14: SZ = 0.2 mm * 100 steps/mm
     // §10.13/§10.14: no E step while G0 or Z move (the first X step of the G0 to its last; the Z steps).
     ASSERT_EQ(x.rises().size(), 300u);
     const Cycle g0_from = x.rises()[100], g0_to = x.rises()[199];
@@ -65,7 +54,7 @@ TEST(Printer3dJob, ExtruderFollowsDepositingMovesAndZMovesAlone) {
 }
 
 TEST(Printer3dJob, HomingStopsEachAxisOnItsSwitch) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     bench->host().add_lines("G28\nM114\n");
     ASSERT_EQ(bench->run_until_idle(20.0), IdleResult::Idle) << bench->host().received_text();
     // The carriages started 3.5 / 2.5 / 1.5 mm from the stop; the switches
@@ -73,9 +62,9 @@ TEST(Printer3dJob, HomingStopsEachAxisOnItsSwitch) {
     for (const char* axis : {"x", "y", "z"}) {
         EXPECT_NEAR(bench->axis(axis).position_mm(), 0.5, 0.02) << axis;
     }
-    EXPECT_NEAR(position(*bench, "drive_x"), -300, 2);
-    EXPECT_NEAR(position(*bench, "drive_y"), -200, 2);
-    EXPECT_NEAR(position(*bench, "drive_z"), -100, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_x"), -300, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_y"), -200, 2);
+    EXPECT_NEAR(test::drive_position(*bench, "drive_z"), -100, 2);
     EXPECT_NE(bench->host().received_text().find("X:0.000 Y:0.000 Z:0.000"), std::string::npos);
     for (const Finding& f : bench->findings()) ADD_FAILURE() << f.source << ": " << f.detail;
 }
@@ -132,18 +121,18 @@ TEST(Printer3dJob, ProtocolChecksumsLineNumbersAndErrors) {
     EXPECT_EQ(send_line(*bench, "G21"), "ok\n");
     EXPECT_EQ(send_line(*bench, "M400"), "ok\n");
     EXPECT_EQ(send_line(*bench, "M114"), "X:4.540 Y:0.000 Z:0.000 E:0\nok\n");
-    EXPECT_EQ(position(*bench, "drive_x"), 454);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 454);
     // G92 sets the position without moving.
     EXPECT_EQ(send_line(*bench, "G92 X10"), "ok\n");
     EXPECT_EQ(send_line(*bench, "M114"), "X:10.000 Y:0.000 Z:0.000 E:0\nok\n");
-    EXPECT_EQ(position(*bench, "drive_x"), 454);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 454);
     // An arc needs its centre; the end point must lie on the circle.
     EXPECT_EQ(send_line(*bench, "G2 X1"), "Error:arc needs I/J or R\nok\n");
     EXPECT_EQ(send_line(*bench, "G2 X1 Y1 I5 J0"), "Error:arc end point not on the circle\nok\n");
 }
 
 TEST(Printer3dJob, M109WaitsForTheHeaterMcuAndM105ReportsIt) {
-    auto bench = powered_printer();
+    auto bench = test::powered_printer();
     bench->host().add_lines("M109 S60\nM105\n");
     ASSERT_EQ(bench->run_until_idle(60.0), IdleResult::Idle) << bench->host().received_text();
     Mcu& heater = bench->mcu("heater");
@@ -164,28 +153,28 @@ TEST(Printer3dJob, M109WaitsForTheHeaterMcuAndM105ReportsIt) {
 // zero (dt_const = 1000000 / 0: on the AVR's division routine all ones, a
 // 65.5 ms tick) and a 10 mm move takes minutes; the host hears nothing.
 TEST(Printer3dThesisParser, ALineWithoutFNeverFinishes) {
-    auto bench = powered_printer("printer3d_interp_thesis_parser");
+    auto bench = test::powered_printer("printer3d_interp_thesis_parser");
     bench->run_for(0.2);
     const std::string reply = send_line(*bench, "G01 X0.5 Y0");  // 500 BLU at the listing's 1000 BLU/mm
     EXPECT_NE(reply.find("<no ok within 3 s>"), std::string::npos) << reply;
     // With F (mm/s in the listing) the same move is done at once.
-    auto fine = powered_printer("printer3d_interp_thesis_parser");
+    auto fine = test::powered_printer("printer3d_interp_thesis_parser");
     fine->run_for(0.2);
     EXPECT_EQ(send_line(*fine, "G01 X0.5 Y0 F10"), "ok\n");
-    EXPECT_EQ(position(*fine, "drive_x"), 500);
+    EXPECT_EQ(test::drive_position(*fine, "drive_x"), 500);
 }
 
 // strcpy into char s[50]: a longer line runs over the parser's stack frame
 // and its return address; the bench reports the crash with PC and cycle.
 TEST(Printer3dThesisParser, ALineLongerThan50BytesCrashesTheInterpolator) {
-    auto bench = powered_printer("printer3d_interp_thesis_parser");
+    auto bench = test::powered_printer("printer3d_interp_thesis_parser");
     bench->run_for(0.2);
     send_line(*bench, "G01 X0.001 Y0.001 F10 " + std::string(60, 'Z'));
     bool crashed = false;
     for (const Finding& f : bench->mcu("interp").findings()) crashed = crashed || f.has_pc;
     EXPECT_TRUE(crashed) << "no crash finding";
     // The fixed parser answers the same line with an error.
-    auto fixed = powered_printer();
+    auto fixed = test::powered_printer();
     fixed->run_for(0.3);
     EXPECT_EQ(send_line(*fixed, "G01 X0.001 Y0.001 F10 " + std::string(80, 'Z')), "Error:line too long\nok\n");
 }
