@@ -31,7 +31,6 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
-#include <util/delay.h>
 
 #include "avrbench_mcu.h"
 #include "config.h"
@@ -370,7 +369,7 @@ static void temperature(const words_t *w, uint8_t wait)
             if (st.temp_ok) break;
             print_temperature(&st); /* a keep-alive each second */
             fw_uart_putc('\n');
-            for (uint8_t k = 0; k < 4; ++k) _delay_ms(250);
+            motion_sleep_ms(1000);
         }
     }
     reply("ok");
@@ -395,7 +394,7 @@ static void dwell(const words_t *w)
     int32_t ms = 0;
     if (w->present & WORD_BIT('P')) ms = w->milli['P' - 'A'] / 1000;
     if (w->present & WORD_BIT('S')) ms = w->milli['S' - 'A'];
-    while (ms-- > 0) _delay_ms(1);
+    if (ms > 0) motion_sleep_ms((uint32_t)ms);
     reply("ok");
 }
 

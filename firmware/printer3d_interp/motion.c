@@ -276,6 +276,33 @@ void motion_wait_idle(void)
     nap_while(motion_busy);
 }
 
+EMPTY_INTERRUPT(TIMER3_COMPA_vect); /* a wake-up for motion_sleep_ms */
+
+void motion_sleep_ms(uint32_t ms)
+{
+    /* Timer3 runs free at 15625 counts per second: at most 4 s per wait. */
+    while (ms > 0) {
+        const uint16_t chunk = ms > 4000 ? 4000 : (uint16_t)ms;
+        ms -= chunk;
+        const uint16_t counts = (uint16_t)(((uint32_t)chunk * 15625UL + 500) / 1000);
+        const uint16_t start = TCNT3;
+        OCR3A = (uint16_t)(start + counts);
+        TIFR3 = _BV(OCF3A);
+        TIMSK3 |= _BV(OCIE3A);
+        set_sleep_mode(SLEEP_MODE_IDLE);
+        for (;;) {
+            cli();
+            if ((uint16_t)(TCNT3 - start) >= counts) break;
+            sleep_enable();
+            sei();
+            sleep_cpu();
+            sleep_disable();
+        }
+        TIMSK3 &= (uint8_t)~_BV(OCIE3A);
+        sei();
+    }
+}
+
 void motion_set_position(uint8_t axis, int32_t blu)
 {
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { step_position[axis] = blu; }

@@ -48,6 +48,9 @@ void motion_wait_idle(void);
  * (Timer3 at clk/1024 runs free as the time base), so the host hears a
  * keep-alive; NULL for none. */
 extern void (*motion_keepalive)(void);
+/* Sleeps (idle mode) for `ms` milliseconds, to Timer3's 64 us resolution;
+ * interrupts (the UART, move ticks) are served meanwhile. */
+void motion_sleep_ms(uint32_t ms);
 uint8_t motion_busy(void);
 /* Sets step_position[axis] while idle (G92, homing). */
 void motion_set_position(uint8_t axis, int32_t blu);
