@@ -112,7 +112,8 @@ uint8_t parse_words(const char *p, words_t *w)
             if (v < 0 || v % 1000) return PARSE_BAD_NUMBER;
             w->m = v / 1000;
         } else if (letter == 'N') {
-            if (v < 0 || v % 1000) return PARSE_BAD_NUMBER;
+            /* Whole numbers; -1 too: hosts reset the count with "N-1 M110". */
+            if (v % 1000) return PARSE_BAD_NUMBER;
             w->n = v / 1000;
         }
     }

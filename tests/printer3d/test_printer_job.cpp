@@ -107,6 +107,10 @@ TEST(Printer3dJob, ProtocolChecksumsLineNumbersAndErrors) {
     EXPECT_EQ(send_line(*bench, with_checksum("N2 G90")), "ok\n");
     EXPECT_EQ(send_line(*bench, with_checksum("N100 M110")), "ok\n");
     EXPECT_EQ(send_line(*bench, with_checksum("N101 G91")), "ok\n");
+    // printcore (pronsole, Pronterface) starts every print with "N-1 M110" and
+    // numbers the job from N0.
+    EXPECT_EQ(send_line(*bench, with_checksum("N-1 M110")), "ok\n");
+    EXPECT_EQ(send_line(*bench, with_checksum("N0 G91")), "ok\n");
     EXPECT_EQ(send_line(*bench, "G1 X"), "Error:bad number\nok\n");
     EXPECT_EQ(send_line(*bench, "G7"), "Error:unknown G code\nok\n");
     EXPECT_EQ(send_line(*bench, "M999"), "Error:unknown M code\nok\n");
