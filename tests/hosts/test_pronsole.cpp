@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <regex>
 #include <string>
 
 #include "support/Paths.hpp"
@@ -17,11 +16,13 @@
 namespace avrbench {
 namespace {
 
+// "axis x     501 full steps of the rotor, at 2.4950 mm" -> 2.495; -1 if absent.
 double axis_mm(const std::string& summary, const std::string& axis) {
-    const std::regex re("axis " + axis + " +[0-9]+ full steps of the rotor, at ([0-9.]+) mm");
-    std::smatch m;
-    if (!std::regex_search(summary, m, re)) return -1;
-    return std::stod(m[1].str());
+    const auto line = summary.find("  axis " + axis + " ");
+    if (line == std::string::npos) return -1;
+    const auto at = summary.find(", at ", line);
+    if (at == std::string::npos) return -1;
+    return std::stod(summary.substr(at + 5));
 }
 
 TEST(Pronsole, PrintsAJobOnTheEmulatedPrinterThroughThePty) {
