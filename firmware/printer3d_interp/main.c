@@ -127,6 +127,19 @@ static void prime(void)
     retracted = 0;
 }
 
+/* A depositing move primes a retracted extruder and carries SP steps per
+ * tick; any other move retracts an extruder that is on (§4.7). */
+static void extruder_for(move_t *m, uint8_t deposit)
+{
+    if (deposit) {
+        prime();
+        m->extrude = 1;
+        plan_position[AXIS_E] += (int32_t)(((int64_t)m->ticks * SP_NUM) / SP_DEN); /* planned */
+    } else if (extruder_on) {
+        retract();
+    }
+}
+
 void queue_line(uint8_t axis_a, int32_t a, uint8_t axis_b, int32_t b, uint32_t dtc, uint8_t deposit)
 {
     move_t m = {0};
@@ -141,13 +154,7 @@ void queue_line(uint8_t axis_a, int32_t a, uint8_t axis_b, int32_t b, uint32_t d
     m.ticks = l;
     m.dtc_half_us = dtc;
     m.ramp = 1;
-    if (deposit) {
-        prime();
-        m.extrude = 1;
-        plan_position[AXIS_E] += (int32_t)(((int64_t)l * SP_NUM) / SP_DEN); /* planned, approximately */
-    } else if (extruder_on) {
-        retract();
-    }
+    extruder_for(&m, deposit);
     motion_push(&m);
 }
 
@@ -179,13 +186,7 @@ const char *queue_arc(int32_t ci, int32_t cj, int32_t x, int32_t y, uint8_t cw, 
     m.end_y = y;
     m.dtc_half_us = dtc;
     m.ramp = 1;
-    if (deposit) {
-        prime();
-        m.extrude = 1;
-        plan_position[AXIS_E] += (int32_t)(((int64_t)m.ticks * SP_NUM) / SP_DEN);
-    } else if (extruder_on) {
-        retract();
-    }
+    extruder_for(&m, deposit);
     motion_push(&m);
     plan_position[AXIS_X] = x;
     plan_position[AXIS_Y] = y;
