@@ -22,6 +22,7 @@ extern "C" {
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
 #include "core/IdleLoopSkip.hpp"
+#include "core/IntelHex.hpp"
 #include "core/Twi.hpp"
 #include "core/UserStop.hpp"
 #include "core/fixes/Fix.hpp"
@@ -29,14 +30,16 @@ extern "C" {
 
 namespace avrbench {
 
-struct WatchdogResetHook {
+struct ResetHook {
     // avr_reset() zeroes the I/O space and then calls every module's reset;
     // the watchdog module sets MCUSR.WDRF in its own reset when the reset was
-    // its doing. Wrapping that hook is how we tell a watchdog reset apart.
+    // its doing. Wrapping that hook is how we see every reset and tell a
+    // watchdog reset apart.
     static void watchdog_reset(avr_io_t* io) {
         avr_t* avr = io->avr;
         auto* mcu = static_cast<Mcu*>(static_cast<SimavrLogSink*>(avr->custom.data));
         mcu->original_watchdog_reset_(io);
+        mcu->reset_seen_ = true;
         if (avr_regbit_get(avr, avr->reset_flags.wdrf)) mcu->watchdog_reset_seen_ = true;
     }
 };
@@ -118,6 +121,18 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     }
     avr_load_firmware(avr_, &firmware);
     avr_->frequency = frequency_hz_;
+    if (options_.fuses) std::copy(options_.fuses->begin(), options_.fuses->end(), avr_->fuse);
+    if (!options_.bootloader_hex.empty()) {
+        try {
+            load_bootloader();
+        } catch (...) {
+            route_simavr_log(avr_, nullptr);
+            avr_terminate(avr_);
+            std::free(avr_);
+            avr_ = nullptr;
+            throw;
+        }
+    }
 
     fixes_ = std::make_unique<SimavrFixes>(avr_);
     scheduler_ = std::make_unique<Scheduler>(avr_);
@@ -129,17 +144,70 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
             original_watchdog_reset_ = io->reset;
-            io->reset = &WatchdogResetHook::watchdog_reset;
+            io->reset = &ResetHook::watchdog_reset;
         }
     }
 
-    code_end_bytes_ = avr_->codeend;
-    if (auto bad = elf_.symbol_address("__bad_interrupt")) bad_interrupt_pc_ = *bad;
+    elf_code_end_bytes_ = avr_->codeend;
+    if (auto bad = elf_.symbol_address("__bad_interrupt")) elf_bad_interrupt_pc_ = *bad;
     if (elf_.ram_end_of_static_data() > 0) {
         // A push writes at SP and then decrements it, so SP = __bss_end - 1
         // is still clear of .bss; one lower and the last push overwrote it.
-        stack_floor_ = static_cast<std::uint16_t>(elf_.ram_end_of_static_data() - 1);
+        elf_stack_floor_ = static_cast<std::uint16_t>(elf_.ram_end_of_static_data() - 1);
     }
+    code_end_bytes_ = elf_code_end_bytes_;
+    bad_interrupt_pc_ = elf_bad_interrupt_pc_;
+    stack_floor_ = elf_stack_floor_;
+}
+
+void Mcu::load_bootloader() {
+    const std::string& hex = options_.bootloader_hex;
+    if (!options_.fuses) {
+        throw BadInput(hex + ": a boot loader needs the fuses that place it (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD} on an UNO)");
+    }
+    boot_ = boot_section(mcu_type_, avr_->fuse);
+    if (!boot_) throw BadInput(hex + ": the bench has no boot section table for " + mcu_type_ + " (core/BootSection.cpp)");
+    char where[160];
+    if (avr_->codeend > boot_->start_bytes) {
+        std::snprintf(where, sizeof where, ": the application (%u bytes of flash) reaches into the boot section at 0x%05X",
+                      static_cast<unsigned>(avr_->codeend), boot_->start_bytes);
+        throw BadInput(elf_.path() + where);
+    }
+    const std::uint32_t flash_bytes = avr_->flashend + 1;
+    for (const HexChunk& chunk : read_intel_hex(hex)) {
+        const std::uint32_t end = chunk.address + static_cast<std::uint32_t>(chunk.bytes.size());
+        if (chunk.address < boot_->start_bytes || end > flash_bytes) {
+            std::snprintf(where, sizeof where,
+                          ": bytes 0x%05X..0x%05X lie outside the boot section 0x%05X..0x%05X that BOOTSZ selects", chunk.address,
+                          end - 1, boot_->start_bytes, flash_bytes - 1);
+            throw BadInput(hex + where);
+        }
+        std::copy(chunk.bytes.begin(), chunk.bytes.end(), avr_->flash + chunk.address);
+    }
+    if (boot_->reset_into_boot) {
+        avr_->reset_pc = boot_->start_bytes;
+        avr_->pc = boot_->start_bytes;
+    }
+}
+
+void Mcu::application_started() {
+    ++application_starts_;
+    // The boot loader may have written a new application: the ELF's oracles
+    // hold while the flash still holds the ELF's bytes.
+    const elf_firmware_t firmware = elf_.simavr_firmware();
+    elf_matches_flash_ = firmware.flashbase + firmware.flashsize <= avr_->flashend + 1 &&
+                         std::memcmp(avr_->flash + firmware.flashbase, firmware.flash, firmware.flashsize) == 0;
+    code_end_bytes_ = elf_matches_flash_ ? elf_code_end_bytes_ : boot_->start_bytes;
+    bad_interrupt_pc_ = elf_matches_flash_ ? elf_bad_interrupt_pc_ : ~0u;
+    stack_floor_ = elf_matches_flash_ ? elf_stack_floor_ : 0;
+}
+
+std::string Mcu::describe_pc(std::uint32_t pc_bytes) const {
+    if (elf_matches_flash_ && !in_boot_section(pc_bytes)) return elf_.describe_flash_address(pc_bytes);
+    char text[32];
+    std::snprintf(text, sizeof text, in_boot_section(pc_bytes) ? "boot loader+0x%x" : "0x%04x",
+                  in_boot_section(pc_bytes) ? pc_bytes - boot_->start_bytes : pc_bytes);
+    return text;
 }
 
 Mcu::~Mcu() {
@@ -339,6 +407,8 @@ void Mcu::reset_external() {
         halt_reason_.clear();
     }
     avr_reset(avr_);
+    reset_seen_ = false;
+    watchdog_reset_seen_ = false;
     avr_regbit_set(avr_, avr_->reset_flags.extrf);
     after_reset();
 }
@@ -365,18 +435,29 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     }
     if (halted_) return false;  // a finding raised from inside the step (invalid opcode)
     const std::uint32_t pc = avr_->pc;
-    if (pc == 0) {
+    // A reset puts the PC at the reset vector (0, or the boot section's start
+    // with BOOTRST), which the oracles' range check always sends here.
+    if (reset_seen_ || pc == 0) {
+        const bool reset = reset_seen_;
+        reset_seen_ = false;
+        if (!reset && in_boot_section(pc_before)) {
+            application_started();  // the boot loader jumps to the application
+            return true;
+        }
         after_reset();
         if (watchdog_reset_seen_) {
             watchdog_reset_seen_ = false;
-            add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
+            // A boot loader leaving through a watchdog reset (optiboot does) is not a finding.
+            if (!in_boot_section(pc_before)) {
+                add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
+            }
         } else {
-            std::snprintf(detail, sizeof detail, "execution jumped to the reset vector from %s",
-                          elf_.describe_flash_address(pc_before).c_str());
+            std::snprintf(detail, sizeof detail, "execution jumped to the reset vector from %s", describe_pc(pc_before).c_str());
             add_finding(FindingKind::JumpToReset, pc_before, detail, false);
         }
         return true;
     }
+    if (in_boot_section(pc)) return true;  // the boot loader's code
     if (pc == bad_interrupt_pc_) {
         const unsigned vector_bytes = avr_->vector_size != 0 ? avr_->vector_size : 4;
         std::snprintf(detail, sizeof detail,
@@ -387,7 +468,7 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     }
     if (pc >= code_end_bytes_) {
         std::snprintf(detail, sizeof detail, "PC 0x%04x is past the end of the program (0x%04x), came from %s",
-                      pc, code_end_bytes_, elf_.describe_flash_address(pc_before).c_str());
+                      pc, code_end_bytes_, describe_pc(pc_before).c_str());
         add_finding(FindingKind::PcOutsideProgram, pc, detail, true);
         return false;
     }
@@ -408,7 +489,7 @@ void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string deta
     f.cycle = avr_->cycle;
     f.clock_hz = frequency_hz_;
     f.pc_bytes = pc_bytes;
-    f.symbol = elf_.describe_flash_address(pc_bytes);
+    f.symbol = describe_pc(pc_bytes);
     f.detail = std::move(detail);
     findings_.push_back(std::move(f));
     if (halt) {

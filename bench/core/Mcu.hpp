@@ -2,14 +2,17 @@
 // scheduler, and the crash oracles checked after every instruction.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <map>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/BootSection.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Finding.hpp"
 #include "core/Pin.hpp"
@@ -40,6 +43,13 @@ struct McuOptions {
     // (core/IdleLoopSkip.hpp); exact, so on unless a test compares without.
     // The reference run loop never skips.
     bool skip_idle_loops = true;
+    // Fuse bytes low, high, extended (e.g. an UNO's 0xFF, 0xDE, 0xFD);
+    // replace the ELF's .fuse section when given.
+    std::optional<std::array<std::uint8_t, 3>> fuses;
+    // A boot loader (Intel HEX, e.g. Debian's optiboot_atmega328.hex) put in
+    // the boot section the fuses' BOOTSZ bits select; with BOOTRST
+    // programmed the MCU starts there (core/BootSection.hpp). Needs `fuses`.
+    std::string bootloader_hex;
 };
 
 enum class StopReason {
@@ -147,8 +157,22 @@ public:
     // `count` bytes from the RAM symbol on (an array); throws BadInput past RAMEND.
     std::vector<std::uint8_t> read_ram(const std::string& symbol, std::size_t count) const;
 
+    // The boot section when a boot loader was loaded (McuOptions::bootloader_hex).
+    const std::optional<BootSection>& boot() const { return boot_; }
+    // False once a boot loader has rewritten the application section with
+    // something other than the ELF: the ELF's symbols and the oracles taken
+    // from it (end of .text, __bad_interrupt, end of .bss) no longer apply.
+    bool elf_matches_flash() const { return elf_matches_flash_; }
+    // How many times a boot loader handed over to the application (a jump
+    // from the boot section to address 0).
+    unsigned application_starts() const { return application_starts_; }
+
 private:
-    friend struct WatchdogResetHook;
+    friend struct ResetHook;
+    void load_bootloader();
+    void application_started();
+    bool in_boot_section(std::uint32_t pc_bytes) const { return boot_ && pc_bytes >= boot_->start_bytes; }
+    std::string describe_pc(std::uint32_t pc_bytes) const;
     bool check_after_step(int state, std::uint32_t pc_before);
     void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);
@@ -178,6 +202,12 @@ private:
     std::uint32_t code_end_bytes_ = 0;        // first flash byte past .text
     std::uint32_t bad_interrupt_pc_ = ~0u;    // __bad_interrupt, or never
     std::uint16_t stack_floor_ = 0;           // SP below this has overwritten .bss
+    std::uint32_t elf_code_end_bytes_ = 0;    // the three above as the ELF gives them
+    std::uint32_t elf_bad_interrupt_pc_ = ~0u;
+    std::uint16_t elf_stack_floor_ = 0;
+    std::optional<BootSection> boot_;
+    bool elf_matches_flash_ = true;
+    unsigned application_starts_ = 0;
 
     std::uint64_t steps_ = 0;
     unsigned resets_ = 0;
@@ -188,6 +218,7 @@ private:
     std::string last_error_log_;
     void (*original_watchdog_reset_)(::avr_io_t*) = nullptr;
     bool watchdog_reset_seen_ = false;
+    bool reset_seen_ = false;  // avr_reset ran (inside a step: the watchdog)
 };
 
 }  // namespace avrbench

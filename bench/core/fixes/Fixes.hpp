@@ -42,6 +42,8 @@ std::unique_ptr<Fix> install_uart_ursel(avr_t* avr);
 // EEPROM: EEPE stays set for the programming time (EEPM modes), CPU halts
 // after EEPE/EERE, EE_READY is a level interrupt.
 std::unique_ptr<Fix> install_eeprom_timing(avr_t* avr);
+// SPM only from the boot loader section (BOOTSZ fuses); elsewhere a no-op.
+std::unique_ptr<Fix> install_self_programming(avr_t* avr);
 
 // --- timers
 // TIFRn write-one-to-clear by OUT/STS and by SBI (one bit); enabling TIMSKn
