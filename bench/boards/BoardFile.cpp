@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -102,6 +103,18 @@ std::vector<std::string> standard_board_dirs() {
     return dirs;
 }
 
+std::vector<std::string> standard_bootloader_dirs() {
+    std::vector<std::string> dirs;
+    if (const char* env = std::getenv("AVRBENCH_BOOTLOADERS_DIR")) dirs.emplace_back(env);
+    std::error_code ec;
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "avrbench" / "bootloaders").string());
+#ifdef AVRBENCH_BUILD_BOOTLOADERS_DIR
+    dirs.emplace_back(AVRBENCH_BUILD_BOOTLOADERS_DIR);  // running from the build tree
+#endif
+    return dirs;
+}
+
 std::string find_board_file(const std::string& name_or_path) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(name_or_path, ec)) return name_or_path;
@@ -139,6 +152,55 @@ void overlay(std::vector<Decl>& into, Decl item) {
 }
 
 BoardSpec parse_board(const std::string& text, const std::string& path, int depth);
+
+// A path (absolute, or relative to the board file), or a bare file name
+// looked up next to the board file and then in the bench's boot loader
+// directories (the ones the build makes, e.g. optiboot_atmega328.hex).
+std::string find_bootloader(const std::string& name, const std::string& board_path, const std::string& location) {
+    const std::filesystem::path given(name);
+    if (given.is_absolute()) return name;
+    std::error_code ec;
+    const std::filesystem::path beside = std::filesystem::path(board_path).parent_path() / given;
+    if (name.find('/') != std::string::npos || std::filesystem::is_regular_file(beside, ec)) return beside.string();
+    std::string searched = beside.parent_path().string();
+    for (const auto& dir : standard_bootloader_dirs()) {
+        const std::filesystem::path candidate = std::filesystem::path(dir) / given;
+        if (std::filesystem::is_regular_file(candidate, ec)) return candidate.string();
+        searched += ", " + dir;
+    }
+    throw BadInput(location + ": bootloader '" + name + "' not found (looked in " + searched + ")");
+}
+
+// `fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}`: all three bytes, as
+// avrdude's -U lfuse/hfuse/efuse and Arduino's boards.txt give them.
+std::array<std::uint8_t, 3> parse_fuses(const YAML::Node& node, const std::string& path, const std::string& what) {
+    if (!node.IsMap()) throw BadInput(where(path, node) + ": " + what + " must be a map {low: 0xFF, high: 0xDE, extended: 0xFD}");
+    std::array<std::uint8_t, 3> fuses{};
+    std::array<bool, 3> given{};
+    static const std::array<std::string, 3> kNames = {"low", "high", "extended"};
+    for (const auto& kv : node) {
+        const std::string key = kv.first.Scalar();
+        const std::string loc = where(path, kv.first);
+        std::size_t index = 0;
+        while (index < kNames.size() && kNames[index] != key) ++index;
+        if (index == kNames.size()) throw BadInput(loc + ": " + what + ": unknown fuse '" + key + "' (expected low, high, extended)");
+        const std::string text = scalar(kv.second, path, key);
+        unsigned value = 0;
+        const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+        const char* first = text.data() + (hex ? 2 : 0);
+        const char* last = text.data() + text.size();
+        const auto [end, ec] = std::from_chars(first, last, value, hex ? 16 : 10);
+        if (ec != std::errc() || end != last || first == last || value > 0xFF) {
+            throw BadInput(loc + ": " + what + ": " + key + " '" + text + "' is not a byte (0x00..0xFF)");
+        }
+        fuses[index] = static_cast<std::uint8_t>(value);
+        given[index] = true;
+    }
+    for (std::size_t i = 0; i < kNames.size(); ++i) {
+        if (!given[i]) throw BadInput(where(path, node) + ": " + what + ": missing '" + kNames[i] + "' (give low, high and extended)");
+    }
+    return fuses;
+}
 
 // `extends: ramps-1.4`: the base board, a standard board's name or a file
 // relative to this one.
@@ -216,8 +278,14 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
             if (key == "type") m.type = scalar(field.second, path, "type");
             else if (key == "clock") m.clock_hz = parse_frequency_hz(scalar(field.second, path, "clock"), loc + ": MCU '" + m.name + "': clock");
             else if (key == "firmware") m.firmware = scalar(field.second, path, "firmware");
-            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware)");
+            else if (key == "bootloader") m.bootloader = scalar(field.second, path, "bootloader");
+            else if (key == "fuses") m.fuses = parse_fuses(field.second, path, "MCU '" + m.name + "': fuses");
+            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware, bootloader, fuses)");
         }
+        if (!m.bootloader.empty() && !m.fuses) {
+            throw BadInput(m.location + ": MCU '" + m.name + "': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})");
+        }
+        if (!m.bootloader.empty()) m.bootloader = find_bootloader(m.bootloader, path, m.location);
         if (m.type.empty()) throw BadInput(m.location + ": MCU '" + m.name + "': missing 'type' (e.g. atmega328p)");
         if (m.clock_hz == 0) throw BadInput(m.location + ": MCU '" + m.name + "': missing 'clock' (e.g. 16MHz)");
         if (!m.firmware.empty() && std::filesystem::path(m.firmware).is_relative()) {

@@ -18,7 +18,9 @@
 //     probe: uno.PC5
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,10 @@ struct McuDecl {
     std::string type;
     std::uint32_t clock_hz = 0;
     std::string firmware;  // optional default ELF, resolved relative to the board file
+    // Optional boot loader (Intel HEX, resolved relative to the board file)
+    // and fuse bytes low, high, extended (core/BootSection.hpp).
+    std::string bootloader;
+    std::optional<std::array<std::uint8_t, 3>> fuses;
     std::string location;
 };
 
@@ -95,6 +101,9 @@ struct BoardSpec {
 BoardSpec load_board_file(const std::string& name_or_path);
 std::string find_board_file(const std::string& name_or_path);
 std::vector<std::string> standard_board_dirs();
+// Where bare boot loader names are looked up: $AVRBENCH_BOOTLOADERS_DIR,
+// <prefix>/share/avrbench/bootloaders, then the build tree's.
+std::vector<std::string> standard_bootloader_dirs();
 BoardSpec parse_board_text(const std::string& text, const std::string& path);
 
 }  // namespace avrbench

@@ -159,6 +159,7 @@ public:
 
     // The boot section when a boot loader was loaded (McuOptions::bootloader_hex).
     const std::optional<BootSection>& boot() const { return boot_; }
+    const std::string& bootloader_path() const { return options_.bootloader_hex; }
     // False once a boot loader has rewritten the application section with
     // something other than the ELF: the ELF's symbols and the oracles taken
     // from it (end of .text, __bad_interrupt, end of .bss) no longer apply.

@@ -415,6 +415,13 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
         std::printf("  mcu        %s: %s at %.6g MHz, firmware %s%s\n", m->name().c_str(), m->mcu_type().c_str(),
                     m->frequency_hz() / 1e6, m->elf().path().c_str(), m->halted() ? " (halted)" : "");
     }
+    for (Mcu* m : board.mcus()) {
+        if (!m->boot()) continue;
+        std::printf("  boot       %s: %s at 0x%05X (%u bytes), started the application %u time%s; the application section %s\n",
+                    m->name().c_str(), m->bootloader_path().c_str(), m->boot()->start_bytes, m->boot()->size_bytes,
+                    m->application_starts(), m->application_starts() == 1 ? "" : "s",
+                    m->elf_matches_flash() ? "holds the ELF" : "now differs from the ELF (rewritten by the boot loader)");
+    }
     std::printf("  simulated  %.6f s\n", simulated_s);
     std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
     for (Mcu* m : board.mcus()) print_idle_skip(*m, board.mcus().size() > 1);

@@ -66,7 +66,12 @@ TEST_P(BoardFileError, NamesFileLineAndProblem) {
         for (const auto& [name, type] : part_types()) types += (types.empty() ? "" : ", ") + name;
         expected.replace(at, 7, types);
     }
-    EXPECT_EQ(error_of(board_with(c.line, c.replacement)), expected);
+    const std::string error = error_of(board_with(c.line, c.replacement));
+    if (expected.rfind("(starts) ", 0) == 0) {
+        EXPECT_EQ(error.substr(0, expected.size() - 9), expected.substr(9));  // the rest lists this machine's folders
+    } else {
+        EXPECT_EQ(error, expected);
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -106,6 +111,16 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"port_beside_a_pin", 11, "  x_carriage: [uno.PB2, x.carriage, x_min.axis]",
              "bad.yaml:11: net 'x_carriage' joins the pin uno.PB2 and the carriage port x.carriage: only analog "
              "outputs share a net with pins"},
+        // Boot loaders (core/BootSection.hpp): the fuses come with them.
+        Case{"bootloader_without_fuses", 2, "  uno: {type: atmega328p, clock: 16MHz, bootloader: optiboot_atmega328.hex}",
+             "bad.yaml:2: MCU 'uno': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})"},
+        Case{"fuse_not_a_byte", 2, "  uno: {type: atmega328p, clock: 16MHz, fuses: {low: 0xFF, high: 0x1DE, extended: 0xFD}}",
+             "bad.yaml:2: MCU 'uno': fuses: high '0x1DE' is not a byte (0x00..0xFF)"},
+        Case{"fuse_missing", 2, "  uno: {type: atmega328p, clock: 16MHz, fuses: {low: 0xFF, high: 0xDE}}",
+             "bad.yaml:2: MCU 'uno': fuses: missing 'extended' (give low, high and extended)"},
+        Case{"bootloader_not_found", 2,
+             "  uno: {type: atmega328p, clock: 16MHz, bootloader: nosuch.hex, fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}}",
+             "(starts) bad.yaml:2: bootloader 'nosuch.hex' not found (looked in "},
         // yaml-cpp reports the line where it noticed the missing ']': the next one.
         Case{"yaml_syntax", 8, "  x_step: [uno.PD2, x_driver.step",
              "bad.yaml:9: YAML syntax error: end of sequence flow not found"},
