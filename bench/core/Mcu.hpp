@@ -167,13 +167,15 @@ public:
     // How many times a boot loader handed over to the application (a jump
     // from the boot section to address 0).
     unsigned application_starts() const { return application_starts_; }
+    // "function+0x12" from the ELF while the flash holds it; "boot
+    // loader+0x4a" in a boot section; else the raw address. For findings.
+    std::string describe_pc(std::uint32_t pc_bytes) const;
 
 private:
     friend struct ResetHook;
     void load_bootloader();
     void application_started();
     bool in_boot_section(std::uint32_t pc_bytes) const { return boot_ && pc_bytes >= boot_->start_bytes; }
-    std::string describe_pc(std::uint32_t pc_bytes) const;
     bool check_after_step(int state, std::uint32_t pc_before);
     void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);

@@ -48,6 +48,7 @@ public:
     avr_irq_t* irq() const { return irq_; }
     avr_t* avr() const { return avr_; }
     avr_ioport_t* port() const { return port_; }
+    std::uint8_t mask() const { return mask_; }  // the pin's bit in its port's registers
 
 private:
     static void notify(avr_irq_t* irq, std::uint32_t value, void* param);

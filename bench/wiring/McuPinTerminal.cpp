@@ -84,8 +84,17 @@ void McuPortWatch::on_pud_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t add
 
 std::uint8_t McuPortWatch::on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr) {
     auto* watch = static_cast<PortWatch*>(hook.context());
+    // Which PINx bits the instruction uses (AVR Instruction Set Manual
+    // encodings; avr->pc is still the reading instruction's address):
+    // SBI/CBI (1001 10x0 AAAA Abbb) read PINx only to write one bit back (a
+    // toggle), SBIC/SBIS (1001 10x1 AAAA Abbb) test bit b; anything else (IN,
+    // LDS, LD) takes the whole byte.
+    const unsigned opcode = avr->flash[avr->pc] | (avr->flash[avr->pc + 1] << 8);
+    std::uint8_t used = 0xFF;
+    if ((opcode & 0xFD00) == 0x9800) used = 0;
+    if ((opcode & 0xFD00) == 0x9900) used = static_cast<std::uint8_t>(1u << (opcode & 0x7));
     for (McuPinTerminal* t : watch->terminals) {
-        if (t->net()->resolution().state == NetState::Floating && !t->pin().is_output()) {
+        if ((used & t->pin().mask()) != 0 && t->net()->resolution().state == NetState::Floating && !t->pin().is_output()) {
             t->net()->floating_read(watch->owner->mcu_, t->label());
         }
     }

@@ -89,7 +89,7 @@ void Net::floating_read(Mcu& reader, const std::string& pin_label) {
     f.cycle = reader.cycle();
     f.clock_hz = reader.frequency_hz();
     f.pc_bytes = reader.pc_bytes();
-    f.symbol = reader.elf().describe_flash_address(f.pc_bytes);
+    f.symbol = reader.describe_pc(f.pc_bytes);
     char why[96];
     if (resolution_.volts_fraction > 0) {
         std::snprintf(why, sizeof why, "its pull resistors hold it at %.2f VCC, between V_IL and V_IH",

@@ -18,7 +18,9 @@
  *   5  PB4 while PB3 is an output driving low (open-drain "on")   -> 0
  *   6  PB3 while PB4 drives low and PB3 is an input               -> 0
  *   7  PB4 after both let go again                                -> 1
- * Then PB5 becomes an output driving high into the tie: contention.
+ * Then PB5 becomes an output driving high into the tie: contention. Last,
+ * PB2 floats again while SBI PINB,7 and SBIS PINB,7 read PINB without using
+ * its bit (no finding for them).
  */
 #include <avr/io.h>
 
@@ -52,6 +54,15 @@ int main(void)
 
     PORTB = _BV(PB5);
     DDRB = _BV(PB5);
+
+    /* PB2's net floats again (pull-up on against 47 kohm), and only
+     * instructions that do not use PB2's bit read PINB: SBI toggles PB7 (a
+     * read-modify-write of one bit; ignored on the ATmega32, whose PINx is
+     * read-only), SBIS tests PB7 alone. No second floating-input finding. */
+    PORTB = _BV(PB5) | _BV(PB2);
+    asm volatile("sbi %[pinb], 7\n\t"
+                 "sbis %[pinb], 7\n\t"
+                 "nop\n\t" ::[pinb] "I"(_SFR_IO_ADDR(PINB)));
     done = 1;
     for (;;) {
     }
