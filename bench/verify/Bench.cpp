@@ -190,7 +190,8 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
 }
 
 IdleResult Bench::run_to_ps(Picoseconds end_ps, const RunSlices& how) {
-    const Picoseconds slice_ps = std::clamp<Picoseconds>(end_ps / 100, 1'000'000, 10 * kPsPerMs);
+    const Picoseconds slice_ps =
+        how.slice_ps != 0 ? how.slice_ps : std::clamp<Picoseconds>(end_ps / 100, 1'000'000, 10 * kPsPerMs);
     // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
     while (now_ps() < end_ps) {
         if (user_stop_requested()) return IdleResult::Interrupted;

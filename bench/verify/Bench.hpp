@@ -89,6 +89,7 @@ public:
         Picoseconds settle_ps = 50 * kPsPerMs;
         std::function<void()> after_slice;
         std::function<bool()> stop_when;  // checked after each slice: true ends the run (Idle)
+        Picoseconds slice_ps = 0;         // 0: a hundredth of the run, from 1 ms to 10 ms
     };
     IdleResult run_to_ps(Picoseconds end_ps, const RunSlices& how);
     Picoseconds now_ps() const { return board_->now_ps(); }
