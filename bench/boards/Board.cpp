@@ -58,6 +58,7 @@ void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
         options.mcu_type = decl.type;
         options.frequency_hz = decl.clock_hz;
         options.fuses = decl.fuses;
+        options.lock_bits = decl.lock_bits;
         options.bootloader_hex = decl.bootloader;
         mcus_.push_back(std::make_unique<Mcu>(elf, options));
     }

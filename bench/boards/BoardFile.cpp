@@ -171,6 +171,19 @@ std::string find_bootloader(const std::string& name, const std::string& board_pa
     throw BadInput(location + ": bootloader '" + name + "' not found (looked in " + searched + ")");
 }
 
+// 0xDE or 222.
+std::uint8_t parse_byte(const std::string& text, const std::string& what) {
+    unsigned value = 0;
+    const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+    const char* first = text.data() + (hex ? 2 : 0);
+    const char* last = text.data() + text.size();
+    const auto [end, ec] = std::from_chars(first, last, value, hex ? 16 : 10);
+    if (ec != std::errc() || end != last || first == last || value > 0xFF) {
+        throw BadInput(what + " '" + text + "' is not a byte (0x00..0xFF)");
+    }
+    return static_cast<std::uint8_t>(value);
+}
+
 // `fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}`: all three bytes, as
 // avrdude's -U lfuse/hfuse/efuse and Arduino's boards.txt give them.
 std::array<std::uint8_t, 3> parse_fuses(const YAML::Node& node, const std::string& path, const std::string& what) {
@@ -184,16 +197,7 @@ std::array<std::uint8_t, 3> parse_fuses(const YAML::Node& node, const std::strin
         std::size_t index = 0;
         while (index < kNames.size() && kNames[index] != key) ++index;
         if (index == kNames.size()) throw BadInput(loc + ": " + what + ": unknown fuse '" + key + "' (expected low, high, extended)");
-        const std::string text = scalar(kv.second, path, key);
-        unsigned value = 0;
-        const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-        const char* first = text.data() + (hex ? 2 : 0);
-        const char* last = text.data() + text.size();
-        const auto [end, ec] = std::from_chars(first, last, value, hex ? 16 : 10);
-        if (ec != std::errc() || end != last || first == last || value > 0xFF) {
-            throw BadInput(loc + ": " + what + ": " + key + " '" + text + "' is not a byte (0x00..0xFF)");
-        }
-        fuses[index] = static_cast<std::uint8_t>(value);
+        fuses[index] = parse_byte(scalar(kv.second, path, key), loc + ": " + what + ": " + key);
         given[index] = true;
     }
     for (std::size_t i = 0; i < kNames.size(); ++i) {
@@ -280,7 +284,8 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
             else if (key == "firmware") m.firmware = scalar(field.second, path, "firmware");
             else if (key == "bootloader") m.bootloader = scalar(field.second, path, "bootloader");
             else if (key == "fuses") m.fuses = parse_fuses(field.second, path, "MCU '" + m.name + "': fuses");
-            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware, bootloader, fuses)");
+            else if (key == "lock") m.lock_bits = parse_byte(scalar(field.second, path, "lock"), loc + ": MCU '" + m.name + "': lock");
+            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware, bootloader, fuses, lock)");
         }
         if (!m.bootloader.empty() && !m.fuses) {
             throw BadInput(m.location + ": MCU '" + m.name + "': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})");

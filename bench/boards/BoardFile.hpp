@@ -44,6 +44,7 @@ struct McuDecl {
     // and fuse bytes low, high, extended (core/BootSection.hpp).
     std::string bootloader;
     std::optional<std::array<std::uint8_t, 3>> fuses;
+    std::optional<std::uint8_t> lock_bits;  // the lock byte (Boot Lock Bits)
     std::string location;
 };
 

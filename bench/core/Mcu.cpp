@@ -119,9 +119,13 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
         avr_ = nullptr;
         throw BadInput(message);
     }
+    // An erased chip's lock byte (simavr leaves 0, every lock programmed);
+    // avr_load_firmware copies the ELF's .lock over it.
+    avr_->lockbits = 0xFF;
     avr_load_firmware(avr_, &firmware);
     avr_->frequency = frequency_hz_;
     if (options_.fuses) std::copy(options_.fuses->begin(), options_.fuses->end(), avr_->fuse);
+    if (options_.lock_bits) avr_->lockbits = *options_.lock_bits;
     if (!options_.bootloader_hex.empty()) {
         try {
             load_bootloader();

@@ -46,6 +46,9 @@ struct McuOptions {
     // Fuse bytes low, high, extended (e.g. an UNO's 0xFF, 0xDE, 0xFD);
     // replace the ELF's .fuse section when given.
     std::optional<std::array<std::uint8_t, 3>> fuses;
+    // The lock byte (e.g. 0x0F, as the Arduino IDE burns with a boot loader);
+    // replaces the ELF's .lock section. Without either: 0xFF, nothing locked.
+    std::optional<std::uint8_t> lock_bits;
     // A boot loader (Intel HEX, e.g. Debian's optiboot_atmega328.hex) put in
     // the boot section the fuses' BOOTSZ bits select; with BOOTRST
     // programmed the MCU starts there (core/BootSection.hpp). Needs `fuses`.

@@ -116,6 +116,8 @@ INSTANTIATE_TEST_SUITE_P(
              "bad.yaml:2: MCU 'uno': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})"},
         Case{"fuse_not_a_byte", 2, "  uno: {type: atmega328p, clock: 16MHz, fuses: {low: 0xFF, high: 0x1DE, extended: 0xFD}}",
              "bad.yaml:2: MCU 'uno': fuses: high '0x1DE' is not a byte (0x00..0xFF)"},
+        Case{"lock_not_a_byte", 2, "  uno: {type: atmega328p, clock: 16MHz, lock: 0x0G}",
+             "bad.yaml:2: MCU 'uno': lock '0x0G' is not a byte (0x00..0xFF)"},
         Case{"fuse_missing", 2, "  uno: {type: atmega328p, clock: 16MHz, fuses: {low: 0xFF, high: 0xDE}}",
              "bad.yaml:2: MCU 'uno': fuses: missing 'extended' (give low, high and extended)"},
         Case{"bootloader_not_found", 2,

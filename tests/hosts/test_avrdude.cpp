@@ -12,6 +12,8 @@
 // Wall-clock guards: avrdude 60 s, the whole 90 s.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <string>
 
 #include "core/IntelHex.hpp"
@@ -62,6 +64,40 @@ TEST_P(Avrdude, FlashesAndVerifiesThroughTheBootLoaderAndTheNewApplicationRuns) 
     EXPECT_NE(summary.find("  findings   0"), std::string::npos) << summary;
     const std::string serial = test::slurp(dir / "firmware.txt");
     EXPECT_NE(serial.find("avrbench uart_echo\r\n"), std::string::npos) << "the new application did not run";
+}
+
+// The UNO's lock byte 0x0F (boards.txt; BLB12..11 = 00, "SPM is not allowed
+// to write to the Boot Loader section") keeps a hex that reaches into
+// optiboot's section from overwriting it: optiboot's SPM page write there
+// does nothing and avrdude's verify finds optiboot's own bytes at 0x7F80.
+TEST(AvrdudeLockBits, CannotOverwriteTheBootLoader) {
+    const auto dir = test::scratch_dir("avrdude-lock");
+    {
+        // 8 records of 16 x 0x55 at 0x7F80..0x7FFF; checksum = two's complement of the byte sum.
+        std::ofstream hex(dir / "over.hex");
+        for (unsigned a = 0x7F80; a < 0x8000; a += 16) {
+            unsigned sum = 16 + (a >> 8) + (a & 0xFF) + 16 * 0x55;
+            char line[64];
+            std::snprintf(line, sizeof line, ":10%04X00", a);
+            hex << line;
+            for (int i = 0; i < 16; ++i) hex << "55";
+            std::snprintf(line, sizeof line, "%02X\n", (0x100 - (sum & 0xFF)) & 0xFF);
+            hex << line;
+        }
+        hex << ":00000001FF\n";
+    }
+    const std::string bench = std::string(AVRBENCH_CLI) + " run " + test::firmware("blink_timer1") +
+                              " --board arduino-uno-optiboot --pty host --pty-link tty --reset-on-open --pace realtime --for 4s";
+    const auto r = test::run_command("cd " + test::quoted(dir.string()) + " || exit 1; " + bench +
+                                         " > bench.out 2>&1 & b=$!; i=0; while [ ! -e tty ] && [ $i -lt 100 ]; do "
+                                         "sleep 0.1; i=$((i+1)); done; timeout 60 avrdude -c arduino -p m328p -P tty "
+                                         "-b 115200 -D -U flash:w:over.hex:i > avrdude.out 2>&1; echo $? > avrdude.rc; wait $b",
+                                     dir, 90);
+    ASSERT_EQ(r.exit_code, 0) << r.err << test::slurp(dir / "bench.out");
+    const std::string log = test::slurp(dir / "avrdude.out");
+    EXPECT_NE(test::slurp(dir / "avrdude.rc"), "0\n") << log;
+    EXPECT_NE(log.find("128 bytes of flash written"), std::string::npos) << log;
+    EXPECT_NE(log.find("!= input 0x55 at addr 0x7f80"), std::string::npos) << log;
 }
 
 std::string upload_name(const ::testing::TestParamInfo<const Upload*>& param_info) { return param_info.param->name; }

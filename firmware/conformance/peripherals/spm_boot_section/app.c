@@ -10,6 +10,8 @@
  * Results in RAM, read by tests/conformance_periph/test_spm_boot_section.cpp:
  *  - reset_cause: GPIOR0 as the boot loader left it (its MCUSR copy);
  *  - boot_page_pattern_bytes: bytes of SPM_TARGET_BOOT equal to spm_pattern();
+ *  - boot_self_pattern_bytes, boot_locked_pattern_bytes: the same for the
+ *    two pages in the boot section;
  *  - app_page_erased_bytes: bytes of SPM_TARGET_APP still 0xFF after the
  *    application's SPM sequence;
  *  - done: 1 once the three above are set.
@@ -24,22 +26,22 @@ AVRBENCH_MCU_SECTION();
 
 volatile uint8_t reset_cause;
 volatile uint16_t boot_page_pattern_bytes;
+volatile uint16_t boot_self_pattern_bytes;
+volatile uint16_t boot_locked_pattern_bytes;
 volatile uint16_t app_page_erased_bytes;
 volatile uint8_t done;
 
 int main(void)
 {
     reset_cause = GPIOR0;
-    uint16_t matches = 0;
-    for (uint16_t i = 0; i < SPM_PAGESIZE; ++i) {
-        if (pgm_read_byte(SPM_TARGET_BOOT + i) == spm_pattern(i)) ++matches;
-    }
-    boot_page_pattern_bytes = matches;
+    boot_page_pattern_bytes = spm_pattern_bytes(SPM_TARGET_BOOT);
+    boot_self_pattern_bytes = spm_pattern_bytes(SPM_TARGET_BOOT_SELF);
+    boot_locked_pattern_bytes = spm_pattern_bytes(SPM_TARGET_BOOT_LOCKED);
 
     spm_program_page(SPM_TARGET_APP, 0, 0x00);
     uint16_t erased = 0;
     for (uint16_t i = 0; i < SPM_PAGESIZE; ++i) {
-        if (pgm_read_byte(SPM_TARGET_APP + i) == 0xFF) ++erased;
+        if (spm_read(SPM_TARGET_APP + i) == 0xFF) ++erased;
     }
     app_page_erased_bytes = erased;
     done = 1;
