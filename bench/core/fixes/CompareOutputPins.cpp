@@ -42,7 +42,8 @@ CompareOutputPins::Port* CompareOutputPins::port_for(avr_ioport_t* io) {
     p->port_write = std::make_unique<IoWriteHook>(avr_, io->r_port, &on_port_write, p.get());
     p->pin_write = std::make_unique<IoWriteHook>(avr_, io->r_pin, &on_pin_write, p.get());
     p->ddr_write = std::make_unique<IoWriteHook>(avr_, io->r_ddr, &on_ddr_write, p.get());
-    p->pin_read = std::make_unique<IoReadHook>(avr_, io->r_pin, &on_pin_read, p.get());
+    // pin_read comes with the port's first connected OCnx (combine): until
+    // then PINx needs no correction, and polling loops read PINx constantly.
     ports_.push_back(std::move(p));
     return ports_.back().get();
 }
@@ -108,6 +109,9 @@ void CompareOutputPins::combine(Port& port, std::uint8_t bit, std::uint8_t port_
     const bool on = n == 1 ? any : ((port_value & mask) != 0 ? any : all);
     port.connected = static_cast<std::uint8_t>(n != 0 ? (port.connected | mask) : (port.connected & ~mask));
     port.level = static_cast<std::uint8_t>(n != 0 && on ? (port.level | mask) : (port.level & ~mask));
+    // Installed once and kept (a hook cannot leave simavr's chain while
+    // others, e.g. the board's pin terminals, may sit in front of it).
+    if (port.connected != 0 && !port.pin_read) port.pin_read = std::make_unique<IoReadHook>(avr_, port.io->r_pin, &on_pin_read, &port);
 }
 
 void CompareOutputPins::update_pin(Port& port, std::uint8_t bit) {

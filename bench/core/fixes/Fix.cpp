@@ -25,13 +25,6 @@ IoWriteHook::~IoWriteHook() {
     }
 }
 
-void IoWriteHook::write_original(avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
-    if (original_ != nullptr) {
-        original_(avr, addr, value, original_param_);
-    } else {
-        avr_core_watch_write(avr, addr, value);
-    }
-}
 
 void IoWriteHook::trampoline(avr_t* avr, avr_io_addr_t addr, std::uint8_t value, void* param) {
     auto* self = static_cast<IoWriteHook*>(param);
@@ -55,10 +48,6 @@ IoReadHook::~IoReadHook() {
     }
 }
 
-std::uint8_t IoReadHook::read_original(avr_t* avr, avr_io_addr_t addr) {
-    if (original_ != nullptr) return original_(avr, addr, original_param_);
-    return avr_core_watch_read(avr, addr);
-}
 
 std::uint8_t IoReadHook::trampoline(avr_t* avr, avr_io_addr_t addr, void* param) {
     auto* self = static_cast<IoReadHook*>(param);

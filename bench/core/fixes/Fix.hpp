@@ -30,7 +30,14 @@ public:
     IoWriteHook(const IoWriteHook&) = delete;
     IoWriteHook& operator=(const IoWriteHook&) = delete;
 
-    void write_original(avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
+    // Inline: on the pin and timer registers this runs for every access.
+    void write_original(avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+        if (original_ != nullptr) {
+            original_(avr, addr, value, original_param_);
+        } else {
+            avr_core_watch_write(avr, addr, value);
+        }
+    }
     void* context() const { return context_; }
 
 private:
@@ -54,7 +61,9 @@ public:
     IoReadHook(const IoReadHook&) = delete;
     IoReadHook& operator=(const IoReadHook&) = delete;
 
-    std::uint8_t read_original(avr_t* avr, avr_io_addr_t addr);
+    std::uint8_t read_original(avr_t* avr, avr_io_addr_t addr) {
+        return original_ != nullptr ? original_(avr, addr, original_param_) : avr_core_watch_read(avr, addr);
+    }
     void* context() const { return context_; }
 
 private:
