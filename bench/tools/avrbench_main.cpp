@@ -21,6 +21,7 @@
 #include "cam/Records.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
+#include "tools/FuzzCommand.hpp"
 #include "core/Mcu.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
@@ -851,6 +852,16 @@ int main(int argc, char** argv) {
     cam_cmd->add_option("--tolerance", cam.tolerance, "endpoints closer than this are one point (default 0.01mm)");
     cam_cmd->add_option("--feed", cam.feed, "drawing feed in mm/min (default 600)");
 
+    FuzzArgs fuzz;
+    CLI::App* fuzz_cmd = app.add_subcommand("fuzz", "coverage-guided G-code fuzzing of a firmware on a board (libFuzzer; docs/FUZZING.md)");
+    fuzz_cmd->add_option("--elf", fuzz.elf, "the firmware")->required();
+    fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name (one MCU)")->required();
+    fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s)");
+    fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");
+    fuzz_cmd->add_option("--out", fuzz.out, "corpus, reproducers, runs and the libFuzzer log (default fuzz-out)");
+    fuzz_cmd->add_option("--jobs", fuzz.jobs, "parallel libFuzzer jobs (default 1)");
+    fuzz_cmd->add_option("--seed", fuzz.seed, "libFuzzer's random seed (default 1)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -870,6 +881,7 @@ int main(int argc, char** argv) {
         if (check_cmd->parsed()) code = check_command(check, false);
         if (update_cmd->parsed()) code = check_command(golden, true);
         if (cam_cmd->parsed()) code = cam_command(cam);
+        if (fuzz_cmd->parsed()) code = fuzz_command(fuzz);
     } catch (const BadInput& e) {
         std::fflush(stdout);
         std::fprintf(stderr, "avrbench: error: %s\n", e.what());

@@ -1,0 +1,183 @@
+// libFuzzer target for firmware: G-code (or any bytes) into a board's
+// serial port, coverage taken from the firmware's own program counter.
+//
+// Configured by the environment (avrbench fuzz and ci/fuzz set it):
+//   AVRBENCH_FUZZ_BOARD  board file or standard board name (single-MCU boards)
+//   AVRBENCH_FUZZ_ELF    the firmware
+//   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
+//
+// Once, at start-up, the firmware boots on the board until its host sees the
+// family's banner (the board's serial port says which: grbl, marlin, teacup).
+// Then per input the process forks: the child sends the input's lines,
+// steps the MCU instruction by instruction and counts every program-counter
+// edge (previous PC, PC) into a map shared with the parent; the parent copies
+// the map into libFuzzer's extra counters, so the search follows the
+// firmware's branches, not the bench's. Booting once and forking keeps an
+// execution to the input's own simulated time.
+//
+// Oracles (a finding aborts, and libFuzzer keeps the input as crash-*):
+// every finding the MCU and board raise during the input (bad opcode, PC
+// outside the program, stack into .bss, watchdog reset, bad interrupt, net
+// faults, part limits); a line the firmware never answers within the serial
+// port's line timeout (a hang); a fatal answer ("!!"). "error" answers are
+// the firmware doing its job and are not findings.
+#include <sys/mman.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "FuzzMutator.hpp"
+#include "core/Errors.hpp"
+#include "verify/Bench.hpp"
+
+namespace {
+
+constexpr std::size_t kMapSize = 1u << 16;
+constexpr std::size_t kDetailBytes = 512;
+
+struct Shared {
+    std::uint8_t edges[kMapSize];
+    std::uint32_t finding;  // 0: none
+    std::uint64_t steps;
+    char detail[kDetailBytes];
+};
+
+// libFuzzer reads every byte of this section as a coverage counter.
+__attribute__((section("__libfuzzer_extra_counters"), used)) std::uint8_t g_counters[kMapSize];
+
+// Never destroyed: at exit the fixes' registries (function-local statics)
+// may go first, and the process is ending anyway.
+avrbench::Bench* g_bench = nullptr;
+Shared* g_shared = nullptr;
+double g_bound_s = 3.0;
+std::size_t g_findings_at_ready = 0;
+
+const char* env_or_die(const char* name) {
+    const char* value = std::getenv(name);
+    if (value == nullptr || *value == '\0') {
+        std::fprintf(stderr, "fuzz_firmware: set %s (see bench/fuzz/fuzz_firmware.cpp)\n", name);
+        std::exit(2);
+    }
+    return value;
+}
+
+bool is_oracle_event(avrbench::HostEventKind kind) {
+    return kind == avrbench::HostEventKind::Timeout || kind == avrbench::HostEventKind::Fatal ||
+           kind == avrbench::HostEventKind::Restarted;
+}
+
+// In the child: run the input, fill g_shared.
+void run_child(const std::uint8_t* data, std::size_t size) {
+    avrbench::Bench& bench = *g_bench;
+    avrbench::Mcu& mcu = bench.mcu();
+    avrbench::UartHost& host = bench.host();
+    try {
+        host.add_lines(std::string(reinterpret_cast<const char*>(data), size));
+    } catch (const avrbench::BadInput&) {
+        return;  // nothing the host would send (it refuses such a job up front)
+    }
+    const avrbench::Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_bound_s);
+    std::uint32_t previous = 0;
+    std::uint64_t steps = 0;
+    while (!host.finished() && mcu.cycle() < end && !mcu.halted()) {
+        for (int i = 0; i < 4096 && mcu.step(); ++i) {
+            // AFL's edge hash: the previous location shifted, so A->B and B->A differ.
+            const std::uint32_t pc = mcu.pc_bytes() >> 1;
+            std::uint8_t& counter = g_shared->edges[(pc ^ previous) & (kMapSize - 1)];
+            if (counter != 0xFF) ++counter;
+            previous = pc >> 1;
+            ++steps;
+        }
+    }
+    g_shared->steps = steps;
+    std::string detail;
+    const auto& findings = mcu.findings();
+    if (findings.size() > g_findings_at_ready) detail = findings[g_findings_at_ready].describe();
+    if (detail.empty()) {
+        for (const auto& e : host.events()) {
+            if (is_oracle_event(e.kind)) {
+                detail = std::string(avrbench::to_string(e.kind)) + ": " + e.message;
+                break;
+            }
+        }
+    }
+    if (!detail.empty()) {
+        g_shared->finding = 1;
+        std::snprintf(g_shared->detail, kDetailBytes, "%s", detail.c_str());
+    }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    const std::string board = env_or_die("AVRBENCH_FUZZ_BOARD");
+    const std::string elf = env_or_die("AVRBENCH_FUZZ_ELF");
+    if (const char* bound = std::getenv("AVRBENCH_FUZZ_BOUND")) g_bound_s = std::max(0.01, std::atof(bound));
+    try {
+        g_bench = new avrbench::Bench(board, elf);
+        if (g_bench->board().mcus().size() != 1) {
+            std::fprintf(stderr, "fuzz_firmware: %s has %zu MCUs; the fuzz target steps one\n", board.c_str(),
+                         g_bench->board().mcus().size());
+            std::exit(2);
+        }
+        avrbench::UartHost& host = g_bench->host();
+        avrbench::Mcu& mcu = g_bench->mcu();
+        const avrbench::Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
+        while (!host.ready() && !host.failed() && !mcu.halted() && mcu.cycle() < limit) g_bench->run_for(0.001);
+        if (!host.ready()) {
+            std::fprintf(stderr, "fuzz_firmware: %s never became ready on %s (%s)\n", elf.c_str(), board.c_str(),
+                         host.failed() ? host.failure_message().c_str() : "no banner");
+            std::exit(2);
+        }
+        g_findings_at_ready = mcu.findings().size();
+    } catch (const avrbench::BadInput& e) {
+        std::fprintf(stderr, "fuzz_firmware: %s\n", e.what());
+        std::exit(2);
+    }
+    void* shared = ::mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (shared == MAP_FAILED) {
+        std::perror("fuzz_firmware: mmap");
+        std::exit(2);
+    }
+    g_shared = static_cast<Shared*>(shared);
+    return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    std::memset(g_shared, 0, sizeof(Shared));
+    const pid_t child = ::fork();
+    if (child < 0) {
+        std::perror("fuzz_firmware: fork");
+        std::abort();
+    }
+    if (child == 0) {
+        run_child(data, size);
+        ::_exit(0);
+    }
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0) {
+    }
+    std::memcpy(g_counters, g_shared->edges, kMapSize);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        std::fprintf(stderr, "fuzz_firmware: the bench itself died on this input (status 0x%x): a bug of the bench\n", status);
+        std::abort();
+    }
+    if (g_shared->finding != 0) {
+        std::fprintf(stderr, "avrbench fuzz: FINDING after %llu AVR instructions: %s\n",
+                     static_cast<unsigned long long>(g_shared->steps), g_shared->detail);
+        std::abort();
+    }
+    return 0;
+}
+
+extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t max_size,
+                                               unsigned int seed) {
+    return avrbench::fuzz::mutate_gcode(data, size, max_size, seed);
+}

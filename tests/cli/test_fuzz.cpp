@@ -1,0 +1,76 @@
+// `avrbench fuzz` smoke runs (issue 16's CI bound): on seed 001's
+// interpolator alone, the thesis' parser (Code 4.11 as printed) has two
+// planted bugs - a line without F is never answered, a line longer than its
+// 50-byte buffer overruns the stack (strcpy) - and the fuzzer must find both
+// within 20 s of wall time; the improved build must give nothing in 10 s.
+// The seed corpus holds only well-formed lines with F, so both findings come
+// from the search. Wall-clock guards: 90 s per run.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "support/Paths.hpp"
+#include "support/RunCommand.hpp"
+
+namespace avrbench {
+namespace {
+
+std::string fuzz(const std::string& elf, const std::string& seconds, const std::filesystem::path& dir, int* exit_code) {
+    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --elf " + test::firmware(elf) + " --board " +
+                                test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
+                                " --for " + seconds + " --seed 1 --out " + (dir / "out").string();
+    const auto r = test::run_command(command, dir, 90);
+    *exit_code = r.exit_code;
+    return r.out + r.err;
+}
+
+// "firmware edge features 2186 at the start, 7015 at the end" -> {2186, 7015}.
+std::pair<long, long> features(const std::string& out) {
+    const auto at = out.find("firmware edge features ");
+    if (at == std::string::npos) return {-1, -1};
+    long first = -1, last = -1;
+    std::sscanf(out.c_str() + at, "firmware edge features %ld at the start, %ld at the end", &first, &last);
+    return {first, last};
+}
+
+TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
+    const auto dir = test::scratch_dir("fuzz-thesis");
+    int code = 0;
+    const std::string out = fuzz("printer3d_interp_thesis_parser", "20s", dir, &code);
+    EXPECT_EQ(code, 1) << out;
+    EXPECT_NE(out.find("timeout: a line got no answer within 2.5 s"), std::string::npos) << out;
+    const bool crash = out.find("simavr-crash, PC") != std::string::npos || out.find("pc-outside-program, PC") != std::string::npos ||
+                       out.find("stack-overflow, PC") != std::string::npos || out.find("invalid-opcode, PC") != std::string::npos;
+    EXPECT_TRUE(crash) << out;
+    const auto [first, last] = features(out);
+    EXPECT_GT(first, 0) << out;
+    EXPECT_GT(last, first) << "coverage must grow over the run\n" << out;
+    EXPECT_NE(out.find("findings/finding-1.txt, " + (dir / "out/findings/finding-1.vcd").string()), std::string::npos) << out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/findings/finding-1.vcd"));
+}
+
+TEST(Fuzz, FindsNothingInTheImprovedInterpolator) {
+    const auto dir = test::scratch_dir("fuzz-improved");
+    int code = 0;
+    const std::string out = fuzz("printer3d_interp", "10s", dir, &code);
+    EXPECT_EQ(code, 0) << out;
+    EXPECT_NE(out.find("findings   0 distinct"), std::string::npos) << out;
+    EXPECT_NE(out.find(" per second)"), std::string::npos) << out;
+}
+
+TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
+    const auto dir = test::scratch_dir("fuzz-bad");
+    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("/nonexistent.elf"), std::string::npos) << r.err;
+    const auto no_target = test::run_command("AVRBENCH_FUZZ_TARGET=/nonexistent " + std::string(AVRBENCH_CLI) +
+                                                 " fuzz --elf " + test::firmware("printer3d_interp") + " --board " +
+                                                 test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
+                                                 " --for 5s --out " + (dir / "out").string(),
+                                             dir, 30);
+    EXPECT_EQ(no_target.exit_code, 2) << no_target.out << no_target.err;
+    EXPECT_NE(no_target.err.find("/nonexistent: cannot start"), std::string::npos) << no_target.err;
+}
+
+}  // namespace
+}  // namespace avrbench
