@@ -101,7 +101,18 @@ void RcServo::on_input(std::size_t pin, bool level) {
         return;
     }
     const double width_us = static_cast<double>(now - rise_cycle_) * 1e6 / clock().frequency_hz();
-    if (width_us < min_pulse_us_ || width_us > max_pulse_us_) return;
+    if (width_us < min_pulse_us_ || width_us > max_pulse_us_) {
+        // The servo ignores it (no valid command), but the firmware sent it:
+        // seed 004's digest §8 "no servo pulse is outside 500..2500 us".
+        if (!out_of_range_) {
+            char detail[160];
+            std::snprintf(detail, sizeof detail, "pulse of %.1f us is outside the %.0f..%.0f us the servo accepts; ignored",
+                          width_us, min_pulse_us_, max_pulse_us_);
+            report(FindingKind::ServoPulseOutOfRange, detail);
+        }
+        out_of_range_ = true;
+        return;
+    }
     on_pulse(width_us, now);
 }
 

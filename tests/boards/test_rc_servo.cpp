@@ -97,6 +97,34 @@ nets:
     EXPECT_EQ(out_of_range, 1);
 }
 
+// A pulse longer than the servo accepts (max_pulse 2500 us here; servo_sweep
+// sends 2000 us from about 0.5 s, 1000 us 25 frames later, 3000 us 25 frames
+// after that, 1500 us 10 frames later: see the test above) is ignored - at
+// 1.65 s the horn is at 0 deg, where the 1000 us pulses sent it (180 deg at
+// 300 deg/s: 0.6 s, done by 1.6 s) - and reported once for the spell.
+TEST(RcServo, PulsesOutsideWhatTheServoAcceptsAreIgnoredAndReported) {
+    const std::string text = R"(mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+parts:
+  pen: {type: rc_servo, calibration: "0:1000,180:2000", slew_deg_per_s: 300, initial_angle: 90deg, max_pulse: 2500us}
+nets:
+  d9: [uno.PB1, pen.signal]
+)";
+    Board board(parse_board_text(text, "servo.yaml"), {{"uno", test::firmware("servo_sweep")}});
+    auto& servo = board.part_as<RcServo>("pen");
+    board.run_until_seconds(1.65);
+    EXPECT_DOUBLE_EQ(servo.angle_deg(), 0.0) << "still at the 1000 us command";
+    EXPECT_DOUBLE_EQ(servo.last_pulse_us(), 1000.0) << "the 3000 us pulses are not taken";
+    int reported = 0;
+    for (const Finding& f : board.findings()) {
+        if (f.kind != FindingKind::ServoPulseOutOfRange) continue;
+        ++reported;
+        EXPECT_NE(f.detail.find("pulse of 3000.0 us is outside the 400..2500 us the servo accepts; ignored"), std::string::npos)
+            << f.detail;
+    }
+    EXPECT_EQ(reported, 1);
+}
+
 TEST(RcServo, CalibrationTableInterpolatesLinearlyBetweenItsPoints) {
     // [T4] Table 4.1, servo 1: 0:641, 45:1032, 90:1474, 135:1902, 180:2305 us.
     const std::string text = R"(mcus:
