@@ -5,6 +5,9 @@
 //   AVRBENCH_FUZZ_BOARD  board file or standard board name (single-MCU boards)
 //   AVRBENCH_FUZZ_ELF    the firmware
 //   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
+//   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
+//                        answer, for what the lines set in motion (default 0.1:
+//                        five RC-servo frames)
 //
 // Once, at start-up, the firmware boots on the board until its host sees the
 // family's banner (the board's serial port says which: grbl, marlin, teacup).
@@ -19,8 +22,8 @@
 // every finding the MCU and board raise during the input (bad opcode, PC
 // outside the program, stack into .bss, watchdog reset, bad interrupt, net
 // faults, part limits); a line the firmware never answers within the serial
-// port's line timeout (a hang); a fatal answer ("!!"). "error" answers are
-// the firmware doing its job and are not findings.
+// port's line timeout (a hang); a fatal answer ("!!"). "error" answers and
+// restarts the firmware announces (grbl's ^X) are not findings.
 #include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -57,6 +60,7 @@ __attribute__((section("__libfuzzer_extra_counters"), used)) std::uint8_t g_coun
 avrbench::Bench* g_bench = nullptr;
 Shared* g_shared = nullptr;
 double g_bound_s = 3.0;
+double g_settle_s = 0.1;
 std::size_t g_findings_at_ready = 0;
 
 const char* env_or_die(const char* name) {
@@ -68,9 +72,10 @@ const char* env_or_die(const char* name) {
     return value;
 }
 
+// A restart mid-job is not one: grbl's ^X restarts on purpose, and a reset
+// the firmware did not ask for is already an MCU finding (watchdog, jump to 0).
 bool is_oracle_event(avrbench::HostEventKind kind) {
-    return kind == avrbench::HostEventKind::Timeout || kind == avrbench::HostEventKind::Fatal ||
-           kind == avrbench::HostEventKind::Restarted;
+    return kind == avrbench::HostEventKind::Timeout || kind == avrbench::HostEventKind::Fatal;
 }
 
 // In the child: run the input, fill g_shared.
@@ -83,10 +88,15 @@ void run_child(const std::uint8_t* data, std::size_t size) {
     } catch (const avrbench::BadInput&) {
         return;  // nothing the host would send (it refuses such a job up front)
     }
-    const avrbench::Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_bound_s);
+    avrbench::Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_bound_s);
     std::uint32_t previous = 0;
     std::uint64_t steps = 0;
-    while (!host.finished() && mcu.cycle() < end && !mcu.halted()) {
+    bool settling = false;
+    while (mcu.cycle() < end && !mcu.halted()) {
+        if (host.finished() && !settling) {
+            settling = true;
+            end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_settle_s));
+        }
         for (int i = 0; i < 4096 && mcu.step(); ++i) {
             // AFL's edge hash: the previous location shifted, so A->B and B->A differ.
             const std::uint32_t pc = mcu.pc_bytes() >> 1;
@@ -98,7 +108,7 @@ void run_child(const std::uint8_t* data, std::size_t size) {
     }
     g_shared->steps = steps;
     std::string detail;
-    const auto& findings = mcu.findings();
+    const auto findings = bench.board().findings();  // the MCU's, the nets', the parts'
     if (findings.size() > g_findings_at_ready) detail = findings[g_findings_at_ready].describe();
     if (detail.empty()) {
         for (const auto& e : host.events()) {
@@ -120,6 +130,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     const std::string board = env_or_die("AVRBENCH_FUZZ_BOARD");
     const std::string elf = env_or_die("AVRBENCH_FUZZ_ELF");
     if (const char* bound = std::getenv("AVRBENCH_FUZZ_BOUND")) g_bound_s = std::max(0.01, std::atof(bound));
+    if (const char* settle = std::getenv("AVRBENCH_FUZZ_SETTLE")) g_settle_s = std::max(0.0, std::atof(settle));
     try {
         g_bench = new avrbench::Bench(board, elf);
         if (g_bench->board().mcus().size() != 1) {
@@ -136,7 +147,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
                          host.failed() ? host.failure_message().c_str() : "no banner");
             std::exit(2);
         }
-        g_findings_at_ready = mcu.findings().size();
+        g_findings_at_ready = g_bench->board().findings().size();
     } catch (const avrbench::BadInput& e) {
         std::fprintf(stderr, "fuzz_firmware: %s\n", e.what());
         std::exit(2);

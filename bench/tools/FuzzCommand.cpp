@@ -23,7 +23,6 @@
 #include "core/Errors.hpp"
 #include "core/Units.hpp"
 #include "stimulus/GcodeMutator.hpp"
-#include "stimulus/UartHost.hpp"
 #include "verify/Bench.hpp"
 
 extern char** environ;
@@ -116,6 +115,54 @@ std::string finding_kind(std::string text) {
     return text;
 }
 
+// The finding an input gives when the target runs it once ("" for none).
+std::string replay(const std::string& target, const std::vector<std::string>& env, const fs::path& input) {
+    const std::string log = input.string() + ".replay.txt";
+    run_logged({target, "-runs=1", input.string()}, env, log);
+    const std::string output = slurp(log);
+    fs::remove(log);
+    const auto at = output.find("avrbench fuzz: FINDING");
+    return at == std::string::npos ? "" : output.substr(at, output.find('\n', at) - at);
+}
+
+// Shrinks `bytes` while the target still reports the same kind of finding:
+// whole lines first, then single bytes (a greedy pass each; every try is a
+// replay, so the tries are bounded).
+std::string minimize(const std::string& target, const std::vector<std::string>& env, const fs::path& scratch,
+                     std::string bytes, const std::string& kind) {
+    int budget = 300;
+    const auto same = [&](const std::string& candidate) {
+        if (budget-- <= 0) return false;
+        std::ofstream(scratch, std::ios::binary) << candidate;
+        const std::string found = replay(target, env, scratch);
+        return !found.empty() && finding_kind(found) == kind;
+    };
+    for (bool shrunk = true; shrunk && budget > 0;) {
+        shrunk = false;
+        for (std::size_t start = 0; start < bytes.size() && budget > 0;) {
+            std::size_t end = bytes.find('\n', start);
+            end = end == std::string::npos ? bytes.size() : end + 1;
+            const std::string candidate = bytes.substr(0, start) + bytes.substr(end);
+            if (same(candidate)) {
+                bytes = candidate;
+                shrunk = true;
+            } else {
+                start = end;
+            }
+        }
+    }
+    for (std::size_t i = 0; i < bytes.size() && budget > 0;) {
+        const std::string candidate = bytes.substr(0, i) + bytes.substr(i + 1);
+        if (same(candidate)) {
+            bytes = candidate;
+        } else {
+            ++i;
+        }
+    }
+    fs::remove(scratch);
+    return bytes;
+}
+
 }  // namespace
 
 int fuzz_command(const FuzzArgs& args) {
@@ -189,15 +236,11 @@ int fuzz_command(const FuzzArgs& args) {
     }
     std::sort(artifacts.begin(), artifacts.end());
     for (const auto& artifact : artifacts) {
-        const std::string replay = artifact.string() + ".replay.txt";
-        run_logged({target, "-runs=1", artifact.string()}, env, replay);
-        const std::string output = slurp(replay);
-        const auto at = output.find("avrbench fuzz: FINDING");
-        if (at == std::string::npos) {
+        const std::string line = replay(target, env, artifact);
+        if (line.empty()) {
             ++not_reproduced;  // e.g. libFuzzer's own crash report of a job, or a flaky bench: kept, not listed
             continue;
         }
-        const std::string line = output.substr(at, output.find('\n', at) - at);
         const std::string finding = finding_kind(line);
         by_finding[finding].push_back(artifact);
         example.emplace(finding, line.substr(line.find("instructions: ") + 14));
@@ -208,25 +251,21 @@ int fuzz_command(const FuzzArgs& args) {
     std::printf(")\n");
     int index = 0;
     for (auto& [finding, files] : by_finding) {
-        // The shortest reproducer of each, recorded as a run with its VCD.
+        // The shortest reproducer of each, minimized (the same kind of
+        // finding must remain), recorded as a run with its VCD.
         const fs::path shortest = *std::min_element(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
             return fs::file_size(a) < fs::file_size(b);
         });
         const std::string base = (findings / ("finding-" + std::to_string(++index))).string();
-        fs::copy_file(shortest, base + ".gcode", fs::copy_options::overwrite_existing);
-        // `run --gcode` refuses bytes that are not text (a user's job file);
-        // such a reproducer goes in as raw bytes (--uart-in) instead.
-        std::string how = "--gcode";
-        try {
-            (void)checked_gcode_text(slurp(base + ".gcode"), base + ".gcode");
-        } catch (const BadInput&) {
-            how = "--uart-in";
-        }
-        run_logged({self_dir() + "/avrbench", "run", args.elf, "--board", args.board, how, base + ".gcode", "--for",
-                    std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"},
+        const std::string minimal = minimize(target, env, base + ".try", slurp(shortest.string()), finding);
+        std::ofstream(base + ".gcode", std::ios::binary) << minimal;
+        // Replayed the way the fuzz target sent it: lines through the port's
+        // host, bytes that are not text included.
+        run_logged({self_dir() + "/avrbench", "run", args.elf, "--board", args.board, "--gcode", base + ".gcode",
+                    "--gcode-bytes", "--for", std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"},
                    {}, base + ".txt");
-        std::printf("    %d. %s (%zu reproducers)\n       e.g. %s\n       shortest: %ju bytes, %s.gcode; its run: %s.txt, %s.vcd\n",
-                    index, finding.c_str(), files.size(), example[finding].c_str(),
+        std::printf("    %d. %s (%zu reproducers)\n       e.g. %s\n       minimized: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
+                    index, finding.c_str(), files.size(), example[finding].c_str(), minimal.size(),
                     static_cast<std::uintmax_t>(fs::file_size(shortest)), base.c_str(), base.c_str(), base.c_str());
     }
     return by_finding.empty() ? 0 : 1;

@@ -74,6 +74,7 @@ struct RunArgs {
     std::string pace = "free";  // free | realtime
     bool reset_on_open = false; // --pty: a host opening the port resets its MCU
     std::string gcode;
+    bool gcode_bytes = false;  // --gcode-bytes: no text check (fuzzing reproducers)
     std::string host;
     std::string flow;
     bool wait_banner = false;
@@ -352,7 +353,15 @@ BoardRun prepare_board_run(const RunArgs& args) {
         if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
         if (args.wait_banner) o.startup = Startup::WaitForBanner;
         run.host = &bench.host(decl.name, o);
-        run.host->load_file(args.gcode);
+        if (args.gcode_bytes) {
+            // The file's bytes as lines, as avrbench fuzz sent them: binary bytes included.
+            std::ifstream in(args.gcode, std::ios::binary);
+            std::ostringstream bytes;
+            bytes << in.rdbuf();
+            run.host->add_lines(bytes.str());
+        } else {
+            run.host->load_file(args.gcode);
+        }
         for (const auto& [at_ps, bytes] : realtime_bytes) {
             run.host->send_bytes_at(bytes, board.mcu(decl.mcu).cycles_from_seconds(seconds_from_ps(at_ps)));
         }
@@ -798,6 +807,8 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--for", run.duration, "simulated time to run, e.g. 2s, 250ms (default 1s; with --gcode the limit for the job, default 60s)")
         ->each([&run](const std::string&) { run.duration_given = true; });
     run_cmd->add_option("--gcode", run.gcode, "stream this G-code file to the board's serial port (needs --board)");
+    run_cmd->add_flag("--gcode-bytes", run.gcode_bytes,
+                      "send --gcode's lines byte for byte, bytes that are not text included (how avrbench fuzz replays a reproducer)");
     run_cmd->add_option("--host", run.host, "the board's serial port for --gcode or --dxf (default: the first)");
     run_cmd->add_option("--dxf", run.dxf,
                         "plot this drawing (seed 002): CAM to G-code, binary records streamed stop-and-wait (needs --board)");
