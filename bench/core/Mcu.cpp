@@ -293,7 +293,15 @@ bool Mcu::run_until_sleep(Cycle end_cycle) {
     return sleeping();
 }
 
-StopReason Mcu::run_until(Cycle target_cycle) {
+StopReason Mcu::run_until(Cycle target_cycle) { return run_until_impl<false>(target_cycle, nullptr); }
+
+StopReason Mcu::run_until_covering(Cycle target_cycle, PcEdgeMap& edges) { return run_until_impl<true>(target_cycle, &edges); }
+
+// kCover: every instruction's new PC goes into `edges` (fuzzing); without it
+// the loop is the plain run loop (a separate instantiation, so the coverage
+// costs the ordinary runs nothing).
+template <bool kCover>
+StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     stop_requested_ = false;
     real_stop_ = false;
     if (halted_) return StopReason::Halted;
@@ -330,6 +338,7 @@ StopReason Mcu::run_until(Cycle target_cycle) {
         const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
         ++steps_;
         check(state, pc_before);
+        if constexpr (kCover) edges->hit(avr->pc);
         if (__builtin_expect(stop_requested_, 0)) break;
         if (reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
@@ -359,6 +368,7 @@ StopReason Mcu::run_until(Cycle target_cycle) {
                 __builtin_expect(avr->interrupt_state != 0, 0)) {
                 const std::uint32_t fast_pc_before = avr->pc;
                 check(stepper.finish(pc), fast_pc_before);
+                if constexpr (kCover) edges->hit(avr->pc);
                 break;
             }
             const std::uint16_t sp = static_cast<std::uint16_t>(data[R_SPL] | (data[R_SPH] << 8));
@@ -366,10 +376,12 @@ StopReason Mcu::run_until(Cycle target_cycle) {
                 const std::uint32_t fast_pc_before = avr->pc;
                 avr->pc = pc;
                 check_after_step(cpu_Running, fast_pc_before);
+                if constexpr (kCover) edges->hit(pc);
                 if (stop_requested_) break;
                 continue;
             }
             avr->pc = pc;
+            if constexpr (kCover) edges->hit(pc);
             // A stop requested during the instruction made stop_timer due:
             // the next turn leaves through finish() above.
         }

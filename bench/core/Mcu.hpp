@@ -69,6 +69,20 @@ public:
     virtual void reach(Mcu& mcu) = 0;
 };
 
+// AFL-style edge coverage of the firmware (bench/fuzz): each instruction's
+// PC with the previous one, hashed into a map of saturating counters.
+struct PcEdgeMap {
+    std::uint8_t* counters = nullptr;
+    std::uint32_t mask = 0;  // map size - 1 (a power of two)
+    std::uint32_t previous = 0;
+    void hit(std::uint32_t pc_bytes) {
+        const std::uint32_t location = pc_bytes >> 1;
+        std::uint8_t& counter = counters[(location ^ previous) & mask];
+        if (counter != 0xFF) ++counter;
+        previous = location >> 1;  // shifted, so A->B and B->A differ
+    }
+};
+
 class Mcu final : private SimavrLogSink {
 public:
     // Throws BadInput (one line) when the MCU type or clock is unknown or
@@ -100,6 +114,8 @@ public:
     // callback asks to stop. A sleeping core jumps straight to its next event.
     StopReason run_until(Cycle target_cycle);
     StopReason run_for(Cycle cycles) { return run_until(cycle() + cycles); }
+    // run_until, recording every instruction's PC edge in `edges` (fuzzing).
+    StopReason run_until_covering(Cycle target_cycle, PcEdgeMap& edges);
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
@@ -180,6 +196,8 @@ private:
     void application_started();
     bool in_boot_section(std::uint32_t pc_bytes) const { return boot_ && pc_bytes >= boot_->start_bytes; }
     bool check_after_step(int state, std::uint32_t pc_before);
+    template <bool kCover>
+    StopReason run_until_impl(Cycle target_cycle, PcEdgeMap* edges);
     void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);
     void on_simavr_error(const char* message) override;

@@ -4,7 +4,15 @@
 // Configured by the environment (avrbench fuzz and ci/fuzz set it):
 //   AVRBENCH_FUZZ_BOARD  board file or standard board name (single-MCU boards)
 //   AVRBENCH_FUZZ_ELF    the firmware
+//   AVRBENCH_FUZZ_FAMILY the host's firmware family (grbl, marlin, teacup,
+//                        generic) when not the board's serial port's
 //   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
+//   AVRBENCH_FUZZ_RAW    1: the input's bytes go to the serial port as they
+//                        are, for binary protocols (seed 002's records): no
+//                        host, so no banner to wait for (the firmware boots
+//                        for AVRBENCH_FUZZ_BOOT seconds, default 0.2) and no
+//                        hang oracle; the run ends the settle time after the
+//                        last byte went in
 //   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
 //                        answer, for what the lines set in motion (default 0.1:
 //                        five RC-servo frames)
@@ -61,6 +69,7 @@ avrbench::Bench* g_bench = nullptr;
 Shared* g_shared = nullptr;
 double g_bound_s = 3.0;
 double g_settle_s = 0.1;
+bool g_raw = false;
 std::size_t g_findings_at_ready = 0;
 
 const char* env_or_die(const char* name) {
@@ -82,36 +91,41 @@ bool is_oracle_event(avrbench::HostEventKind kind) {
 void run_child(const std::uint8_t* data, std::size_t size) {
     avrbench::Bench& bench = *g_bench;
     avrbench::Mcu& mcu = bench.mcu();
-    avrbench::UartHost& host = bench.host();
-    try {
-        host.add_lines(std::string(reinterpret_cast<const char*>(data), size));
-    } catch (const avrbench::BadInput&) {
-        return;  // nothing the host would send (it refuses such a job up front)
+    avrbench::UartHost* host = g_raw ? nullptr : &bench.host();
+    avrbench::Uart& serial = bench.serial();
+    const std::string bytes(reinterpret_cast<const char*>(data), size);
+    if (host != nullptr) {
+        try {
+            host->add_lines(bytes);
+        } catch (const avrbench::BadInput&) {
+            return;  // nothing the host would send (it refuses such a job up front)
+        }
+    } else {
+        serial.send(bytes);
     }
+    // Done sending: every line answered (or the host gave up), or every raw byte taken.
+    const auto sent = [&] { return host != nullptr ? host->finished() : serial.pending_rx() == 0; };
     avrbench::Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_bound_s);
-    std::uint32_t previous = 0;
-    std::uint64_t steps = 0;
+    // The run loop with coverage (Mcu::run_until_covering), in slices of 1 ms
+    // simulated between which the settle time may start.
+    avrbench::PcEdgeMap edges{g_shared->edges, kMapSize - 1};
+    const avrbench::Cycle slice = mcu.cycles_from_seconds(0.001);
+    const std::uint64_t steps_before = mcu.steps();
     bool settling = false;
     while (mcu.cycle() < end && !mcu.halted()) {
-        if (host.finished() && !settling) {
+        if (!settling && sent()) {
             settling = true;
             end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_settle_s));
         }
-        for (int i = 0; i < 4096 && mcu.step(); ++i) {
-            // AFL's edge hash: the previous location shifted, so A->B and B->A differ.
-            const std::uint32_t pc = mcu.pc_bytes() >> 1;
-            std::uint8_t& counter = g_shared->edges[(pc ^ previous) & (kMapSize - 1)];
-            if (counter != 0xFF) ++counter;
-            previous = pc >> 1;
-            ++steps;
-        }
+        mcu.run_until_covering(std::min(end, mcu.cycle() + slice), edges);
     }
+    const std::uint64_t steps = mcu.steps() - steps_before;
     g_shared->steps = steps;
     std::string detail;
     const auto findings = bench.board().findings();  // the MCU's, the nets', the parts'
     if (findings.size() > g_findings_at_ready) detail = findings[g_findings_at_ready].describe();
-    if (detail.empty()) {
-        for (const auto& e : host.events()) {
+    if (detail.empty() && host != nullptr) {
+        for (const auto& e : host->events()) {
             if (is_oracle_event(e.kind)) {
                 detail = std::string(avrbench::to_string(e.kind)) + ": " + e.message;
                 break;
@@ -131,6 +145,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     const std::string elf = env_or_die("AVRBENCH_FUZZ_ELF");
     if (const char* bound = std::getenv("AVRBENCH_FUZZ_BOUND")) g_bound_s = std::max(0.01, std::atof(bound));
     if (const char* settle = std::getenv("AVRBENCH_FUZZ_SETTLE")) g_settle_s = std::max(0.0, std::atof(settle));
+    if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) g_raw = std::string(raw) == "1";
     try {
         g_bench = new avrbench::Bench(board, elf);
         if (g_bench->board().mcus().size() != 1) {
@@ -138,14 +153,25 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
                          g_bench->board().mcus().size());
             std::exit(2);
         }
-        avrbench::UartHost& host = g_bench->host();
         avrbench::Mcu& mcu = g_bench->mcu();
-        const avrbench::Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
-        while (!host.ready() && !host.failed() && !mcu.halted() && mcu.cycle() < limit) g_bench->run_for(0.001);
-        if (!host.ready()) {
-            std::fprintf(stderr, "fuzz_firmware: %s never became ready on %s (%s)\n", elf.c_str(), board.c_str(),
-                         host.failed() ? host.failure_message().c_str() : "no banner");
-            std::exit(2);
+        if (g_raw) {
+            double boot_s = 0.2;
+            if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) boot_s = std::max(0.0, std::atof(boot));
+            (void)g_bench->serial();  // the USART model listens from here on
+            g_bench->run_for(boot_s);
+        } else {
+            avrbench::UartHostOptions options = avrbench::default_host_options(g_bench->serial_decl());
+            if (const char* family = std::getenv("AVRBENCH_FUZZ_FAMILY"); family != nullptr && *family != '\0') {
+                options.family = avrbench::parse_firmware_family(family, "AVRBENCH_FUZZ_FAMILY");
+            }
+            avrbench::UartHost& host = g_bench->host("", options);
+            const avrbench::Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
+            while (!host.ready() && !host.failed() && !mcu.halted() && mcu.cycle() < limit) g_bench->run_for(0.001);
+            if (!host.ready()) {
+                std::fprintf(stderr, "fuzz_firmware: %s never became ready on %s (%s)\n", elf.c_str(), board.c_str(),
+                             host.failed() ? host.failure_message().c_str() : "no banner");
+                std::exit(2);
+            }
         }
         g_findings_at_ready = g_bench->board().findings().size();
     } catch (const avrbench::BadInput& e) {
@@ -190,5 +216,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
 extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t max_size,
                                                unsigned int seed) {
+    if (g_raw) return LLVMFuzzerMutate(data, size, max_size);  // a binary protocol: bytes, not G-code
     return avrbench::fuzz::mutate_gcode(data, size, max_size, seed);
 }

@@ -23,6 +23,7 @@
 #include "core/Errors.hpp"
 #include "core/Units.hpp"
 #include "stimulus/GcodeMutator.hpp"
+#include "stimulus/UartHost.hpp"
 #include "verify/Bench.hpp"
 
 extern char** environ;
@@ -95,8 +96,13 @@ std::string finding_kind(std::string text) {
         std::size_t i = at + 5;
         while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
         if (i == at + 5 || i + 1 >= text.size() || text[i] != ' ' || text[i + 1] != '\'') continue;
-        const auto close = text.find('\'', i + 2);
+        auto close = text.find('\'', i + 2);
         if (close == std::string::npos) break;
+        // A long line is shown cut, with its length: "'G92 X0...' (129 bytes)".
+        if (text.compare(close + 1, 2, " (") == 0) {
+            const auto bytes = text.find(" bytes)", close);
+            if (bytes != std::string::npos && bytes < close + 16) close = bytes + 6;
+        }
         text.replace(at, close + 1 - at, "a line");
     }
     // A crash: "interp: simavr-crash, PC 0x40ca strcpy+0x8: <detail>" - the
@@ -130,7 +136,7 @@ std::string replay(const std::string& target, const std::vector<std::string>& en
 // replay, so the tries are bounded).
 std::string minimize(const std::string& target, const std::vector<std::string>& env, const fs::path& scratch,
                      std::string bytes, const std::string& kind) {
-    int budget = 300;
+    int budget = 150;
     const auto same = [&](const std::string& candidate) {
         if (budget-- <= 0) return false;
         std::ofstream(scratch, std::ios::binary) << candidate;
@@ -176,21 +182,28 @@ int fuzz_command(const FuzzArgs& args) {
             throw BadInput(args.board + ": has " + std::to_string(bench.board().mcus().size()) +
                            " MCUs; avrbench fuzz steps boards with one MCU");
         }
-        family = bench.serial_decl().family;
+        family = args.family.empty() ? bench.serial_decl().family : args.family;
+        (void)parse_firmware_family(family, "--family");
     }
     const std::string target = find_target();
     const fs::path out = args.out;
     const fs::path corpus = out / "corpus", findings = out / "findings";
     fs::create_directories(corpus);
     fs::create_directories(findings);
-    const auto seeds = seed_lines(family);
+    // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
+    // coverage finds the rest.
+    const std::vector<std::string> seeds =
+        args.raw ? std::vector<std::string>{std::string("\x3b", 1), std::string("\x00\x00\x10\x00\x10\x40\x40\x05", 8)}
+                 : seed_lines(family);
     for (std::size_t i = 0; i < seeds.size(); ++i) std::ofstream(corpus / ("seed-" + std::to_string(i))) << seeds[i];
     {
         std::ofstream dict(out / "gcode.dict");
         for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";
     }
     const std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
-                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s)};
+                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
+                                          std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
+                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot")))};
     std::vector<std::string> argv = {target,
                                      corpus.string(),
                                      "-max_total_time=" + std::to_string(static_cast<long>(seconds)),
@@ -261,9 +274,16 @@ int fuzz_command(const FuzzArgs& args) {
         std::ofstream(base + ".gcode", std::ios::binary) << minimal;
         // Replayed the way the fuzz target sent it: lines through the port's
         // host, bytes that are not text included.
-        run_logged({self_dir() + "/avrbench", "run", args.elf, "--board", args.board, "--gcode", base + ".gcode",
-                    "--gcode-bytes", "--for", std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"},
-                   {}, base + ".txt");
+        std::vector<std::string> run = {self_dir() + "/avrbench", "run", args.elf, "--board", args.board, "--for",
+                                        std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"};
+        if (args.raw) {
+            // The bytes from power-on (the fuzz target sent them after its boot time; --uart-in holds
+            // them until the firmware enables its receiver).
+            run.insert(run.end(), {"--uart-in", base + ".gcode"});
+        } else {
+            run.insert(run.end(), {"--family", family, "--gcode", base + ".gcode", "--gcode-bytes"});
+        }
+        run_logged(run, {}, base + ".txt");
         std::printf("    %d. %s (%zu reproducers)\n       e.g. %s\n       minimized: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
                     index, finding.c_str(), files.size(), example[finding].c_str(), minimal.size(),
                     static_cast<std::uintmax_t>(fs::file_size(shortest)), base.c_str(), base.c_str(), base.c_str());

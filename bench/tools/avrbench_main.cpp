@@ -870,6 +870,9 @@ int main(int argc, char** argv) {
     fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s)");
     fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");
     fuzz_cmd->add_option("--out", fuzz.out, "corpus, reproducers, runs and the libFuzzer log (default fuzz-out)");
+    fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, teacup, generic (default: the board's)");
+    fuzz_cmd->add_flag("--raw", fuzz.raw, "send the input's bytes to the port as they are (binary protocols such as seed 002's records)");
+    fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw: simulated time the firmware boots before the first input (default 0.2s)");
     fuzz_cmd->add_option("--jobs", fuzz.jobs, "parallel libFuzzer jobs (default 1)");
     fuzz_cmd->add_option("--seed", fuzz.seed, "libFuzzer's random seed (default 1)");
 

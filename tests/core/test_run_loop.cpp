@@ -124,5 +124,41 @@ TEST(RunLoop, SkippingIdleLoopsEndsWhereAvrRunEndsOnEveryFirmware) {
     }
 }
 
+// Mcu::run_until_covering (the fuzz target's loop) is the run loop with every
+// instruction's PC edge counted: it must end exactly where run_until ends,
+// and the same run must give the same map. For busy_poll, whose main loop
+// is a handful of instructions repeated, the map has few distinct edges but
+// they saturate (255) after 20 ms.
+TEST(RunLoop, CoveringRunEndsWhereThePlainRunEndsAndCountsEdges) {
+    for (const char* name : {"busy_poll", "blink_timer1", "uart_echo", "printer3d_interp"}) {
+        std::vector<std::uint8_t> first;
+        for (int pass = 0; pass < 2; ++pass) {
+            Mcu plain(ElfImage::load(test::firmware(name)));
+            Mcu covered(ElfImage::load(test::firmware(name)));
+            std::vector<std::uint8_t> map(1u << 16);
+            PcEdgeMap edges{map.data(), static_cast<std::uint32_t>(map.size() - 1)};
+            const Cycle end = plain.frequency_hz() / 50;  // 20 ms
+            plain.run_until(end);
+            for (Cycle c = 0; c < end;) {  // in 1 ms slices, as the fuzz target runs
+                c = std::min<Cycle>(end, c + plain.frequency_hz() / 1000);
+                covered.run_until_covering(c, edges);
+            }
+            EXPECT_EQ(plain.cycle(), covered.cycle()) << name;
+            EXPECT_EQ(plain.pc_bytes(), covered.pc_bytes()) << name;
+            EXPECT_TRUE(std::equal(plain.avr()->data, plain.avr()->data + plain.avr()->ramend + 1, covered.avr()->data)) << name;
+            const auto distinct = std::count_if(map.begin(), map.end(), [](std::uint8_t c) { return c != 0; });
+            EXPECT_GE(distinct, 5) << name;
+            if (std::string(name) == "busy_poll") {
+                EXPECT_NE(std::count(map.begin(), map.end(), 0xFF), 0) << "the loop's edges saturate";
+            }
+            if (pass == 0) {
+                first = map;
+            } else {
+                EXPECT_EQ(map, first) << name << ": the same run gives the same map";
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace avrbench
