@@ -90,29 +90,36 @@ const SerialDecl* BoardSpec::find_serial(const std::string& n) const {
     return nullptr;
 }
 
-std::vector<std::string> standard_board_dirs() {
+namespace {
+
+// $ENV, then beside the installed avrbench (<prefix>/bin/avrbench and
+// <prefix>/share/avrbench/<data>), then the build tree's folder ("" = none).
+std::vector<std::string> standard_dirs(const char* env_var, const char* data, const char* build_tree_dir) {
     std::vector<std::string> dirs;
-    if (const char* env = std::getenv("AVRBENCH_BOARDS_DIR")) dirs.emplace_back(env);
-    // Installed: <prefix>/bin/avrbench and <prefix>/share/avrbench/boards.
+    if (const char* env = std::getenv(env_var)) dirs.emplace_back(env);
     std::error_code ec;
     const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "avrbench" / "boards").string());
-#ifdef AVRBENCH_SOURCE_BOARDS_DIR
-    dirs.emplace_back(AVRBENCH_SOURCE_BOARDS_DIR);  // running from the build tree
-#endif
+    if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "avrbench" / data).string());
+    if (*build_tree_dir != '\0') dirs.emplace_back(build_tree_dir);
     return dirs;
 }
 
-std::vector<std::string> standard_bootloader_dirs() {
-    std::vector<std::string> dirs;
-    if (const char* env = std::getenv("AVRBENCH_BOOTLOADERS_DIR")) dirs.emplace_back(env);
-    std::error_code ec;
-    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "avrbench" / "bootloaders").string());
-#ifdef AVRBENCH_BUILD_BOOTLOADERS_DIR
-    dirs.emplace_back(AVRBENCH_BUILD_BOOTLOADERS_DIR);  // running from the build tree
+}  // namespace
+
+std::vector<std::string> standard_board_dirs() {
+#ifdef AVRBENCH_SOURCE_BOARDS_DIR
+    return standard_dirs("AVRBENCH_BOARDS_DIR", "boards", AVRBENCH_SOURCE_BOARDS_DIR);
+#else
+    return standard_dirs("AVRBENCH_BOARDS_DIR", "boards", "");
 #endif
-    return dirs;
+}
+
+std::vector<std::string> standard_bootloader_dirs() {
+#ifdef AVRBENCH_BUILD_BOOTLOADERS_DIR
+    return standard_dirs("AVRBENCH_BOOTLOADERS_DIR", "bootloaders", AVRBENCH_BUILD_BOOTLOADERS_DIR);
+#else
+    return standard_dirs("AVRBENCH_BOOTLOADERS_DIR", "bootloaders", "");
+#endif
 }
 
 std::string find_board_file(const std::string& name_or_path) {
