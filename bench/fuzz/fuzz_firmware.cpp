@@ -7,6 +7,10 @@
 //   AVRBENCH_FUZZ_FAMILY the host's firmware family (grbl, marlin, teacup,
 //                        generic) when not the board's serial port's
 //   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
+//   AVRBENCH_FUZZ_SEEN   a file of the finding kinds already reported in the
+//                        campaign (FuzzFindings.hpp): an input whose finding
+//                        is of a kind listed there is not a crash, so a job
+//                        is not stopped and restarted for the same bug again
 //   AVRBENCH_FUZZ_RAW    1: the input's bytes go to the serial port as they
 //                        are, for binary protocols (seed 002's records): no
 //                        host, so no banner to wait for (the firmware boots
@@ -32,6 +36,7 @@
 // faults, part limits); a line the firmware never answers within the serial
 // port's line timeout (a hang); a fatal answer ("!!"). "error" answers and
 // restarts the firmware announces (grbl's ^X) are not findings.
+#include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -41,9 +46,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <string>
 
+#include "FuzzFindings.hpp"
 #include "FuzzMutator.hpp"
 #include "core/Errors.hpp"
 #include "verify/Bench.hpp"
@@ -207,8 +214,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::abort();
     }
     if (g_shared->finding != 0) {
-        std::fprintf(stderr, "avrbench fuzz: FINDING after %llu AVR instructions: %s\n",
-                     static_cast<unsigned long long>(g_shared->steps), g_shared->detail);
+        char line[kDetailBytes + 96];
+        std::snprintf(line, sizeof line, "avrbench fuzz: FINDING after %llu AVR instructions: %s",
+                      static_cast<unsigned long long>(g_shared->steps), g_shared->detail);
+        if (const char* seen = std::getenv("AVRBENCH_FUZZ_SEEN"); seen != nullptr && *seen != '\0') {
+            const std::string kind = avrbench::finding_kind(line);
+            std::ifstream in(seen);
+            for (std::string known; std::getline(in, known);) {
+                // Reported already: keep fuzzing, but keep the input out of the
+                // corpus (-1), or inputs that crash at once would crowd it.
+                if (known == kind) return -1;
+            }
+            // One short append (O_APPEND): jobs running side by side do not mix lines.
+            const int fd = ::open(seen, O_WRONLY | O_CREAT | O_APPEND, 0644);
+            if (fd >= 0) {
+                const std::string entry = kind + "\n";
+                (void)!::write(fd, entry.data(), entry.size());
+                ::close(fd);
+            }
+        }
+        std::fprintf(stderr, "%s\n", line);
         std::abort();
     }
     return 0;

@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "core/Errors.hpp"
+#include "fuzz/FuzzFindings.hpp"
 #include "core/Units.hpp"
 #include "stimulus/GcodeMutator.hpp"
 #include "stimulus/UartHost.hpp"
@@ -84,41 +85,6 @@ std::vector<std::string> seed_lines(const std::string& family) {
     if (family == "grbl") return {"G21 G91\nG1 X1 Y1 F500\n", "$$\n", "G0 X2\nG4 P0.1\n", "?"};
     if (family == "marlin" || family == "teacup") return {"G1 X1 Y1 F500\n", "G01 X0.5 Y0 F10\n", "M105\n", "M114\n", "G92 X0 Y0\n"};
     return {"G1 X1 F500\n", "\n"};
-}
-
-// "avrbench fuzz: FINDING after 28672 AVR instructions: timeout: line 1 'G1 X5'
-// got no answer within 1 s" -> "timeout: a line got no answer within 1 s":
-// grouped by what happened, not by which line or when.
-std::string finding_kind(std::string text) {
-    const auto colon = text.find("instructions: ");
-    if (colon != std::string::npos) text.erase(0, colon + 14);
-    for (auto at = text.find("line "); at != std::string::npos; at = text.find("line ", at + 1)) {
-        std::size_t i = at + 5;
-        while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
-        if (i == at + 5 || i + 1 >= text.size() || text[i] != ' ' || text[i + 1] != '\'') continue;
-        auto close = text.find('\'', i + 2);
-        if (close == std::string::npos) break;
-        // A long line is shown cut, with its length: "'G92 X0...' (129 bytes)".
-        if (text.compare(close + 1, 2, " (") == 0) {
-            const auto bytes = text.find(" bytes)", close);
-            if (bytes != std::string::npos && bytes < close + 16) close = bytes + 6;
-        }
-        text.replace(at, close + 1 - at, "a line");
-    }
-    // A crash: "interp: simavr-crash, PC 0x40ca strcpy+0x8: <detail>" - the
-    // place is the finding; the detail varies with the bytes written.
-    if (const auto pc = text.find(", PC "); pc != std::string::npos) {
-        const auto detail = text.find(": ", pc);
-        if (detail != std::string::npos) text.erase(detail);
-    }
-    // A finding's time and cycle: " at 1.200917 s (cycle 19214673)".
-    const auto when = text.find(" s (cycle ");
-    if (when != std::string::npos) {
-        const auto start = text.rfind(" at ", when);
-        const auto end = text.find(')', when);
-        if (start != std::string::npos && end != std::string::npos) text.erase(start, end + 1 - start);
-    }
-    return text;
 }
 
 // The finding an input gives when the target runs it once ("" for none).
@@ -200,7 +166,7 @@ int fuzz_command(const FuzzArgs& args) {
         std::ofstream dict(out / "gcode.dict");
         for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";
     }
-    const std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
+    std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
                                           "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
                                           std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
                                           "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot")))};
@@ -214,10 +180,16 @@ int fuzz_command(const FuzzArgs& args) {
                                      "-artifact_prefix=" + findings.string() + "/",
                                      "-seed=" + std::to_string(args.seed)};
     const std::string log = (out / "fuzz.log").string();
+    // Kinds of finding already reported in this campaign: a job does not
+    // stop (and restart) for a kind it or another job already found.
+    const std::string seen = (out / "seen-findings.txt").string();
+    fs::remove(seen);
+    std::vector<std::string> campaign_env = env;
+    campaign_env.push_back("AVRBENCH_FUZZ_SEEN=" + seen);
     std::printf("avrbench fuzz: %s on %s (family %s) for %.0f s, %d job(s); libFuzzer log %s\n", args.elf.c_str(),
                 args.board.c_str(), family.c_str(), seconds, std::max(1, args.jobs), log.c_str());
     std::fflush(stdout);
-    run_logged(argv, env, log);
+    run_logged(argv, campaign_env, log);
 
     // libFuzzer's fork-mode status lines: "#<execs>: cov: .. ft: <features> ..".
     std::vector<std::pair<unsigned long, unsigned long>> progress;

