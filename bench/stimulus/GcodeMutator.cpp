@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <random>
 
 namespace avrbench {
@@ -71,6 +73,7 @@ const char* to_string(GcodeMutation mutation) {
         case GcodeMutation::OverlongLine: return "overlong line";
         case GcodeMutation::BinaryByte: return "binary byte";
         case GcodeMutation::DegenerateArc: return "degenerate arc";
+        case GcodeMutation::NearbyNumber: return "nearby number";
         case GcodeMutation::ByteLevel: return "byte level";
     }
     return "?";
@@ -88,7 +91,7 @@ std::size_t mutate_gcode(std::uint8_t* data, std::size_t size, std::size_t max_s
                          ByteMutator byte_level, GcodeMutation* chosen) {
     std::mt19937 rng(seed);
     const auto pick = [&rng](std::size_t n) { return n == 0 ? 0 : std::uniform_int_distribution<std::size_t>(0, n - 1)(rng); };
-    const int kinds = byte_level != nullptr ? 9 : 8;
+    const int kinds = byte_level != nullptr ? 10 : 9;
     auto mutation = static_cast<GcodeMutation>(pick(static_cast<std::size_t>(kinds)));
     if (chosen != nullptr) *chosen = mutation;
     if (mutation == GcodeMutation::ByteLevel) return byte_level(data, size, max_size);
@@ -143,6 +146,28 @@ std::size_t mutate_gcode(std::uint8_t* data, std::size_t size, std::size_t max_s
             static const char* const kArcs[] = {"G2 X0 Y0 I0 J0", "G3 X0 Y0 I0 J0 F300", "G2 X10 Y10 I1e9 J0 F300",
                                                 "G2 X10 Y0 R0 F300", "G3 X1 Y1 I0.0001 J0 F300", "G2 I-5 J0 F300"};
             line = kArcs[pick(std::size(kArcs))];
+            break;
+        }
+        case GcodeMutation::NearbyNumber: {
+            // Data bugs with no branch of their own (an unchecked table index
+            // from a target just out of reach: seed 004) give coverage
+            // nothing to follow; they need numbers of the right size. Each
+            // word's number (at least one) is scaled by -4..4 or shifted by up
+            // to twice its magnitude (at least 100), and kept whole: the
+            // target moves to somewhere near, in any direction.
+            if (words.empty()) break;
+            const std::size_t always = pick(words.size());
+            for (std::size_t w = words.size(); w-- > 0;) {  // from the end: earlier offsets stay valid
+                const bool also = pick(2) == 0;
+                if (w != always && !also) continue;
+                const auto [begin, end] = words[w];
+                if (end - begin < 2) continue;
+                const double value = std::atof(line.substr(begin + 1, end - begin - 1).c_str());
+                const double magnitude = std::max(100.0, 2 * std::abs(value));
+                const double moved = pick(2) == 0 ? value * (static_cast<double>(pick(81)) / 10.0 - 4.0)
+                                                  : value + (static_cast<double>(pick(2001)) / 1000.0 - 1.0) * magnitude;
+                line.replace(begin + 1, end - begin - 1, std::to_string(static_cast<long>(moved)));
+            }
             break;
         }
         case GcodeMutation::ByteLevel: break;

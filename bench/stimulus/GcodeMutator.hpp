@@ -1,7 +1,8 @@
 // Structure-aware mutation of G-code for fuzzing firmware (bench/fuzz): keeps
 // lines mostly well formed and aims at what parsers get wrong - extreme and
 // malformed numbers (1e9, -0, 99999999999), a missing F word, overlong lines,
-// huge or degenerate arcs, binary bytes - and otherwise hands the bytes to a
+// huge or degenerate arcs, binary bytes, plausible numbers a few times off
+// (where a machine's reachable space ends) - and otherwise hands the bytes to a
 // byte-level mutator (libFuzzer's LLVMFuzzerMutate). Deterministic: the
 // same input, size limit and seed give the same output.
 #pragma once
@@ -22,6 +23,7 @@ enum class GcodeMutation {
     OverlongLine,    // a line padded past 50..400 bytes
     BinaryByte,      // a byte outside printable ASCII inserted
     DegenerateArc,   // G2/G3 with a zero or huge radius, or the end at the start
+    NearbyNumber,    // a number moved within a few times its size: a target just outside the workspace
     ByteLevel,       // the fallback mutator's change
 };
 

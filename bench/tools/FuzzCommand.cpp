@@ -1,7 +1,9 @@
 // `avrbench fuzz`: the front door to the firmware fuzz target
-// (bench/fuzz/fuzz_firmware.cpp, Debian's libFuzzer). Checks the board and
-// firmware, writes a seed corpus and a G-code dictionary, runs libFuzzer in
-// fork mode for the given wall time (findings do not stop the campaign),
+// (bench/fuzz/FirmwareTarget.hpp). Checks the board and firmware, writes a
+// seed corpus and a G-code dictionary, runs the engine for the given wall
+// time - Debian's libFuzzer in fork mode (fuzz_firmware.cpp), or Debian's
+// AFL++ as one main and --jobs - 1 secondary instances on a shared sync
+// directory (fuzz_firmware_afl.cpp); findings do not stop the campaign -
 // then replays every reproducer once to name its finding, groups them, and
 // records one run per distinct finding with `avrbench run` (summary + VCD).
 #include "tools/FuzzCommand.hpp"
@@ -41,19 +43,34 @@ std::string self_dir() {
     return ec ? std::string(".") : exe.parent_path().string();
 }
 
-std::string find_target() {
-    if (const char* env = std::getenv("AVRBENCH_FUZZ_TARGET")) return env;
-    const std::string beside = self_dir() + "/avrbench-fuzz-firmware";
+std::string find_target(const std::string& name, const char* override_variable) {
+    if (const char* env = std::getenv(override_variable)) return env;
+    const std::string beside = self_dir() + "/" + name;
     if (fs::exists(beside)) return beside;
-    throw BadInput("avrbench-fuzz-firmware not found beside avrbench (" + beside +
-                   "); it is built with Debian's libFuzzer (libfuzzer-14-dev, ci/setup)");
+    throw BadInput(name + " not found beside avrbench (" + beside + "); the build makes it (bench/CMakeLists.txt)");
 }
 
-// Runs argv with `env` added; stdout+stderr to `log`. Returns the exit status.
-int run_logged(const std::vector<std::string>& argv, const std::vector<std::string>& env, const std::string& log) {
-    std::vector<std::string> environment;
-    for (char** e = environ; *e != nullptr; ++e) environment.emplace_back(*e);
-    environment.insert(environment.end(), env.begin(), env.end());
+// A program on PATH (the AFL++ tools), or BadInput naming the package.
+std::string find_on_path(const std::string& program, const std::string& package) {
+    const char* path = std::getenv("PATH");
+    std::istringstream dirs(path != nullptr ? path : "/usr/bin");
+    for (std::string dir; std::getline(dirs, dir, ':');) {
+        const fs::path candidate = fs::path(dir.empty() ? "." : dir) / program;
+        if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
+    }
+    throw BadInput(program + " not found on PATH; install Debian's " + package + " (ci/setup lists it)");
+}
+
+// Starts argv with `env` added; stdout+stderr to `log`. Returns the pid.
+pid_t spawn_logged(const std::vector<std::string>& argv, const std::vector<std::string>& env, const std::string& log) {
+    // `env` replaces variables of the same name (getenv takes the first).
+    const auto name_of = [](const std::string& entry) { return entry.substr(0, entry.find('=')); };
+    std::vector<std::string> environment = env;
+    for (char** e = environ; *e != nullptr; ++e) {
+        const std::string entry(*e);
+        const bool replaced = std::any_of(env.begin(), env.end(), [&](const std::string& mine) { return name_of(mine) == name_of(entry); });
+        if (!replaced) environment.push_back(entry);
+    }
     std::vector<char*> args, envp;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -67,10 +84,19 @@ int run_logged(const std::vector<std::string>& argv, const std::vector<std::stri
     const int rc = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
     if (rc != 0) throw BadInput(argv[0] + ": cannot start (" + std::strerror(rc) + ")");
+    return pid;
+}
+
+int wait_for(pid_t pid) {
     int status = 0;
     while (waitpid(pid, &status, 0) < 0) {
     }
     return status;
+}
+
+// Runs argv with `env` added; stdout+stderr to `log`. Returns the exit status.
+int run_logged(const std::vector<std::string>& argv, const std::vector<std::string>& env, const std::string& log) {
+    return wait_for(spawn_logged(argv, env, log));
 }
 
 std::string slurp(const std::string& path) {
@@ -87,10 +113,21 @@ std::vector<std::string> seed_lines(const std::string& family) {
     return {"G1 X1 F500\n", "\n"};
 }
 
+// How a target runs one input: libFuzzer's needs -runs=1, AFL++'s runs its
+// argument once when no fork server is listening.
+struct Target {
+    std::string path;
+    bool libfuzzer = true;
+};
+
 // The finding an input gives when the target runs it once ("" for none).
-std::string replay(const std::string& target, const std::vector<std::string>& env, const fs::path& input) {
+std::string replay(const Target& target, const std::vector<std::string>& env, const fs::path& input) {
     const std::string log = input.string() + ".replay.txt";
-    run_logged({target, "-runs=1", input.string()}, env, log);
+    if (target.libfuzzer) {
+        run_logged({target.path, "-runs=1", input.string()}, env, log);
+    } else {
+        run_logged({target.path, input.string()}, env, log);
+    }
     const std::string output = slurp(log);
     fs::remove(log);
     const auto at = output.find("avrbench fuzz: FINDING");
@@ -100,7 +137,7 @@ std::string replay(const std::string& target, const std::vector<std::string>& en
 // Shrinks `bytes` while the target still reports the same kind of finding:
 // whole lines first, then single bytes (a greedy pass each; every try is a
 // replay, so the tries are bounded).
-std::string minimize(const std::string& target, const std::vector<std::string>& env, const fs::path& scratch,
+std::string minimize(const Target& target, const std::vector<std::string>& env, const fs::path& scratch,
                      std::string bytes, const std::string& kind) {
     int budget = 150;
     const auto same = [&](const std::string& candidate) {
@@ -135,42 +172,22 @@ std::string minimize(const std::string& target, const std::vector<std::string>& 
     return bytes;
 }
 
-}  // namespace
+// What a campaign leaves for the replays, whichever engine ran it.
+struct Campaign {
+    Target target;
+    unsigned long executions = 0;
+    unsigned long coverage_start = 0, coverage_end = 0;
+    unsigned long wall_timeouts = 0;  // AFL++ only
+    std::vector<fs::path> artifacts;  // inputs the engine kept as crashes
+    std::string artifact_dir;
+};
 
-int fuzz_command(const FuzzArgs& args) {
-    const double seconds = seconds_from_ps(parse_duration_ps(args.duration, "--for"));
-    const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
-    if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
-    std::string family;
-    {
-        Bench bench(args.board, args.elf);  // BadInput for a bad board or ELF, as `run` says it
-        if (bench.board().mcus().size() != 1) {
-            throw BadInput(args.board + ": has " + std::to_string(bench.board().mcus().size()) +
-                           " MCUs; avrbench fuzz steps boards with one MCU");
-        }
-        family = args.family.empty() ? bench.serial_decl().family : args.family;
-        (void)parse_firmware_family(family, "--family");
-    }
-    const std::string target = find_target();
-    const fs::path out = args.out;
-    const fs::path corpus = out / "corpus", findings = out / "findings";
-    fs::create_directories(corpus);
-    fs::create_directories(findings);
-    // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
-    // coverage finds the rest.
-    const std::vector<std::string> seeds =
-        args.raw ? std::vector<std::string>{std::string("\x3b", 1), std::string("\x00\x00\x10\x00\x10\x40\x40\x05", 8)}
-                 : seed_lines(family);
-    for (std::size_t i = 0; i < seeds.size(); ++i) std::ofstream(corpus / ("seed-" + std::to_string(i))) << seeds[i];
-    {
-        std::ofstream dict(out / "gcode.dict");
-        for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";
-    }
-    std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
-                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
-                                          std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
-                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot")))};
-    std::vector<std::string> argv = {target,
+Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>& env, const fs::path& out,
+                            const fs::path& corpus, const fs::path& findings, double seconds, const std::string& family) {
+    Campaign campaign;
+    campaign.target = {find_target("avrbench-fuzz-firmware", "AVRBENCH_FUZZ_TARGET"), true};
+    campaign.artifact_dir = findings.string();
+    std::vector<std::string> argv = {campaign.target.path,
                                      corpus.string(),
                                      "-max_total_time=" + std::to_string(static_cast<long>(seconds)),
                                      "-fork=" + std::to_string(std::max(1, args.jobs)),
@@ -204,21 +221,166 @@ int fuzz_command(const FuzzArgs& args) {
         }
     }
     if (progress.empty()) throw BadInput(log + ": libFuzzer reported no progress (see the log)");
-    const unsigned long execs = progress.back().first;
-    std::printf("  executions %lu (%.0f per second)\n", execs, static_cast<double>(execs) / seconds);
-    std::printf("  coverage   firmware edge features %lu at the start, %lu at the end\n", progress.front().second,
-                progress.back().second);
+    campaign.executions = progress.back().first;
+    campaign.coverage_start = progress.front().second;
+    campaign.coverage_end = progress.back().second;
+    for (const auto& entry : fs::directory_iterator(findings)) {
+        if (entry.path().filename().string().rfind("crash-", 0) == 0 && entry.path().extension().empty()) {
+            campaign.artifacts.push_back(entry.path());
+        }
+    }
+    return campaign;
+}
+
+// "key : value" from an AFL++ fuzzer_stats file (0 when absent).
+unsigned long afl_stat(const fs::path& stats, const std::string& key) {
+    std::istringstream lines(slurp(stats.string()));
+    for (std::string line; std::getline(lines, line);) {
+        const auto colon = line.find(':');
+        if (colon == std::string::npos) continue;
+        std::string name = line.substr(0, colon);
+        name.erase(name.find_last_not_of(' ') + 1);
+        if (name == key) return std::strtoul(line.c_str() + colon + 1, nullptr, 10);
+    }
+    return 0;
+}
+
+Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env, const fs::path& out,
+                      const fs::path& corpus, double seconds, double bound_s, const std::string& family) {
+    Campaign campaign;
+    campaign.target = {find_target("avrbench-fuzz-firmware-afl", "AVRBENCH_FUZZ_AFL_TARGET"), false};
+    const std::string afl_fuzz = find_on_path("afl-fuzz", "afl++");
+    const std::string afl_showmap = find_on_path("afl-showmap", "afl++");
+    const fs::path sync = out / "afl";
+    fs::remove_all(sync);  // AFL++ refuses to resume into a finished directory without -i -
+    // Wall-clock limit per input, generous: an input may take bound_s of
+    // simulated time, and the slowest firmware here runs ~10x real time.
+    const long timeout_ms = 2000 + static_cast<long>(bound_s * 1000);
+    std::vector<std::string> afl_env = env;
+    afl_env.insert(afl_env.end(), {"AFL_SKIP_CPUFREQ=1", "AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1", "AFL_NO_UI=1",
+                                   "AFL_NO_AFFINITY=1", "AFL_FORKSRV_INIT_TMOUT=60000",
+                                   // AFL++ refuses sanitizer settings that do not abort (a sanitized build of the bench)
+                                   "ASAN_OPTIONS=abort_on_error=1:symbolize=0:detect_leaks=0",
+                                   "UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:symbolize=0"});
+    if (!args.raw) {
+        // The structure-aware G-code mutator (bench/fuzz/afl_gcode_mutator.cpp) beside AFL++'s own havoc.
+        const std::string mutator = self_dir() + "/libavrbench-afl-gcode-mutator.so";
+        if (fs::exists(mutator)) afl_env.push_back("AFL_CUSTOM_MUTATOR_LIBRARY=" + mutator);
+    }
+    const int jobs = std::max(1, args.jobs);
+    std::printf("avrbench fuzz: %s on %s (family %s) for %.0f s, AFL++ with %d instance(s) on %s; logs %s/*.log\n",
+                args.elf.c_str(), args.board.c_str(), family.c_str(), seconds, jobs, sync.string().c_str(),
+                out.string().c_str());
+    std::fflush(stdout);
+    std::vector<pid_t> instances;
+    for (int i = 0; i < jobs; ++i) {
+        const std::string name = i == 0 ? "main" : "secondary-" + std::to_string(i);
+        std::vector<std::string> argv = {afl_fuzz,
+                                         "-i", corpus.string(),
+                                         "-o", sync.string(),
+                                         i == 0 ? "-M" : "-S", name,
+                                         "-V", std::to_string(static_cast<long>(seconds)),
+                                         "-t", std::to_string(timeout_ms),
+                                         "-s", std::to_string(args.seed + static_cast<unsigned>(i)),
+                                         "-x", (out / "gcode.dict").string(),
+                                         "--", campaign.target.path, "@@"};
+        instances.push_back(spawn_logged(argv, afl_env, (out / ("afl-" + name + ".log")).string()));
+    }
+    // Coverage of the seeds alone, with AFL++'s own count, while the instances start.
+    const fs::path seed_map = out / "seed-coverage.txt";
+    run_logged({afl_showmap, "-C", "-i", corpus.string(), "-o", seed_map.string(), "-t", std::to_string(timeout_ms),
+                "--", campaign.target.path, "@@"},
+               afl_env, (out / "afl-showmap.log").string());
+    {
+        std::ifstream map(seed_map);
+        for (std::string line; std::getline(map, line);) ++campaign.coverage_start;
+    }
+    bool all_ran = true;
+    for (pid_t pid : instances) {
+        const int status = wait_for(pid);
+        all_ran = all_ran && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    }
+    if (!fs::exists(sync / "main" / "fuzzer_stats")) {
+        throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (see the log)");
+    }
+    if (!all_ran) std::printf("  (an AFL++ instance ended with an error; see %s/afl-*.log)\n", out.string().c_str());
+    campaign.coverage_end = afl_stat(sync / "main" / "fuzzer_stats", "edges_found");  // main imports the others' finds
+    campaign.artifact_dir = (sync / "*" / "crashes").string();
+    for (const auto& instance : fs::directory_iterator(sync)) {
+        campaign.executions += afl_stat(instance.path() / "fuzzer_stats", "execs_done");
+        campaign.wall_timeouts += afl_stat(instance.path() / "fuzzer_stats", "saved_hangs");
+        if (!fs::is_directory(instance.path() / "crashes")) continue;
+        for (const auto& entry : fs::directory_iterator(instance.path() / "crashes")) {
+            if (entry.path().filename().string().rfind("id:", 0) == 0) campaign.artifacts.push_back(entry.path());
+        }
+    }
+    return campaign;
+}
+
+}  // namespace
+
+int fuzz_command(const FuzzArgs& args) {
+    const double seconds = seconds_from_ps(parse_duration_ps(args.duration, "--for"));
+    const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
+    if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
+    std::string family;
+    {
+        Bench bench(args.board, args.elf);  // BadInput for a bad board or ELF, as `run` says it
+        if (bench.board().mcus().size() != 1) {
+            throw BadInput(args.board + ": has " + std::to_string(bench.board().mcus().size()) +
+                           " MCUs; avrbench fuzz steps boards with one MCU");
+        }
+        family = args.family.empty() ? bench.serial_decl().family : args.family;
+        (void)parse_firmware_family(family, "--family");
+    }
+    const fs::path out = args.out;
+    const fs::path corpus = out / "corpus", findings = out / "findings";
+    fs::create_directories(corpus);
+    fs::create_directories(findings);
+    // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
+    // coverage finds the rest.
+    const std::vector<std::string> seeds =
+        args.raw ? std::vector<std::string>{std::string("\x3b", 1), std::string("\x00\x00\x10\x00\x10\x40\x40\x05", 8)}
+                 : seed_lines(family);
+    for (std::size_t i = 0; i < seeds.size(); ++i) std::ofstream(corpus / ("seed-" + std::to_string(i))) << seeds[i];
+    if (!args.corpus.empty()) {
+        std::error_code ec;
+        if (!fs::is_directory(args.corpus, ec)) throw BadInput(args.corpus + ": --corpus is not a directory");
+        std::size_t copied = 0;
+        for (const auto& entry : fs::directory_iterator(args.corpus)) {
+            if (!entry.is_regular_file()) continue;
+            fs::copy_file(entry.path(), corpus / ("user-" + entry.path().filename().string()), fs::copy_options::overwrite_existing);
+            ++copied;
+        }
+        if (copied == 0) throw BadInput(args.corpus + ": --corpus holds no files");
+    }
+    {
+        std::ofstream dict(out / "gcode.dict");
+        for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";  // libFuzzer's and AFL's format
+    }
+    std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
+                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
+                                          std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
+                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot")))};
+    Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
+                                             : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
+    const Target& target = campaign.target;
+    std::printf("  executions %lu (%.0f per second)\n", campaign.executions,
+                static_cast<double>(campaign.executions) / seconds);
+    std::printf("  coverage   firmware edge %s %lu at the start, %lu at the end\n",
+                campaign.target.libfuzzer ? "features" : "tuples (AFL++'s edges)", campaign.coverage_start,
+                campaign.coverage_end);
+    if (campaign.wall_timeouts != 0) {
+        std::printf("  timeouts   %lu inputs ran past AFL++'s wall-clock limit (out/afl/*/hangs; not findings: "
+                    "the simulated bound is the hang oracle)\n",
+                    campaign.wall_timeouts);
+    }
 
     // Replay each reproducer once: the target prints the finding and aborts.
     std::map<std::string, std::vector<fs::path>> by_finding;
     std::map<std::string, std::string> example;  // finding -> the first replay's whole line
     std::size_t not_reproduced = 0;
-    std::vector<fs::path> artifacts;
-    for (const auto& entry : fs::directory_iterator(findings)) {
-        if (entry.path().filename().string().rfind("crash-", 0) == 0 && entry.path().extension().empty()) {
-            artifacts.push_back(entry.path());
-        }
-    }
+    std::vector<fs::path>& artifacts = campaign.artifacts;
     std::sort(artifacts.begin(), artifacts.end());
     for (const auto& artifact : artifacts) {
         const std::string line = replay(target, env, artifact);
@@ -231,7 +393,7 @@ int fuzz_command(const FuzzArgs& args) {
         example.emplace(finding, line.substr(line.find("instructions: ") + 14));
     }
     std::printf("  findings   %zu distinct (%zu reproducers in %s", by_finding.size(), artifacts.size(),
-                findings.string().c_str());
+                campaign.artifact_dir.c_str());
     if (not_reproduced != 0) std::printf("; %zu did not reproduce on replay", not_reproduced);
     std::printf(")\n");
     int index = 0;

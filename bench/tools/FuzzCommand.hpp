@@ -11,9 +11,11 @@ struct FuzzArgs {
     std::string duration = "60s";  // wall-clock time of the campaign
     std::string bound = "5s";      // simulated time one input may take
     std::string out = "fuzz-out";
-    std::string family;  // "" = the board's serial port's
+    std::string family;  // "" = the board's
+    std::string corpus;  // a directory of seed inputs, or "" serial port's
     bool raw = false;             // bytes straight to the port (binary protocols)
     std::string boot = "0.2s";    // raw: simulated time the firmware boots before the first input
+    std::string engine = "libfuzzer";  // or "afl"
     int jobs = 1;
     unsigned seed = 1;
 };

@@ -864,7 +864,7 @@ int main(int argc, char** argv) {
     cam_cmd->add_option("--feed", cam.feed, "drawing feed in mm/min (default 600)");
 
     FuzzArgs fuzz;
-    CLI::App* fuzz_cmd = app.add_subcommand("fuzz", "coverage-guided G-code fuzzing of a firmware on a board (libFuzzer; docs/FUZZING.md)");
+    CLI::App* fuzz_cmd = app.add_subcommand("fuzz", "coverage-guided G-code fuzzing of a firmware on a board (libFuzzer or AFL++; docs/FUZZING.md)");
     fuzz_cmd->add_option("--elf", fuzz.elf, "the firmware")->required();
     fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name (one MCU)")->required();
     fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s)");
@@ -873,8 +873,11 @@ int main(int argc, char** argv) {
     fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, teacup, generic (default: the board's)");
     fuzz_cmd->add_flag("--raw", fuzz.raw, "send the input's bytes to the port as they are (binary protocols such as seed 002's records)");
     fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw: simulated time the firmware boots before the first input (default 0.2s)");
-    fuzz_cmd->add_option("--jobs", fuzz.jobs, "parallel libFuzzer jobs (default 1)");
-    fuzz_cmd->add_option("--seed", fuzz.seed, "libFuzzer's random seed (default 1)");
+    fuzz_cmd->add_option("--corpus", fuzz.corpus, "a directory of seed inputs (your jobs' lines) added to the family's seed lines");
+    fuzz_cmd->add_option("--engine", fuzz.engine, "libfuzzer (default) or afl (Debian's afl++: one main and --jobs - 1 secondary instances)")
+        ->check(CLI::IsMember({"libfuzzer", "afl"}));
+    fuzz_cmd->add_option("--jobs", fuzz.jobs, "parallel jobs: libFuzzer's fork jobs or AFL++ instances (default 1)");
+    fuzz_cmd->add_option("--seed", fuzz.seed, "the engine's random seed (default 1)");
 
     try {
         app.parse(argc, argv);

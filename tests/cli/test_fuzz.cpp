@@ -6,7 +6,9 @@
 // slower); the improved build must give nothing
 // in 10 s. The thesis run's board has a 0.5 s line timeout (see its file:
 // the listing sends no keep-alive). The seed corpus holds well-formed lines
-// only; the overrun comes from the search. Wall-clock guards: 90 s per run.
+// only; the overrun comes from the search. The same with AFL++ (--engine
+// afl, its own fork server in the target, the G-code mutator as its custom
+// mutator): 20 s. Wall-clock guards: 90 s per run.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -18,22 +20,31 @@ namespace avrbench {
 namespace {
 
 std::string fuzz(const std::string& elf, const std::string& board, const std::string& seconds, const std::filesystem::path& dir,
-                 int* exit_code) {
-    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --elf " + test::firmware(elf) + " --board " +
-                                test::source_path("tests/fixtures/fuzz/firmware/" + board) +
-                                " --for " + seconds + " --seed 1 --out " + (dir / "out").string();
+                 int* exit_code, const std::string& engine = "libfuzzer") {
+    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --engine " + engine + " --elf " + test::firmware(elf) +
+                                " --board " + test::source_path("tests/fixtures/fuzz/firmware/" + board) + " --for " +
+                                seconds + " --seed 1 --out " + (dir / "out").string();
     const auto r = test::run_command(command, dir, 90);
     *exit_code = r.exit_code;
     return r.out + r.err;
 }
 
-// "firmware edge features 2186 at the start, 7015 at the end" -> {2186, 7015}.
+// "firmware edge features 2186 at the start, 7015 at the end" -> {2186, 7015};
+// AFL++: "firmware edge tuples (AFL++'s edges) 1737 at the start, 2400 at the end".
 std::pair<long, long> features(const std::string& out) {
-    const auto at = out.find("firmware edge features ");
-    if (at == std::string::npos) return {-1, -1};
     long first = -1, last = -1;
-    std::sscanf(out.c_str() + at, "firmware edge features %ld at the start, %ld at the end", &first, &last);
+    if (const auto at = out.find("firmware edge features "); at != std::string::npos) {
+        std::sscanf(out.c_str() + at, "firmware edge features %ld at the start, %ld at the end", &first, &last);
+    } else if (const auto afl = out.find("(AFL++'s edges) "); afl != std::string::npos) {
+        std::sscanf(out.c_str() + afl, "(AFL++'s edges) %ld at the start, %ld at the end", &first, &last);
+    }
     return {first, last};
+}
+
+bool reports_a_crash(const std::string& out) {
+    return out.find("simavr-crash, PC") != std::string::npos || out.find("pc-outside-program, PC") != std::string::npos ||
+           out.find("pc-outside-program from") != std::string::npos || out.find("stack-overflow, PC") != std::string::npos ||
+           out.find("invalid-opcode, PC") != std::string::npos;
 }
 
 TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
@@ -42,9 +53,7 @@ TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
     const std::string out = fuzz("printer3d_interp_thesis_parser", "printer3d-interp-thesis.yaml", "30s", dir, &code);
     EXPECT_EQ(code, 1) << out;
     EXPECT_NE(out.find("timeout: a line got no answer within 0.5 s"), std::string::npos) << out;
-    const bool crash = out.find("simavr-crash, PC") != std::string::npos || out.find("pc-outside-program, PC") != std::string::npos ||
-                       out.find("stack-overflow, PC") != std::string::npos || out.find("invalid-opcode, PC") != std::string::npos;
-    EXPECT_TRUE(crash) << out;
+    EXPECT_TRUE(reports_a_crash(out)) << out;
     const auto [first, last] = features(out);
     EXPECT_GT(first, 0) << out;
     EXPECT_GT(last, first) << "coverage must grow over the run\n" << out;
@@ -61,6 +70,29 @@ TEST(Fuzz, FindsNothingInTheImprovedInterpolator) {
     EXPECT_NE(out.find(" per second)"), std::string::npos) << out;
 }
 
+TEST(Fuzz, AflFindsTheThesisParsersPlantedBugs) {
+    const auto dir = test::scratch_dir("fuzz-afl-thesis");
+    int code = 0;
+    const std::string out = fuzz("printer3d_interp_thesis_parser", "printer3d-interp-thesis.yaml", "20s", dir, &code, "afl");
+    EXPECT_EQ(code, 1) << out;
+    EXPECT_NE(out.find("AFL++ with 1 instance(s)"), std::string::npos) << out;
+    EXPECT_NE(out.find("timeout: a line got no answer within 0.5 s"), std::string::npos) << out;
+    EXPECT_TRUE(reports_a_crash(out)) << out;
+    const auto [first, last] = features(out);
+    EXPECT_GT(first, 0) << out;
+    EXPECT_GT(last, first) << "coverage must grow over the run\n" << out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/afl/main/fuzzer_stats"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/findings/finding-1.vcd"));
+}
+
+TEST(Fuzz, AflFindsNothingInTheImprovedInterpolator) {
+    const auto dir = test::scratch_dir("fuzz-afl-improved");
+    int code = 0;
+    const std::string out = fuzz("printer3d_interp", "printer3d-interp-alone.yaml", "10s", dir, &code, "afl");
+    EXPECT_EQ(code, 0) << out;
+    EXPECT_NE(out.find("findings   0 distinct"), std::string::npos) << out;
+}
+
 TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("fuzz-bad");
     const auto r = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
@@ -73,6 +105,15 @@ TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
                                              dir, 30);
     EXPECT_EQ(no_target.exit_code, 2) << no_target.out << no_target.err;
     EXPECT_NE(no_target.err.find("/nonexistent: cannot start"), std::string::npos) << no_target.err;
+    const auto no_afl = test::run_command("PATH=/nonexistent " + std::string(AVRBENCH_CLI) + " fuzz --engine afl --elf " +
+                                              test::firmware("printer3d_interp") + " --board " +
+                                              test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
+                                              " --for 5s --out " + (dir / "out-afl").string(),
+                                          dir, 30);
+    EXPECT_EQ(no_afl.exit_code, 2) << no_afl.out << no_afl.err;
+    EXPECT_NE(no_afl.err.find("afl-fuzz not found on PATH; install Debian's afl++"), std::string::npos) << no_afl.err;
+    const auto bad_engine = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --engine honggfuzz --elf x --board y", dir, 30);
+    EXPECT_EQ(bad_engine.exit_code, 2) << bad_engine.out << bad_engine.err;
 }
 
 }  // namespace

@@ -61,6 +61,15 @@ TEST(GcodeMutator, MakesEveryKindOfMutationAndEachDoesWhatItSays) {
                 EXPECT_EQ(m.text[0], 'G') << m.text;
                 EXPECT_NE(m.text, line);
                 break;
+            case GcodeMutation::NearbyNumber: {
+                // Words' numbers replaced by whole numbers: 1 (G1) within
+                // [-99, 101], 5 within [-95, 105], 600 within [-2400, 2400]:
+                // at most 2 more characters per word.
+                EXPECT_EQ(m.text.rfind("G", 0), 0u) << m.text;
+                EXPECT_LE(m.text.size(), line.size() + 8) << m.text;
+                EXPECT_EQ(m.text.find_first_not_of("GXYF0123456789- \n"), std::string::npos) << m.text;
+                break;
+            }
             case GcodeMutation::ByteLevel:
                 EXPECT_EQ(m.text, std::string(line.rbegin(), line.rend())) << "the fallback's bytes, untouched";
                 break;
@@ -81,6 +90,23 @@ TEST(GcodeMutator, ExtremeNumbersIncludeTheIssuesExamples) {
         for (auto& [text, hit] : found) hit = hit || m.text.find(text) != std::string::npos;
     }
     for (const auto& [text, hit] : found) EXPECT_TRUE(hit) << text;
+}
+
+TEST(GcodeMutator, NearbyNumbersStayWithinAFewTimesTheOriginal) {
+    // From X-33 (mm): scaled by -4..4 gives -132..132, shifted by up to
+    // max(100, 66) gives -133..67; all within [-133, 133], and both signs come up.
+    bool negative = false, positive = false, moved = false;
+    for (unsigned seed = 0; seed < 3000; ++seed) {
+        const Mutated m = mutate("G1 X-33\n", seed);
+        if (m.kind != GcodeMutation::NearbyNumber) continue;
+        const long x = std::strtol(m.text.c_str() + m.text.find('X') + 1, nullptr, 10);
+        EXPECT_GE(x, -133) << m.text;
+        EXPECT_LE(x, 133) << m.text;
+        negative = negative || x < 0;
+        positive = positive || x > 0;
+        moved = moved || x != -33;
+    }
+    EXPECT_TRUE(negative && positive && moved);
 }
 
 TEST(GcodeMutator, KeepsToTheSizeLimitAndIsDeterministic) {

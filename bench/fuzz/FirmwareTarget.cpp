@@ -1,0 +1,132 @@
+#include "FirmwareTarget.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "core/Errors.hpp"
+#include "verify/Bench.hpp"
+
+namespace avrbench::fuzz {
+
+namespace {
+
+// Never destroyed: at exit the fixes' registries (function-local statics)
+// may go first, and the process is ending anyway.
+Bench* g_bench = nullptr;
+TargetConfig g_config;
+std::size_t g_findings_at_ready = 0;
+
+std::string env_or_die(const char* name, const char* who) {
+    const char* value = std::getenv(name);
+    if (value == nullptr || *value == '\0') {
+        std::fprintf(stderr, "%s: set %s (see bench/fuzz/FirmwareTarget.hpp)\n", who, name);
+        std::exit(2);
+    }
+    return value;
+}
+
+// A restart mid-job is not one: grbl's ^X restarts on purpose, and a reset
+// the firmware did not ask for is already an MCU finding (watchdog, jump to 0).
+bool is_oracle_event(HostEventKind kind) { return kind == HostEventKind::Timeout || kind == HostEventKind::Fatal; }
+
+}  // namespace
+
+TargetConfig config_from_environment(const char* who) {
+    TargetConfig config;
+    config.board = env_or_die("AVRBENCH_FUZZ_BOARD", who);
+    config.elf = env_or_die("AVRBENCH_FUZZ_ELF", who);
+    if (const char* family = std::getenv("AVRBENCH_FUZZ_FAMILY")) config.family = family;
+    if (const char* bound = std::getenv("AVRBENCH_FUZZ_BOUND")) config.bound_s = std::max(0.01, std::atof(bound));
+    if (const char* settle = std::getenv("AVRBENCH_FUZZ_SETTLE")) config.settle_s = std::max(0.0, std::atof(settle));
+    if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) config.raw = std::string(raw) == "1";
+    if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) config.boot_s = std::max(0.0, std::atof(boot));
+    return config;
+}
+
+bool target_is_raw() { return g_config.raw; }
+
+void boot_target(const TargetConfig& config, const char* who) {
+    g_config = config;
+    try {
+        g_bench = new Bench(config.board, config.elf);
+        if (g_bench->board().mcus().size() != 1) {
+            std::fprintf(stderr, "%s: %s has %zu MCUs; the fuzz target steps one\n", who, config.board.c_str(),
+                         g_bench->board().mcus().size());
+            std::exit(2);
+        }
+        Mcu& mcu = g_bench->mcu();
+        if (config.raw) {
+            (void)g_bench->serial();  // the USART model listens from here on
+            g_bench->run_for(config.boot_s);
+        } else {
+            UartHostOptions options = default_host_options(g_bench->serial_decl());
+            if (!config.family.empty()) options.family = parse_firmware_family(config.family, "AVRBENCH_FUZZ_FAMILY");
+            UartHost& host = g_bench->host("", options);
+            const Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
+            while (!host.ready() && !host.failed() && !mcu.halted() && mcu.cycle() < limit) g_bench->run_for(0.001);
+            if (!host.ready()) {
+                std::fprintf(stderr, "%s: %s never became ready on %s (%s)\n", who, config.elf.c_str(),
+                             config.board.c_str(), host.failed() ? host.failure_message().c_str() : "no banner");
+                std::exit(2);
+            }
+        }
+        g_findings_at_ready = g_bench->board().findings().size();
+    } catch (const BadInput& e) {
+        std::fprintf(stderr, "%s: %s\n", who, e.what());
+        std::exit(2);
+    }
+}
+
+void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_map, std::uint32_t edge_mask,
+               InputOutcome& outcome) {
+    Bench& bench = *g_bench;
+    Mcu& mcu = bench.mcu();
+    UartHost* host = g_config.raw ? nullptr : &bench.host();
+    Uart& serial = bench.serial();
+    const std::string bytes(reinterpret_cast<const char*>(data), size);
+    if (host != nullptr) {
+        try {
+            host->add_lines(bytes);
+        } catch (const BadInput&) {
+            return;  // nothing the host would send (it refuses such a job up front)
+        }
+    } else {
+        serial.send(bytes);
+    }
+    // Done sending: every line answered (or the host gave up), or every raw byte taken.
+    const auto sent = [&] { return host != nullptr ? host->finished() : serial.pending_rx() == 0; };
+    Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_config.bound_s);
+    // The run loop with coverage (Mcu::run_until_covering), in slices of 1 ms
+    // simulated between which the settle time may start.
+    PcEdgeMap edges{edge_map, edge_mask};
+    const Cycle slice = mcu.cycles_from_seconds(0.001);
+    const std::uint64_t steps_before = mcu.steps();
+    bool settling = false;
+    while (mcu.cycle() < end && !mcu.halted()) {
+        if (!settling && sent()) {
+            settling = true;
+            end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_config.settle_s));
+        }
+        mcu.run_until_covering(std::min(end, mcu.cycle() + slice), edges);
+    }
+    outcome.steps = mcu.steps() - steps_before;
+    std::string detail;
+    const auto findings = bench.board().findings();  // the MCU's, the nets', the parts'
+    if (findings.size() > g_findings_at_ready) detail = findings[g_findings_at_ready].describe();
+    if (detail.empty() && host != nullptr) {
+        for (const auto& e : host->events()) {
+            if (is_oracle_event(e.kind)) {
+                detail = std::string(to_string(e.kind)) + ": " + e.message;
+                break;
+            }
+        }
+    }
+    if (!detail.empty()) {
+        outcome.finding = true;
+        std::snprintf(outcome.detail, sizeof outcome.detail, "%s", detail.c_str());
+    }
+}
+
+}  // namespace avrbench::fuzz

@@ -1,0 +1,74 @@
+// The firmware fuzz target's engine-independent part, shared by the libFuzzer
+// front end (fuzz_firmware.cpp) and the AFL++ one (fuzz_firmware_afl.cpp).
+//
+// Configured by the environment (avrbench fuzz sets it):
+//   AVRBENCH_FUZZ_BOARD  board file or standard board name (single-MCU boards)
+//   AVRBENCH_FUZZ_ELF    the firmware
+//   AVRBENCH_FUZZ_FAMILY the host's firmware family (grbl, marlin, teacup,
+//                        generic) when not the board's serial port's
+//   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
+//   AVRBENCH_FUZZ_RAW    1: the input's bytes go to the serial port as they
+//                        are, for binary protocols (seed 002's records): no
+//                        host, so no banner to wait for (the firmware boots
+//                        for AVRBENCH_FUZZ_BOOT seconds, default 0.2) and no
+//                        hang oracle; the run ends the settle time after the
+//                        last byte went in
+//   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
+//                        answer, for what the lines set in motion (default 0.1:
+//                        five RC-servo frames)
+//
+// Once, at start-up, the firmware boots on the board until its host sees the
+// family's banner (the board's serial port says which: grbl, marlin, teacup).
+// An engine then forks per input; in the child, run_input() sends the
+// input's lines, runs the MCU and counts every program-counter edge
+// (previous PC, PC) into the engine's map, so the search follows the
+// firmware's branches, not the bench's. Booting once and forking keeps an
+// execution to the input's own simulated time.
+//
+// Oracles: every finding the MCU and board raise during the input (bad
+// opcode, PC outside the program, stack into .bss, watchdog reset, bad
+// interrupt, net faults, part limits); a line the firmware never answers
+// within the serial port's line timeout (a hang); a fatal answer ("!!").
+// "error" answers and restarts the firmware announces (grbl's ^X) are not
+// findings.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace avrbench::fuzz {
+
+struct TargetConfig {
+    std::string board;
+    std::string elf;
+    std::string family;    // empty: the board's
+    double bound_s = 3.0;  // simulated time one input may take
+    double settle_s = 0.1;
+    bool raw = false;
+    double boot_s = 0.2;   // raw mode: no banner, boot this long
+};
+
+// From the AVRBENCH_FUZZ_* variables; `who` names the program in the
+// one-line error (exit 2) when one is missing.
+TargetConfig config_from_environment(const char* who);
+
+// Builds the board and boots the firmware to its ready state; on failure
+// prints one line naming the cause and exits with 2.
+void boot_target(const TargetConfig& config, const char* who);
+
+// What one input did (filled in the child, so engines put it in shared memory).
+struct InputOutcome {
+    std::uint64_t steps = 0;      // AVR instructions
+    bool finding = false;
+    char detail[512] = {};        // the first finding, one line
+};
+
+// Runs one input on the booted target, counting PC edges into
+// edges[0..edge_mask]. Changes the target for good: call it in a forked child.
+void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edges, std::uint32_t edge_mask,
+               InputOutcome& outcome);
+
+bool target_is_raw();
+
+}  // namespace avrbench::fuzz

@@ -1,0 +1,122 @@
+// AFL++ front end of the firmware fuzz target (FirmwareTarget.hpp says what
+// it runs and which findings it reports).
+//
+//   afl-fuzz -i seeds -o out -t 20000 -- avrbench-fuzz-firmware-afl @@
+//   (or without @@: the input on standard input)
+//
+// The binary carries no compiler instrumentation: coverage is the firmware's,
+// AVR program-counter edges counted straight into AFL's shared map (the
+// System V segment named by __AFL_SHM_ID, 64 KiB). It boots the firmware
+// once and then serves AFL's fork-server protocol itself on descriptors
+// 198/199 (AFL++'s docs, "forkserver"): a 4-byte hello, then per input a
+// 4-byte request, fork, the child's pid, its wait status (the hello
+// carries the map size, below). So every
+// execution starts from the booted firmware, as with libFuzzer. A finding
+// prints its one line to stderr and aborts, which AFL files under crashes/.
+//
+// Started outside AFL (no fork server on 198), it runs the one input once:
+// `avrbench-fuzz-firmware-afl crash-file` replays a reproducer (exit 0: no
+// finding; a finding aborts).
+#include <sys/shm.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "FirmwareTarget.hpp"
+
+namespace {
+
+constexpr int kControlFd = 198;  // AFL's FORKSRV_FD; status goes to FORKSRV_FD + 1
+constexpr int kStatusFd = kControlFd + 1;
+constexpr std::uint32_t kMapSize = 1u << 16;  // AFL's default MAP_SIZE
+constexpr const char* kWho = "fuzz_firmware_afl";
+
+std::vector<std::uint8_t> read_input(const char* path) {
+    if (path != nullptr) {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) {
+            std::fprintf(stderr, "%s: cannot read %s\n", kWho, path);
+            std::exit(2);
+        }
+        return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    }
+    std::vector<std::uint8_t> data;
+    std::uint8_t buffer[4096];
+    for (;;) {
+        const ssize_t n = ::read(0, buffer, sizeof buffer);
+        if (n <= 0) break;
+        data.insert(data.end(), buffer, buffer + n);
+    }
+    return data;
+}
+
+[[noreturn]] void run_one(const char* path, std::uint8_t* map) {
+    const std::vector<std::uint8_t> input = read_input(path);
+    avrbench::fuzz::InputOutcome outcome;
+    avrbench::fuzz::run_input(input.data(), input.size(), map, kMapSize - 1, outcome);
+    if (outcome.finding) {
+        std::fprintf(stderr, "avrbench fuzz: FINDING after %llu AVR instructions: %s\n",
+                     static_cast<unsigned long long>(outcome.steps), outcome.detail);
+        std::fflush(stderr);
+        std::abort();
+    }
+    std::_Exit(0);
+}
+
+std::uint8_t* coverage_map() {
+    if (const char* id = std::getenv("__AFL_SHM_ID"); id != nullptr && *id != '\0') {
+        void* map = ::shmat(std::atoi(id), nullptr, 0);
+        if (map == reinterpret_cast<void*>(-1)) {
+            std::perror("fuzz_firmware_afl: shmat");
+            std::exit(2);
+        }
+        return static_cast<std::uint8_t*>(map);
+    }
+    static std::vector<std::uint8_t> local(kMapSize);  // outside AFL: counted and dropped
+    return local.data();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const char* path = argc > 1 ? argv[1] : nullptr;
+    avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(kWho), kWho);
+    std::uint8_t* map = coverage_map();
+
+    // The hello announces the map size (AFL++'s fork-server options: bit 31
+    // and bit 0 say options follow, bit 30 a map size, bits 1..23 the size
+    // minus one); without it AFL++ 4 would use an 8 MiB map, 128x the
+    // bytes to classify per execution for the same edges.
+    constexpr std::uint32_t kOptionsFollow = 0x80000001u;
+    constexpr std::uint32_t kMapSizeOption = 0x40000000u;
+    const std::uint32_t hello = kOptionsFollow | kMapSizeOption | ((kMapSize - 1) << 1);
+    if (::write(kStatusFd, &hello, sizeof hello) != sizeof hello) run_one(path, map);  // not under AFL
+
+    for (;;) {
+        std::uint32_t request = 0;
+        if (::read(kControlFd, &request, sizeof request) != sizeof request) return 0;  // AFL is gone
+        const pid_t child = ::fork();
+        if (child < 0) {
+            std::perror("fuzz_firmware_afl: fork");
+            return 2;
+        }
+        if (child == 0) {
+            ::close(kControlFd);
+            ::close(kStatusFd);
+            run_one(path, map);
+        }
+        const std::int32_t pid = child;
+        if (::write(kStatusFd, &pid, sizeof pid) != sizeof pid) return 0;
+        int status = 0;
+        if (::waitpid(child, &status, 0) < 0) return 2;
+        const std::int32_t wait_status = status;
+        if (::write(kStatusFd, &wait_status, sizeof wait_status) != sizeof wait_status) return 0;
+    }
+}
