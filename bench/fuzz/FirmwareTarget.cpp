@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "core/Errors.hpp"
@@ -31,9 +33,36 @@ std::string env_or_die(const char* name, const char* who) {
 // the firmware did not ask for is already an MCU finding (watchdog, jump to 0).
 bool is_oracle_event(HostEventKind kind) { return kind == HostEventKind::Timeout || kind == HostEventKind::Fatal; }
 
+// NAME=VALUE lines of `<executable>.avrbench` into the environment (never
+// over a variable already set), "$ORIGIN" standing for the executable's directory.
+void load_config_file(const char* executable, const char* who) {
+    if (executable == nullptr || std::getenv("AVRBENCH_FUZZ_BOARD") != nullptr) return;
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::canonical(executable, ec);
+    if (ec) return;
+    const std::string path = exe.string() + ".avrbench";
+    std::ifstream in(path);
+    if (!in) return;
+    const std::string origin = exe.parent_path().string();
+    int line_number = 0;
+    for (std::string line; std::getline(in, line);) {
+        ++line_number;
+        if (line.empty() || line[0] == '#') continue;
+        const auto equals = line.find('=');
+        if (equals == std::string::npos || equals == 0) {
+            std::fprintf(stderr, "%s: %s:%d: expected NAME=VALUE\n", who, path.c_str(), line_number);
+            std::exit(2);
+        }
+        std::string value = line.substr(equals + 1);
+        for (std::size_t at; (at = value.find("$ORIGIN")) != std::string::npos;) value.replace(at, 7, origin);
+        ::setenv(line.substr(0, equals).c_str(), value.c_str(), 0);
+    }
+}
+
 }  // namespace
 
-TargetConfig config_from_environment(const char* who) {
+TargetConfig config_from_environment(const char* who, const char* executable) {
+    load_config_file(executable, who);
     TargetConfig config;
     config.board = env_or_die("AVRBENCH_FUZZ_BOARD", who);
     config.elf = env_or_die("AVRBENCH_FUZZ_ELF", who);

@@ -17,6 +17,13 @@
 //                        answer, for what the lines set in motion (default 0.1:
 //                        five RC-servo frames)
 //
+// When AVRBENCH_FUZZ_BOARD is not set, the same variables come from a file
+// beside the executable, named after it with ".avrbench" added
+// (`fuzz_firmware_x` reads `fuzz_firmware_x.avrbench`): NAME=VALUE lines,
+// "$ORIGIN" in a value standing for the executable's directory. That is how
+// a ClusterFuzzLite build (.clusterfuzzlite/build.sh) ships one fuzzer per
+// firmware: a fuzzer there is only a binary, run without our environment.
+//
 // Once, at start-up, the firmware boots on the board until its host sees the
 // family's banner (the board's serial port says which: grbl, marlin, teacup).
 // An engine then forks per input; in the child, run_input() sends the
@@ -49,9 +56,10 @@ struct TargetConfig {
     double boot_s = 0.2;   // raw mode: no banner, boot this long
 };
 
-// From the AVRBENCH_FUZZ_* variables; `who` names the program in the
-// one-line error (exit 2) when one is missing.
-TargetConfig config_from_environment(const char* who);
+// From the AVRBENCH_FUZZ_* variables (or the file beside `executable`, see
+// above); `who` names the program in the one-line error (exit 2) when one is
+// missing.
+TargetConfig config_from_environment(const char* who, const char* executable);
 
 // Builds the board and boots the firmware to its ready state; on failure
 // prints one line naming the cause and exits with 2.

@@ -47,9 +47,10 @@ Shared* g_shared = nullptr;
 
 }  // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
     const char* who = "fuzz_firmware";
-    avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(who), who);
+    const char* executable = argc != nullptr && *argc > 0 ? (*argv)[0] : nullptr;
+    avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(who, executable), who);
     void* shared = ::mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
     if (shared == MAP_FAILED) {
         std::perror("fuzz_firmware: mmap");

@@ -87,7 +87,7 @@ std::uint8_t* coverage_map() {
 
 int main(int argc, char** argv) {
     const char* path = argc > 1 ? argv[1] : nullptr;
-    avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(kWho), kWho);
+    avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(kWho, argv[0]), kWho);
     std::uint8_t* map = coverage_map();
 
     // The hello announces the map size (AFL++'s fork-server options: bit 31

@@ -261,7 +261,8 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
                                    "AFL_NO_AFFINITY=1", "AFL_FORKSRV_INIT_TMOUT=60000",
                                    // AFL++ refuses sanitizer settings that do not abort (a sanitized build of the bench)
                                    "ASAN_OPTIONS=abort_on_error=1:symbolize=0:detect_leaks=0",
-                                   "UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:symbolize=0"});
+                                   "UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:symbolize=0",
+                                   "LSAN_OPTIONS=symbolize=0"});
     if (!args.raw) {
         // The structure-aware G-code mutator (bench/fuzz/afl_gcode_mutator.cpp) beside AFL++'s own havoc.
         const std::string mutator = self_dir() + "/libavrbench-afl-gcode-mutator.so";
@@ -301,7 +302,21 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
         all_ran = all_ran && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     }
     if (!fs::exists(sync / "main" / "fuzzer_stats")) {
-        throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (see the log)");
+        // AFL++ says why on a "PROGRAM ABORT" line, between colour codes.
+        std::string why = "see the log";
+        std::istringstream lines(slurp((out / "afl-main.log").string()));
+        for (std::string line; std::getline(lines, line);) {
+            if (line.find("PROGRAM ABORT") == std::string::npos) continue;
+            why.clear();
+            for (std::size_t i = 0; i < line.size(); ++i) {
+                if (line[i] == '\x1b') {
+                    while (i < line.size() && !std::isalpha(static_cast<unsigned char>(line[i]))) ++i;
+                    continue;
+                }
+                why += line[i];
+            }
+        }
+        throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (" + why + ")");
     }
     if (!all_ran) std::printf("  (an AFL++ instance ended with an error; see %s/afl-*.log)\n", out.string().c_str());
     campaign.coverage_end = afl_stat(sync / "main" / "fuzzer_stats", "edges_found");  // main imports the others' finds

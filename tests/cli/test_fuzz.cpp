@@ -11,6 +11,8 @@
 // mutator): 20 s. Wall-clock guards: 90 s per run.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "support/Paths.hpp"
@@ -91,6 +93,35 @@ TEST(Fuzz, AflFindsNothingInTheImprovedInterpolator) {
     const std::string out = fuzz("printer3d_interp", "printer3d-interp-alone.yaml", "10s", dir, &code, "afl");
     EXPECT_EQ(code, 0) << out;
     EXPECT_NE(out.find("findings   0 distinct"), std::string::npos) << out;
+}
+
+// ClusterFuzzLite runs a fuzzer as a bare binary: the target takes its
+// settings from `<binary>.avrbench` beside it ($ORIGIN = its directory) when
+// the environment has none. The AFL++ front end is used here because,
+// started alone, it runs one input and aborts on a finding.
+TEST(Fuzz, TargetReadsItsSettingsFromTheFileBesideIt) {
+    namespace fs = std::filesystem;
+    const auto dir = test::scratch_dir("fuzz-config");
+    const fs::path target = dir / "fuzz_firmware_x";
+    fs::copy_file(fs::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl", target,
+                  fs::copy_options::overwrite_existing);
+    fs::copy_file(test::firmware("printer3d_interp_thesis_parser"), dir / "fw.elf", fs::copy_options::overwrite_existing);
+    const std::string board = test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-thesis.yaml");
+    // A lone NUL byte: the thesis parser never answers a line it does not understand (docs/FUZZING.md).
+    std::ofstream(dir / "input", std::ios::binary) << std::string(1, '\0') << "\n";
+    const std::string run = "env -u AVRBENCH_FUZZ_BOARD -u AVRBENCH_FUZZ_ELF " + target.string() + " " + (dir / "input").string();
+
+    std::ofstream(target.string() + ".avrbench") << "# settings\nAVRBENCH_FUZZ_ELF=$ORIGIN/fw.elf\nAVRBENCH_FUZZ_BOARD=" << board << "\n";
+    const auto found = test::run_command(run, dir, 60);
+    EXPECT_NE(found.exit_code, 0) << found.out << found.err;
+    EXPECT_NE(found.exit_code, 2) << found.err;
+    EXPECT_NE(found.err.find("avrbench fuzz: FINDING"), std::string::npos) << found.err;
+    EXPECT_NE(found.err.find("got no answer within 0.5 s"), std::string::npos) << found.err;
+
+    std::ofstream(target.string() + ".avrbench") << "AVRBENCH_FUZZ_ELF=$ORIGIN/fw.elf\nno equals sign here\n";
+    const auto bad = test::run_command(run, dir, 60);
+    EXPECT_EQ(bad.exit_code, 2) << bad.out << bad.err;
+    EXPECT_NE(bad.err.find("fuzz_firmware_x.avrbench:2: expected NAME=VALUE"), std::string::npos) << bad.err;
 }
 
 TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
