@@ -293,7 +293,10 @@ bool Mcu::run_until_sleep(Cycle end_cycle) {
     return sleeping();
 }
 
-StopReason Mcu::run_until(Cycle target_cycle) { return run_until_impl<false>(target_cycle, nullptr); }
+StopReason Mcu::run_until(Cycle target_cycle) {
+    return run_coverage_ != nullptr ? run_until_impl<true>(target_cycle, run_coverage_)
+                                    : run_until_impl<false>(target_cycle, nullptr);
+}
 
 StopReason Mcu::run_until_covering(Cycle target_cycle, PcEdgeMap& edges) { return run_until_impl<true>(target_cycle, &edges); }
 

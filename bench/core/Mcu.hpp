@@ -116,6 +116,10 @@ public:
     StopReason run_for(Cycle cycles) { return run_until(cycle() + cycles); }
     // run_until, recording every instruction's PC edge in `edges` (fuzzing).
     StopReason run_until_covering(Cycle target_cycle, PcEdgeMap& edges);
+    // From now on every run_until covers into `edges` (nullptr: no longer),
+    // also when a board's lockstep drives this MCU among others (fuzzing a
+    // multi-MCU board through one of them).
+    void set_run_coverage(PcEdgeMap* edges) { run_coverage_ = edges; }
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
@@ -216,6 +220,7 @@ private:
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
+    PcEdgeMap* run_coverage_ = nullptr;
     bool real_stop_ = false;  // stop_requested_ came from request_stop, not request_yield
     PeerSync* peer_sync_ = nullptr;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;

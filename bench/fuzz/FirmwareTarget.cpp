@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
 #include "verify/Bench.hpp"
 
@@ -18,6 +19,7 @@ namespace {
 // may go first, and the process is ending anyway.
 Bench* g_bench = nullptr;
 TargetConfig g_config;
+std::string g_mcu_name;  // the fuzzed MCU: the serial port's
 std::size_t g_findings_at_ready = 0;
 
 std::string env_or_die(const char* name, const char* who) {
@@ -71,6 +73,21 @@ TargetConfig config_from_environment(const char* who, const char* executable) {
     if (const char* settle = std::getenv("AVRBENCH_FUZZ_SETTLE")) config.settle_s = std::max(0.0, std::atof(settle));
     if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) config.raw = std::string(raw) == "1";
     if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) config.boot_s = std::max(0.0, std::atof(boot));
+    if (const char* list = std::getenv("AVRBENCH_FUZZ_FIRMWARE")) {
+        std::string entries = list;
+        for (std::size_t start = 0; start < entries.size();) {
+            std::size_t end = entries.find(';', start);
+            if (end == std::string::npos) end = entries.size();
+            const std::string entry = entries.substr(start, end - start);
+            const auto equals = entry.find('=');
+            if (equals == std::string::npos || equals == 0 || equals + 1 == entry.size()) {
+                std::fprintf(stderr, "%s: AVRBENCH_FUZZ_FIRMWARE: '%s' is not mcu=elf\n", who, entry.c_str());
+                std::exit(2);
+            }
+            config.other_firmware[entry.substr(0, equals)] = entry.substr(equals + 1);
+            start = end + 1;
+        }
+    }
     return config;
 }
 
@@ -79,13 +96,16 @@ bool target_is_raw() { return g_config.raw; }
 void boot_target(const TargetConfig& config, const char* who) {
     g_config = config;
     try {
-        g_bench = new Bench(config.board, config.elf);
-        if (g_bench->board().mcus().size() != 1) {
-            std::fprintf(stderr, "%s: %s has %zu MCUs; the fuzz target steps one\n", who, config.board.c_str(),
-                         g_bench->board().mcus().size());
+        BoardSpec spec = load_board_file(config.board);
+        if (spec.serial.empty()) {
+            std::fprintf(stderr, "%s: %s has no serial port to send the input to\n", who, config.board.c_str());
             std::exit(2);
         }
-        Mcu& mcu = g_bench->mcu();
+        g_mcu_name = spec.serial.front().mcu;
+        std::map<std::string, std::string> firmware = config.other_firmware;
+        firmware[g_mcu_name] = config.elf;
+        g_bench = new Bench(std::move(spec), firmware);
+        Mcu& mcu = g_bench->mcu(g_mcu_name);
         if (config.raw) {
             (void)g_bench->serial();  // the USART model listens from here on
             g_bench->run_for(config.boot_s);
@@ -111,7 +131,7 @@ void boot_target(const TargetConfig& config, const char* who) {
 void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_map, std::uint32_t edge_mask,
                InputOutcome& outcome) {
     Bench& bench = *g_bench;
-    Mcu& mcu = bench.mcu();
+    Mcu& mcu = bench.mcu(g_mcu_name);
     UartHost* host = g_config.raw ? nullptr : &bench.host();
     Uart& serial = bench.serial();
     const std::string bytes(reinterpret_cast<const char*>(data), size);
@@ -127,9 +147,11 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     // Done sending: every line answered (or the host gave up), or every raw byte taken.
     const auto sent = [&] { return host != nullptr ? host->finished() : serial.pending_rx() == 0; };
     Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_config.bound_s);
-    // The run loop with coverage (Mcu::run_until_covering), in slices of 1 ms
-    // simulated between which the settle time may start.
+    // The board's run loop with the fuzzed MCU covering (Mcu::set_run_coverage:
+    // alone, or in the lockstep among the board's other MCUs), in slices of
+    // 1 ms simulated between which the settle time may start.
     PcEdgeMap edges{edge_map, edge_mask};
+    mcu.set_run_coverage(&edges);
     const Cycle slice = mcu.cycles_from_seconds(0.001);
     const std::uint64_t steps_before = mcu.steps();
     bool settling = false;
@@ -138,8 +160,12 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
             settling = true;
             end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_config.settle_s));
         }
-        mcu.run_until_covering(std::min(end, mcu.cycle() + slice), edges);
+        const Cycle from = mcu.cycle();
+        const Cycle to = std::min(end, from + slice);
+        bench.run_for(static_cast<double>(to - from) / mcu.frequency_hz());
+        if (mcu.cycle() == from) break;  // nothing moved (a stop): never spin
     }
+    mcu.set_run_coverage(nullptr);
     outcome.steps = mcu.steps() - steps_before;
     std::string detail;
     const auto findings = bench.board().findings();  // the MCU's, the nets', the parts'

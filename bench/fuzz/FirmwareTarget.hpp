@@ -2,8 +2,12 @@
 // front end (fuzz_firmware.cpp) and the AFL++ one (fuzz_firmware_afl.cpp).
 //
 // Configured by the environment (avrbench fuzz sets it):
-//   AVRBENCH_FUZZ_BOARD  board file or standard board name (single-MCU boards)
-//   AVRBENCH_FUZZ_ELF    the firmware
+//   AVRBENCH_FUZZ_BOARD  board file or standard board name
+//   AVRBENCH_FUZZ_ELF    the firmware fuzzed: it runs on the MCU of the
+//                        board's (first) serial port, whose edges are counted
+//   AVRBENCH_FUZZ_FIRMWARE  the other MCUs' firmware on a multi-MCU board,
+//                        "mcu=elf;mcu=elf" (as `run --firmware`); the board
+//                        runs in its lockstep, coverage from the fuzzed MCU
 //   AVRBENCH_FUZZ_FAMILY the host's firmware family (grbl, marlin, teacup,
 //                        generic) when not the board's serial port's
 //   AVRBENCH_FUZZ_BOUND  simulated seconds one input may take (default 3)
@@ -42,6 +46,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
 
 namespace avrbench::fuzz {
@@ -49,6 +54,7 @@ namespace avrbench::fuzz {
 struct TargetConfig {
     std::string board;
     std::string elf;
+    std::map<std::string, std::string> other_firmware;  // MCU -> ELF, multi-MCU boards
     std::string family;    // empty: the board's
     double bound_s = 3.0;  // simulated time one input may take
     double settle_s = 0.1;

@@ -22,6 +22,7 @@
 #include <map>
 #include <sstream>
 
+#include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
 #include "fuzz/FuzzFindings.hpp"
 #include "core/Units.hpp"
@@ -339,12 +340,23 @@ int fuzz_command(const FuzzArgs& args) {
     const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
     if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
     std::string family;
+    std::string other_firmware;  // "mcu=elf;mcu=elf" for the target
     {
-        Bench bench(args.board, args.elf);  // BadInput for a bad board or ELF, as `run` says it
-        if (bench.board().mcus().size() != 1) {
-            throw BadInput(args.board + ": has " + std::to_string(bench.board().mcus().size()) +
-                           " MCUs; avrbench fuzz steps boards with one MCU");
+        // The fuzzed ELF runs on the MCU of the board's serial port; the
+        // others take --firmware. BadInput for a bad board or ELF, as `run` says it.
+        BoardSpec spec = load_board_file(args.board);
+        if (spec.serial.empty()) throw BadInput(args.board + ": has no serial port for the fuzz input");
+        std::map<std::string, std::string> firmware;
+        for (const std::string& entry : args.firmware) {
+            const auto equals = entry.find('=');
+            if (equals == std::string::npos || equals == 0 || equals + 1 == entry.size()) {
+                throw BadInput("--firmware " + entry + ": expected MCU=ELF");
+            }
+            firmware[entry.substr(0, equals)] = entry.substr(equals + 1);
+            other_firmware += (other_firmware.empty() ? "" : ";") + entry;
         }
+        firmware[spec.serial.front().mcu] = args.elf;
+        Bench bench(std::move(spec), firmware);
         family = args.family.empty() ? bench.serial_decl().family : args.family;
         (void)parse_firmware_family(family, "--family");
     }
@@ -376,7 +388,8 @@ int fuzz_command(const FuzzArgs& args) {
     std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
                                           "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
                                           std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
-                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot")))};
+                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
+                                          "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware};
     Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
                                              : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
     const Target& target = campaign.target;
@@ -425,6 +438,7 @@ int fuzz_command(const FuzzArgs& args) {
         // host, bytes that are not text included.
         std::vector<std::string> run = {self_dir() + "/avrbench", "run", args.elf, "--board", args.board, "--for",
                                         std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"};
+        for (const std::string& entry : args.firmware) run.insert(run.end(), {"--firmware", entry});
         if (args.raw) {
             // The bytes from power-on (the fuzz target sent them after its boot time; --uart-in holds
             // them until the firmware enables its receiver).

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace avrbench {
 
@@ -12,7 +13,8 @@ struct FuzzArgs {
     std::string bound = "5s";      // simulated time one input may take
     std::string out = "fuzz-out";
     std::string family;  // "" = the board's
-    std::string corpus;  // a directory of seed inputs, or "" serial port's
+    std::string corpus;  // a directory of seed inputs, or ""
+    std::vector<std::string> firmware;  // "mcu=elf" for a multi-MCU board's other MCUs serial port's
     bool raw = false;             // bytes straight to the port (binary protocols)
     std::string boot = "0.2s";    // raw: simulated time the firmware boots before the first input
     std::string engine = "libfuzzer";  // or "afl"

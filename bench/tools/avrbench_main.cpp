@@ -866,13 +866,14 @@ int main(int argc, char** argv) {
     FuzzArgs fuzz;
     CLI::App* fuzz_cmd = app.add_subcommand("fuzz", "coverage-guided G-code fuzzing of a firmware on a board (libFuzzer or AFL++; docs/FUZZING.md)");
     fuzz_cmd->add_option("--elf", fuzz.elf, "the firmware")->required();
-    fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name (one MCU)")->required();
+    fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name; --elf runs on its serial port's MCU")->required();
     fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s)");
     fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");
     fuzz_cmd->add_option("--out", fuzz.out, "corpus, reproducers, runs and the libFuzzer log (default fuzz-out)");
     fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, teacup, generic (default: the board's)");
     fuzz_cmd->add_flag("--raw", fuzz.raw, "send the input's bytes to the port as they are (binary protocols such as seed 002's records)");
     fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw: simulated time the firmware boots before the first input (default 0.2s)");
+    fuzz_cmd->add_option("--firmware", fuzz.firmware, "MCU=ELF for a multi-MCU board's other MCUs (repeatable; as run's)");
     fuzz_cmd->add_option("--corpus", fuzz.corpus, "a directory of seed inputs (your jobs' lines) added to the family's seed lines");
     fuzz_cmd->add_option("--engine", fuzz.engine, "libfuzzer (default) or afl (Debian's afl++: one main and --jobs - 1 secondary instances)")
         ->check(CLI::IsMember({"libfuzzer", "afl"}));

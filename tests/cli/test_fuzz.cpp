@@ -124,6 +124,33 @@ TEST(Fuzz, TargetReadsItsSettingsFromTheFileBesideIt) {
     EXPECT_NE(bad.err.find("fuzz_firmware_x.avrbench:2: expected NAME=VALUE"), std::string::npos) << bad.err;
 }
 
+// A board of several MCUs: the fuzzed ELF runs on the serial port's MCU
+// (seed 001's interpolator), the others get theirs from
+// AVRBENCH_FUZZ_FIRMWARE and run in the board's lockstep. The X carriage
+// starts at 3.5 mm (bench/boards/printer3d-seed001.yaml); a full circle
+// G2 I-5 J0 from there has its centre 5 mm to the left and reaches
+// 3.5 - 10 = -6.5 mm, past the travel's lower end: the drive board's motor
+// must carry it there (the interpolator has no soft limits). G1 X5 stays
+// inside. M400 keeps each input running until the move is done.
+TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
+    const auto dir = test::scratch_dir("fuzz-multi");
+    const std::string drive = test::firmware("printer3d_drive");
+    const std::string env = "env AVRBENCH_FUZZ_BOARD=printer3d-seed001 AVRBENCH_FUZZ_ELF=" + test::firmware("printer3d_interp") +
+                            " 'AVRBENCH_FUZZ_FIRMWARE=drive_x=" + drive + ";drive_y=" + drive + ";drive_z=" + drive +
+                            ";drive_e=" + drive + ";heater=" + test::firmware("printer3d_heater") + "' " +
+                            (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
+    std::ofstream(dir / "circle") << "G2 I-5 J0 F300\nM400\n";
+    const auto circle = test::run_command(env + (dir / "circle").string(), dir, 60);
+    EXPECT_NE(circle.exit_code, 0) << circle.err;
+    EXPECT_NE(circle.err.find("FINDING"), std::string::npos) << circle.err;
+    EXPECT_NE(circle.err.find("x: axis-out-of-travel"), std::string::npos) << circle.err;
+    EXPECT_NE(circle.err.find("past the lower end of travel"), std::string::npos) << circle.err;
+    std::ofstream(dir / "inside") << "G1 X5 F600\nM400\n";
+    const auto inside = test::run_command(env + (dir / "inside").string(), dir, 60);
+    EXPECT_EQ(inside.exit_code, 0) << inside.err;
+    EXPECT_EQ(inside.err.find("FINDING"), std::string::npos) << inside.err;
+}
+
 TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("fuzz-bad");
     const auto r = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
