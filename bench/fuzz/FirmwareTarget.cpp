@@ -72,6 +72,7 @@ TargetConfig config_from_environment(const char* who, const char* executable) {
     if (const char* bound = std::getenv("AVRBENCH_FUZZ_BOUND")) config.bound_s = std::max(0.01, std::atof(bound));
     if (const char* settle = std::getenv("AVRBENCH_FUZZ_SETTLE")) config.settle_s = std::max(0.0, std::atof(settle));
     if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) config.raw = std::string(raw) == "1";
+    if (const char* hang = std::getenv("AVRBENCH_FUZZ_HANG")) config.hang_at_bound = std::string(hang) == "1";
     if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) config.boot_s = std::max(0.0, std::atof(boot));
     if (const char* list = std::getenv("AVRBENCH_FUZZ_FIRMWARE")) {
         std::string entries = list;
@@ -177,6 +178,15 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
                 break;
             }
         }
+    }
+    if (detail.empty() && host != nullptr && g_config.hang_at_bound && !settling && !mcu.halted() &&
+        host->outstanding_lines() > 0 && host->lines_acknowledged() < host->lines().size()) {
+        // The oldest line still waiting when the input's simulated time ran out.
+        const GcodeLine& line = host->lines()[host->lines_acknowledged()];
+        char bound[32];
+        std::snprintf(bound, sizeof bound, "%g", g_config.bound_s);
+        detail = "hang: line " + std::to_string(line.number) + " " + quoted_line(line.text) +
+                 " got no answer within the bound of " + bound + " s (keep-alives not counted)";
     }
     if (!detail.empty()) {
         outcome.finding = true;

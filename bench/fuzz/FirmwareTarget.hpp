@@ -17,6 +17,9 @@
 //                        for AVRBENCH_FUZZ_BOOT seconds, default 0.2) and no
 //                        hang oracle; the run ends the settle time after the
 //                        last byte went in
+//   AVRBENCH_FUZZ_HANG   1: a line still unanswered when the bound ends is a
+//                        finding ("hang"), keep-alives or not (the
+//                        serial port's line timeout is restarted by them)
 //   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
 //                        answer, for what the lines set in motion (default 0.1:
 //                        five RC-servo frames)
@@ -59,6 +62,7 @@ struct TargetConfig {
     double bound_s = 3.0;  // simulated time one input may take
     double settle_s = 0.1;
     bool raw = false;
+    bool hang_at_bound = false;  // an unanswered line at the bound's end is a finding
     double boot_s = 0.2;   // raw mode: no banner, boot this long
 };
 

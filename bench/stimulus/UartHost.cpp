@@ -62,15 +62,13 @@ std::string printable(const std::string& text) {
     return out;
 }
 
-// A job line as messages quote it: whole up to 80 bytes, else its start and
-// its length (a 100 kB line must not become a 100 kB error message).
+}  // namespace
+
 std::string quoted_line(const std::string& text) {
     constexpr std::size_t kShown = 60;
     if (text.size() <= 80) return "'" + printable(text) + "'";
     return "'" + printable(text.substr(0, kShown)) + "...' (" + std::to_string(text.size()) + " bytes)";
 }
-
-}  // namespace
 
 const char* to_string(FlowControl flow) {
     switch (flow) {

@@ -112,6 +112,11 @@ struct GcodeLine {
     std::string origin;      // the file path, or "<lines>" for add_line(s)
 };
 
+// A job line as messages quote it: whole up to 80 bytes, else its start and
+// its length (a 100 kB line must not become a 100 kB error message); control
+// bytes as \xNN.
+std::string quoted_line(const std::string& text);
+
 // Strips "; ..." to the end of the line and "( ... )" comments (an unclosed
 // '(' runs to the end of the line), leading and trailing whitespace, and
 // drops the lines left empty. Accepts "\n", "\r\n" and lone "\r" line ends.

@@ -389,7 +389,8 @@ int fuzz_command(const FuzzArgs& args) {
                                           "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
                                           std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
                                           "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
-                                          "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware};
+                                          "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
+                                          std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
     Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
                                              : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
     const Target& target = campaign.target;

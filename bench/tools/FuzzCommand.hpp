@@ -16,6 +16,7 @@ struct FuzzArgs {
     std::string corpus;  // a directory of seed inputs, or ""
     std::vector<std::string> firmware;  // "mcu=elf" for a multi-MCU board's other MCUs serial port's
     bool raw = false;             // bytes straight to the port (binary protocols)
+    bool hang = false;            // a line unanswered when the bound ends is a finding
     std::string boot = "0.2s";    // raw: simulated time the firmware boots before the first input
     std::string engine = "libfuzzer";  // or "afl"
     int jobs = 1;

@@ -151,6 +151,25 @@ TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
     EXPECT_EQ(inside.err.find("FINDING"), std::string::npos) << inside.err;
 }
 
+// The hang oracle of `--hang` (AVRBENCH_FUZZ_HANG=1): a line still
+// unanswered when the input's bound ends. A 10 s dwell (G4 P10000) against a
+// 2 s bound: the improved interpolator sends `echo:busy` every second, under
+// the port's 2.5 s line timeout, so only the bound can see it.
+TEST(Fuzz, ALineUnansweredAtTheBoundIsAHangOnlyWhenAsked) {
+    const auto dir = test::scratch_dir("fuzz-hang");
+    std::ofstream(dir / "dwell") << "G4 P10000\n";
+    const std::string run = "AVRBENCH_FUZZ_BOUND=2 AVRBENCH_FUZZ_BOARD=" +
+                            test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
+                            " AVRBENCH_FUZZ_ELF=" + test::firmware("printer3d_interp") + " " +
+                            (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " " +
+                            (dir / "dwell").string();
+    const auto plain = test::run_command("env AVRBENCH_FUZZ_HANG=0 " + run, dir, 60);
+    EXPECT_EQ(plain.exit_code, 0) << plain.err;
+    const auto hang = test::run_command("env AVRBENCH_FUZZ_HANG=1 " + run, dir, 60);
+    EXPECT_NE(hang.exit_code, 0) << hang.err;
+    EXPECT_NE(hang.err.find("hang: line 1 'G4 P10000' got no answer within the bound of 2 s"), std::string::npos) << hang.err;
+}
+
 TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("fuzz-bad");
     const auto r = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
