@@ -341,6 +341,9 @@ int fuzz_command(const FuzzArgs& args) {
     if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
     std::string family;
     std::string other_firmware;  // "mcu=elf;mcu=elf" for the target
+    // `run ELF --firmware ...` as the recorded runs give it: run's ELF goes
+    // to the board's first MCU, which need not be the serial port's.
+    std::vector<std::string> run_firmware;
     {
         // The fuzzed ELF runs on the MCU of the board's serial port; the
         // others take --firmware. BadInput for a bad board or ELF, as `run` says it.
@@ -356,6 +359,11 @@ int fuzz_command(const FuzzArgs& args) {
             other_firmware += (other_firmware.empty() ? "" : ";") + entry;
         }
         firmware[spec.serial.front().mcu] = args.elf;
+        const std::string first_mcu = spec.mcus.front().name;
+        run_firmware.push_back(firmware.count(first_mcu) != 0 ? firmware[first_mcu] : args.elf);
+        for (const auto& [mcu, elf] : firmware) {
+            if (mcu != first_mcu) run_firmware.insert(run_firmware.end(), {"--firmware", mcu + "=" + elf});
+        }
         Bench bench(std::move(spec), firmware);
         family = args.family.empty() ? bench.serial_decl().family : args.family;
         (void)parse_firmware_family(family, "--family");
@@ -437,9 +445,9 @@ int fuzz_command(const FuzzArgs& args) {
         std::ofstream(base + ".gcode", std::ios::binary) << minimal;
         // Replayed the way the fuzz target sent it: lines through the port's
         // host, bytes that are not text included.
-        std::vector<std::string> run = {self_dir() + "/avrbench", "run", args.elf, "--board", args.board, "--for",
-                                        std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"};
-        for (const std::string& entry : args.firmware) run.insert(run.end(), {"--firmware", entry});
+        std::vector<std::string> run = {self_dir() + "/avrbench", "run"};
+        run.insert(run.end(), run_firmware.begin(), run_firmware.end());
+        run.insert(run.end(), {"--board", args.board, "--for", std::to_string(bound_s + 1) + "s", "--vcd", base + ".vcd"});
         if (args.raw) {
             // The bytes from power-on (the fuzz target sent them after its boot time; --uart-in holds
             // them until the firmware enables its receiver).
