@@ -328,12 +328,17 @@ void HybridStepper::update_command_from_polarity() {
             release_pending_[p] = true;
             release_since_[p] = now;
             const std::uint64_t generation = ++release_generation_[p];
-            clock().scheduler().at(now + release_cycles_, [this, p, generation](Cycle) {
-                if (generation != release_generation_[p] || !release_pending_[p]) return;
+            // Phase and generation in one word: with `this` the capture stays
+            // within std::function's in-place buffer (16 bytes in libstdc++),
+            // so a phase release allocates nothing.
+            const std::uint64_t key = generation << 1 | static_cast<std::uint64_t>(p);
+            clock().scheduler().at(now + release_cycles_, [this, key](Cycle) {
+                const int phase = static_cast<int>(key & 1);
+                if ((key >> 1) != release_generation_[phase] || !release_pending_[phase]) return;
                 sync();
                 // Phases switched off by the same update (or earlier) go together:
                 // releasing one alone would swing the command half a step.
-                const Cycle since = release_since_[p];
+                const Cycle since = release_since_[phase];
                 for (int q = 0; q < 2; ++q) {
                     if (release_pending_[q] && release_since_[q] <= since) {
                         release_pending_[q] = false;

@@ -1,6 +1,7 @@
 #include "core/fixes/Interrupts.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <mutex>
 #include <string_view>
@@ -170,18 +171,31 @@ void remove_sleep_entry_listener(avr_t* avr, void* context) {
 }
 
 avr_cycle_count_t notify_sleep_entry(avr_t* avr, std::uint8_t mode) {
-    std::vector<SleepListener> mine;
+    // This MCU's listeners copied out (a listener may add or remove one while
+    // it runs, and the lock is not held across the calls) into a buffer on
+    // the stack: a sleep entry allocates nothing. An MCU has a handful.
+    constexpr std::size_t kInPlace = 8;
+    std::array<SleepListener, kInPlace> mine;
+    std::vector<SleepListener> more;  // only past kInPlace (never in our boards)
+    std::size_t count = 0;
     {
         std::lock_guard<std::mutex> lock(sleep_listeners_mutex);
         for (const auto& l : sleep_listeners()) {
-            if (l.avr == avr) mine.push_back(l);
+            if (l.avr != avr) continue;
+            if (count < kInPlace) {
+                mine[count++] = l;
+            } else {
+                more.push_back(l);
+            }
         }
     }
     avr_cycle_count_t earliest = 0;
-    for (const auto& l : mine) {
+    const auto call = [&](const SleepListener& l) {
         const avr_cycle_count_t at = l.fn(l.context, avr, mode);
         if (at != 0 && (earliest == 0 || at < earliest)) earliest = at;
-    }
+    };
+    for (std::size_t i = 0; i < count; ++i) call(mine[i]);
+    for (const auto& l : more) call(l);
     return earliest;
 }
 
