@@ -28,6 +28,7 @@
 #include "core/Units.hpp"
 #include "stimulus/GcodeMutator.hpp"
 #include "stimulus/UartHost.hpp"
+#include "tools/FirmwareArgs.hpp"
 #include "verify/Bench.hpp"
 
 extern char** environ;
@@ -349,15 +350,8 @@ int fuzz_command(const FuzzArgs& args) {
         // others take --firmware. BadInput for a bad board or ELF, as `run` says it.
         BoardSpec spec = load_board_file(args.board);
         if (spec.serial.empty()) throw BadInput(args.board + ": has no serial port for the fuzz input");
-        std::map<std::string, std::string> firmware;
-        for (const std::string& entry : args.firmware) {
-            const auto equals = entry.find('=');
-            if (equals == std::string::npos || equals == 0 || equals + 1 == entry.size()) {
-                throw BadInput("--firmware " + entry + ": expected MCU=ELF");
-            }
-            firmware[entry.substr(0, equals)] = entry.substr(equals + 1);
-            other_firmware += (other_firmware.empty() ? "" : ";") + entry;
-        }
+        std::map<std::string, std::string> firmware = firmware_assignments(args.firmware);
+        for (const auto& [mcu, elf] : firmware) other_firmware += (other_firmware.empty() ? "" : ";") + mcu + "=" + elf;
         firmware[spec.serial.front().mcu] = args.elf;
         const std::string first_mcu = spec.mcus.front().name;
         run_firmware.push_back(firmware.count(first_mcu) != 0 ? firmware[first_mcu] : args.elf);

@@ -21,6 +21,7 @@
 #include "cam/Records.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
+#include "tools/FirmwareArgs.hpp"
 #include "tools/FuzzCommand.hpp"
 #include "core/Mcu.hpp"
 #include "core/Units.hpp"
@@ -302,13 +303,8 @@ BoardRun prepare_board_run(const RunArgs& args) {
         throw BadInput("--mcu/--freq do not apply with --board: the board file gives each MCU's type and clock");
     }
     BoardSpec spec = load_board_file(args.board);
-    std::map<std::string, std::string> firmware;
+    std::map<std::string, std::string> firmware = firmware_assignments(args.firmware);
     firmware[spec.mcus.front().name] = args.elf;
-    for (const auto& item : args.firmware) {
-        const auto eq = item.find('=');
-        if (eq == std::string::npos) throw BadInput("--firmware '" + item + "': expected MCU=ELF");
-        firmware[item.substr(0, eq)] = item.substr(eq + 1);
-    }
     BoardRun run;
     // With a job, --for is the limit for finishing it (default 60 s; a plot 600 s).
     const char* job_default = !args.dxf.empty() ? "600s" : "60s";
