@@ -94,6 +94,7 @@ const char* to_string(HostEventKind kind) {
         case HostEventKind::BannerTimeout: return "banner-timeout";
         case HostEventKind::LineTooLong: return "line-too-long";
         case HostEventKind::Restarted: return "restarted";
+        case HostEventKind::ResendLoop: return "resend-loop";
     }
     return "?";
 }
@@ -446,6 +447,7 @@ void UartHost::acknowledge() {
     outstanding_bytes_ -= outstanding_.front().bytes;
     outstanding_.pop_front();
     ++acknowledged_;
+    resends_of_oldest_ = 0;
     if (failed_) return;
     // Progress: the next unanswered line (if any) gets a fresh timeout.
     if (!outstanding_.empty()) {
@@ -545,9 +547,22 @@ void UartHost::arm_quiet_timer() {
 // or a line-number mismatch) and then says "ok": that "ok" means "ready",
 // not "done". The host sends its oldest unanswered line again on that ok
 // (as Printrun does); the resent line gets an ok of its own.
-void UartHost::resend(Cycle, const std::string&) {
+void UartHost::resend(Cycle cycle, const std::string& text) {
     ++resends_;
-    if (!outstanding_.empty()) resend_on_next_ok_ = true;
+    if (outstanding_.empty()) return;
+    // A line the firmware rejects every time (a bad checksum of its own,
+    // a `*` with nothing before it) would be resent forever: give up after
+    // this many in a row (assumed: a host's patience, as OctoPrint warns
+    // about resend storms; Printrun has no limit).
+    constexpr std::size_t kMaxResendsOfOneLine = 5;
+    if (++resends_of_oldest_ > kMaxResendsOfOneLine) {
+        HostEvent e = event_at_oldest_line(HostEventKind::ResendLoop, cycle, text);
+        e.message = "line " + std::to_string(e.line->number) + " " + quoted_line(e.line->text) + " was asked for again " +
+                    std::to_string(kMaxResendsOfOneLine) + " times in a row ('" + text + "'): the firmware rejects it every time";
+        fail(std::move(e));
+        return;
+    }
+    resend_on_next_ok_ = true;
 }
 
 // The timeout for the oldest unanswered line: longer for commands that take

@@ -147,6 +147,7 @@ enum class HostEventKind {
     BannerTimeout,  // WaitForBanner: no banner within banner_timeout_s
     LineTooLong,    // character counting: a line longer than the receive buffer can never be sent
     Restarted,      // the family's welcome came again mid-job: the firmware reset
+    ResendLoop,     // the firmware asked for the same line again and again (Marlin's Resend:)
 };
 
 const char* to_string(HostEventKind kind);
@@ -256,6 +257,7 @@ private:
     std::uint64_t quiet_generation_ = 0;
     std::size_t resends_ = 0;
     bool resend_on_next_ok_ = false;
+    std::size_t resends_of_oldest_ = 0;  // Resend: answers since the oldest line was last acknowledged
 
     struct Outstanding {
         std::size_t index;  // into lines_

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <ostream>
 
 #include "support/Paths.hpp"
@@ -54,6 +55,30 @@ TEST(CliRun, TwoRunsGiveByteIdenticalVcds) {
     const std::string a = test::slurp(dir / "a.vcd");
     ASSERT_GT(a.size(), 200u);
     EXPECT_EQ(a, test::slurp(dir / "b.vcd"));
+}
+
+// Marlin's resend protocol with a line the firmware rejects every time: a
+// lone `*` is a checksum with no line before it, so seed 001's interpolator
+// answers "Error:checksum mismatch", "Resend: 1", "ok" each time (its
+// protocol, Printer3dJob.ProtocolChecksumsLineNumbersAndErrors). The host
+// resends it 5 times (UartHost's limit) and then gives up with one line,
+// instead of resending until --for ends (found by fuzzing: 1 750 resends in
+// 6 s), and M114 after it is never sent.
+TEST(CliRun, AHostGivesUpOnALineTheFirmwareRejectsEveryTime) {
+    const auto dir = test::scratch_dir("cli-resend-loop");
+    const auto job = dir / "job.gcode";
+    std::ofstream(job) << "G91\n*\nM114\n";
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("printer3d_interp")) + " --board " +
+                                         quoted(test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml")) +
+                                         " --gcode " + quoted(job.string()) + " --for 5s",
+                                     dir);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_NE(r.err.find("line 2 '*' was asked for again 5 times in a row ('Resend: 1')"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("host failed"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("> M114"), std::string::npos) << r.out;
+    std::size_t resent = 0;
+    for (std::size_t at = r.out.find("> *"); at != std::string::npos; at = r.out.find("> *", at + 1)) ++resent;
+    EXPECT_LE(resent, 6u) << r.out;  // the transcript tail shows at most the first send and 5 resends
 }
 
 TEST(CliRun, UartInAndOut) {
