@@ -25,7 +25,10 @@
  *    plane, though the program's own targets need -40..57 deg: here an
  *    angle is valid when its table index offset - angle lies in 0..180 (the
  *    servo's calibrated range);
- *  - the call was spelled delta_calInverse (did not compile).
+ *  - the call was spelled delta_calInverse (did not compile);
+ *  - nothing kept the target below the base: z = 0 made every angle NaN
+ *    and the move was carried out with whatever (int)round(NaN) gave (found
+ *    by fuzzing this build, `G1 Z0`); here z must be below 0.
  * THESIS_LITERAL builds the listing's behaviour: angles used whatever the
  * status, and table indexes unchecked (an index outside 0..180 reads past
  * the table).
@@ -229,8 +232,14 @@ static int8_t plan(float x_cm, float y_cm, float z_cm, int angle[3])
 {
     float theta[3];
     const int8_t status = calc_inverse(x_cm, y_cm, z_cm, theta);
-    int8_t ok = status == 0;
+    /* The robot hangs below its base: z = 0 divides by zero in
+     * calc_angle_yz (NaN passes "d < 0"), z > 0 is through the base plate. */
+    int8_t ok = status == 0 && z_cm < 0;
     for (uint8_t n = 0; n < 3; ++n) {
+        if (!isfinite(theta[n])) {
+            ok = 0;
+            theta[n] = 0;
+        }
         angle[n] = (int)round(theta[n]);
         const int index = offset[n] - angle[n];
         if (index < 0 || index > 180) ok = 0;
