@@ -26,6 +26,7 @@ const char* to_string(FindingKind kind) {
         case FindingKind::HostProtocol: return "host-protocol";
         case FindingKind::SerialFraming: return "serial-framing";
         case FindingKind::ServoPulseOutOfRange: return "servo-pulse-out-of-range";
+        case FindingKind::TargetOutOfReach: return "target-out-of-reach";
         case FindingKind::NetContention: return "net-contention";
         case FindingKind::FloatingInputRead: return "floating-input-read";
     }

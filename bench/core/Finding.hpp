@@ -33,6 +33,7 @@ enum class FindingKind {
     HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
     SerialFraming,       // a pin-level serial frame with a bad stop bit or edges off the bit grid
     ServoPulseOutOfRange,  // an RC servo pulse wider or narrower than its calibrated range
+    TargetOutOfReach,    // the firmware answered ok to a move the machine cannot make (a delta's arms or servos)
 
     // Found by the nets (wiring/).
     NetContention,       // two outputs drive one net to opposite levels

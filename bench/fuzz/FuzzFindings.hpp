@@ -38,6 +38,12 @@ inline std::string finding_kind(std::string text) {
         const auto detail = text.find(": ", pc);
         if (detail != std::string::npos) text.erase(detail);
     }
+    // A move the machine cannot make: which limit is the finding ("arm 2
+    // beyond its servo's travel"); the line and target vary.
+    if (const auto reach = text.find(": target-out-of-reach"); reach != std::string::npos) {
+        const auto specifics = text.find("; ", reach);
+        if (specifics != std::string::npos) text.erase(specifics);
+    }
     // A finding's time and cycle: " at 1.200917 s (cycle 19214673)".
     const auto when = text.find(" s (cycle ");
     if (when != std::string::npos) {

@@ -32,6 +32,10 @@ std::vector<ParamSpec> DeltaRobot::param_specs() {
          .source = "assumed; seed 004's firmware: 110 deg", .help = "servo 2's angle with its upper arm horizontal"},
         {.name = "offset3", .type = PT::Quantity, .dimension = D::Angle, .default_value = "90deg",
          .source = "assumed; seed 004's firmware: 116 deg", .help = "servo 3's angle with its upper arm horizontal"},
+        {.name = "move_commands", .type = PT::Choice, .default_value = "base_frame", .choices = {"base_frame", "unchecked"},
+         .source = "firmware/delta's G1 X Y Z",
+         .help = "base_frame: G0/G1 X Y Z (mm) answered ok are targets in this part's frame and are checked "
+                 "(target-out-of-reach); unchecked: the firmware uses another frame"},
         {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "5ms",
          .source = "assumed: a 285 deg/s servo moves 1.4 deg in 5 ms",
          .help = "how often the effector position is recomputed from the horns"},
@@ -48,6 +52,7 @@ DeltaRobot::DeltaRobot(std::string name, Mcu& clock, const ParamValues& params) 
         throw BadInput("part '" + this->name() + "': needs base_side > effector_side and forearm > upper_arm > 0");
     }
     for (int k = 0; k < 3; ++k) offset_deg_[static_cast<std::size_t>(k)] = params.quantity("offset" + std::to_string(k + 1)) * kRadToDeg;
+    check_moves_ = params.text("move_commands") == "base_frame";
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
@@ -94,6 +99,41 @@ void DeltaRobot::sample() {
     publish(sig_y_, p->y());
     publish(sig_z_, p->z());
     for (auto& fn : move_listeners_) fn(effector_mm_);
+}
+
+void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) {
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.3f, %.3f, %.3f) mm", target_mm.x(), target_mm.y(), target_mm.z());
+    // The robot hangs below its base (seed 004 §2: z < 0): above the base
+    // plane the forearms would pass through it, and the forward kinematics
+    // (the lower meeting point of the three spheres) never goes there.
+    const auto pose = [this](const Eigen::Vector3d& p) {
+        return p.z() < 0 ? delta_inverse(geometry_, p) : std::nullopt;
+    };
+    const auto theta = pose(target_mm);
+    if (!theta) {
+        // Out of reach, and clearly so: every point within the margin is too.
+        for (int axis = 0; axis < 3; ++axis) {
+            for (double sign : {-1.0, 1.0}) {
+                Eigen::Vector3d near = target_mm;
+                near[axis] += sign * kReachMarginMm;
+                if (pose(near)) return;
+            }
+        }
+        report(FindingKind::TargetOutOfReach, std::string("no pose of the arms below the base reaches the target; ") + line +
+                                                  " was answered ok, target " + where);
+        return;
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+        const double horn = offset_deg_[k] - (*theta)[k];
+        const double lo = horns_[k]->min_angle_deg(), hi = horns_[k]->max_angle_deg();
+        if (horn >= lo - kTravelMarginDeg && horn <= hi + kTravelMarginDeg) continue;
+        char detail[200];
+        std::snprintf(detail, sizeof detail, " was answered ok, target %s needs %s at %.1f deg, its travel %g..%g deg", where,
+                      horns_[k]->name().c_str(), horn, lo, hi);
+        report(FindingKind::TargetOutOfReach, "arm " + std::to_string(k + 1) + " beyond its servo's travel; " + line + detail);
+        return;
+    }
 }
 
 std::string DeltaRobot::summary() {

@@ -37,6 +37,22 @@ public:
     std::array<double, 3> arm_angles_deg() const;
     void on_move(std::function<void(const Eigen::Vector3d&)> fn) { move_listeners_.push_back(std::move(fn)); }
 
+    // Whether G0/G1 X Y Z lines the firmware accepts are targets in this
+    // part's frame (mm, origin at the base centre, z negative below it; the
+    // `move_commands` parameter). Bench checks each one with check_accepted_move.
+    bool checks_move_commands() const { return check_moves_; }
+    // The firmware answered ok to a move to `target_mm` (`line` quotes it):
+    // a target-out-of-reach finding when no pose of the arms reaches it or an
+    // arm would need its servo's horn beyond the servo's travel. Targets
+    // near either limit are not judged, since a firmware's float32
+    // arithmetic may fall either side there: within kReachMarginMm of the
+    // reachable space, or within kTravelMarginDeg of the travel's ends (half
+    // a degree for a firmware that rounds angles to whole table entries, as
+    // seed 004's does, and 0.1 deg for float32).
+    void check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line);
+    static constexpr double kReachMarginMm = 0.5;
+    static constexpr double kTravelMarginDeg = 0.6;
+
 private:
     void tick();
     void sample();
@@ -49,6 +65,7 @@ private:
     Eigen::Vector3d effector_mm_ = Eigen::Vector3d::Zero();
     bool reachable_ = false;
     bool sampled_ = false;
+    bool check_moves_ = true;
     std::size_t sig_x_, sig_y_, sig_z_, sig_reachable_;
     std::vector<std::function<void(const Eigen::Vector3d&)>> move_listeners_;
 };

@@ -27,6 +27,9 @@ public:
     double target_deg() const { return target_deg_; }
     double last_pulse_us() const { return last_pulse_us_; }
     unsigned pulses() const { return pulses_; }
+    // The horn's travel: the calibration table's first and last angle.
+    double min_angle_deg() const { return table_.front().deg; }
+    double max_angle_deg() const { return table_.back().deg; }
     // The table's angle for a pulse width (clamped to the table's ends).
     double angle_for_pulse_us(double width_us) const;
 

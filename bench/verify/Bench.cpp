@@ -10,9 +10,11 @@
 
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
+#include "parts/DeltaRobot.hpp"
 #include "parts/Heater.hpp"
 #include "parts/StepDirDriver.hpp"
 #include "parts/ThermalPlant.hpp"
+#include "stimulus/CommandedTarget.hpp"
 
 namespace avrbench {
 
@@ -112,8 +114,35 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
             o = default_host_options(*decl);
         }
         slot = std::make_unique<UartHost>(board_->mcu(decl->mcu), decl->usart, o);
+        check_accepted_moves(*slot);
     }
     return *slot;
+}
+
+void Bench::check_accepted_moves(UartHost& host) {
+    std::vector<DeltaRobot*> robots;
+    for (DeltaRobot* robot : board_->parts_of_type<DeltaRobot>()) {
+        if (robot->checks_move_commands()) robots.push_back(robot);
+    }
+    if (robots.empty()) return;
+    // Every answer that acknowledges a line (ok or error) moves
+    // lines_acknowledged() on by one, in the order the lines went out.
+    struct Seen {
+        CommandedTarget target;
+        std::size_t acknowledged = 0;
+    };
+    auto seen = std::make_shared<Seen>();
+    host.on_line_received([&host, robots, seen](const TranscriptEntry& entry) {
+        const std::size_t acknowledged = host.lines_acknowledged();
+        if (acknowledged == seen->acknowledged) return;
+        seen->acknowledged = acknowledged;
+        if (entry.text.rfind("ok", 0) != 0) return;  // an error: the firmware did not take the line
+        const GcodeLine& line = host.lines()[acknowledged - 1];
+        const auto target = seen->target.accept(line.text);
+        if (!target) return;
+        const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
+        for (DeltaRobot* robot : robots) robot->check_accepted_move(Eigen::Vector3d{(*target)[0], (*target)[1], (*target)[2]}, quoted);
+    });
 }
 
 void Bench::trace_board() {

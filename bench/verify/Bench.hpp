@@ -106,6 +106,9 @@ public:
 
 private:
     void watch_motion();
+    // G0/G1 targets the firmware answers ok to, checked against the board's
+    // machines that can judge them (parts/DeltaRobot: target-out-of-reach).
+    void check_accepted_moves(UartHost& host);
 
     std::unique_ptr<Board> board_;
     Timeline timeline_;
