@@ -152,9 +152,11 @@ std::size_t mutate_gcode(std::uint8_t* data, std::size_t size, std::size_t max_s
             // Data bugs with no branch of their own (an unchecked table index
             // from a target just out of reach: seed 004) give coverage
             // nothing to follow; they need numbers of the right size. Each
-            // word's number (at least one) is scaled by -4..4 or shifted by up
-            // to twice its magnitude (at least 100), and kept whole: the
-            // target moves to somewhere near, in any direction.
+            // word's number (at least one) is scaled by -4..4, shifted by up
+            // to twice its magnitude (at least 100), or nudged by up to 10 %
+            // and 5 units (limits lie just beyond the targets a job uses: the
+            // delta's servo travel runs out 20 mm above seed 004's), and kept
+            // whole: the target moves to somewhere near, in any direction.
             if (words.empty()) break;
             const std::size_t always = pick(words.size());
             for (std::size_t w = words.size(); w-- > 0;) {  // from the end: earlier offsets stay valid
@@ -164,8 +166,15 @@ std::size_t mutate_gcode(std::uint8_t* data, std::size_t size, std::size_t max_s
                 if (end - begin < 2) continue;
                 const double value = std::atof(line.substr(begin + 1, end - begin - 1).c_str());
                 const double magnitude = std::max(100.0, 2 * std::abs(value));
-                const double moved = pick(2) == 0 ? value * (static_cast<double>(pick(81)) / 10.0 - 4.0)
-                                                  : value + (static_cast<double>(pick(2001)) / 1000.0 - 1.0) * magnitude;
+                double moved = value;
+                switch (pick(3)) {
+                    case 0: moved = value * (static_cast<double>(pick(81)) / 10.0 - 4.0); break;
+                    case 1: moved = value + (static_cast<double>(pick(2001)) / 1000.0 - 1.0) * magnitude; break;
+                    default:
+                        moved = value * (1.0 + (static_cast<double>(pick(201)) / 1000.0 - 0.1)) +
+                                (static_cast<double>(pick(11)) - 5.0);
+                        break;
+                }
                 line.replace(begin + 1, end - begin - 1, std::to_string(static_cast<long>(moved)));
             }
             break;

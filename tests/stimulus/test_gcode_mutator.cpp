@@ -109,6 +109,24 @@ TEST(GcodeMutator, NearbyNumbersStayWithinAFewTimesTheOriginal) {
     EXPECT_TRUE(negative && positive && moved);
 }
 
+TEST(GcodeMutator, NearbyNumbersOftenStayCloseToTheOriginal) {
+    // A limit just past a job's targets needs small moves often: from X-33,
+    // the nudge (a third of the nearby mutations) lands in -33 * (0.9..1.1)
+    // -+ 5 = [-41.3, -24.7] always; scaling (0.8..1.2 of the 81 factors) and
+    // shifting (16 of 200 units) add about 2 % more. Together about a third:
+    // at least a fifth, over ~300 mutations, leaves room for chance.
+    int nearby = 0, close = 0;
+    for (unsigned seed = 0; seed < 3000; ++seed) {
+        const Mutated m = mutate("G1 X-33\n", seed);
+        if (m.kind != GcodeMutation::NearbyNumber) continue;
+        ++nearby;
+        const long x = std::strtol(m.text.c_str() + m.text.find('X') + 1, nullptr, 10);
+        if (x >= -41 && x <= -25 && x != -33) ++close;
+    }
+    ASSERT_GT(nearby, 200);
+    EXPECT_GT(close * 5, nearby) << close << " of " << nearby;
+}
+
 TEST(GcodeMutator, KeepsToTheSizeLimitAndIsDeterministic) {
     for (unsigned seed = 0; seed < 500; ++seed) {
         EXPECT_LE(mutate("G1 X5 Y5 F600\nM105\n", seed, 20).text.size(), 20u);
