@@ -487,6 +487,14 @@ StopReason Board::run_for_seconds(double seconds) {
     return run_until_ps(add_ps(now_ps(), ps_from_seconds(seconds, "run_for_seconds")));
 }
 
+std::size_t Board::finding_count() const {
+    std::size_t n = 0;
+    for (const auto& m : mcus_) n += m->findings().size();
+    for (const auto& p : parts_) n += p->findings().size();
+    for (const auto& net : nets_) n += net->findings().size();
+    return n;
+}
+
 std::vector<Finding> Board::findings() const {
     std::vector<Finding> out;
     for (const auto& m : mcus_) out.insert(out.end(), m->findings().begin(), m->findings().end());

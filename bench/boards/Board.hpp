@@ -74,6 +74,8 @@ public:
 
     // Every finding of every MCU and part, in the order they happened per source.
     std::vector<Finding> findings() const;
+    // How many there are (cheap: nothing is copied).
+    std::size_t finding_count() const;
 
 private:
     void build_mcus(const std::map<std::string, std::string>& firmware);

@@ -21,6 +21,10 @@ Bench* g_bench = nullptr;
 TargetConfig g_config;
 std::string g_mcu_name;  // the fuzzed MCU: the serial port's
 std::size_t g_findings_at_ready = 0;
+// Per source (MCU, part, net): how many findings it had at ready. Board::
+// findings() groups them by source, so a new one of an early source comes
+// before an old one of a later source.
+std::map<std::string, std::size_t> g_findings_at_ready_by_source;
 
 std::string env_or_die(const char* name, const char* who) {
     const char* value = std::getenv(name);
@@ -122,7 +126,9 @@ void boot_target(const TargetConfig& config, const char* who) {
                 std::exit(2);
             }
         }
-        g_findings_at_ready = g_bench->board().findings().size();
+        const auto at_ready = g_bench->board().findings();
+        g_findings_at_ready = at_ready.size();
+        for (const auto& f : at_ready) ++g_findings_at_ready_by_source[f.source];
     } catch (const BadInput& e) {
         std::fprintf(stderr, "%s: %s\n", who, e.what());
         std::exit(2);
@@ -156,7 +162,17 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     const Cycle slice = mcu.cycles_from_seconds(0.001);
     const std::uint64_t steps_before = mcu.steps();
     bool settling = false;
-    while (mcu.cycle() < end && !mcu.halted()) {
+    // The first finding ends the input: only it is reported, and an input
+    // that drives a carriage into its end would otherwise run to the bound.
+    const auto found = [&] {
+        if (bench.board().finding_count() > g_findings_at_ready) return true;
+        if (host == nullptr) return false;
+        for (const auto& e : host->events()) {
+            if (is_oracle_event(e.kind)) return true;
+        }
+        return false;
+    };
+    while (mcu.cycle() < end && !mcu.halted() && !found()) {
         if (!settling && sent()) {
             settling = true;
             end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_config.settle_s));
@@ -169,8 +185,17 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     mcu.set_run_coverage(nullptr);
     outcome.steps = mcu.steps() - steps_before;
     std::string detail;
-    const auto findings = bench.board().findings();  // the MCU's, the nets', the parts'
-    if (findings.size() > g_findings_at_ready) detail = findings[g_findings_at_ready].describe();
+    // The MCU's, the nets', the parts' (grouped by source): the earliest new one.
+    const auto findings = bench.board().findings();
+    const Finding* first = nullptr;
+    const auto seconds = [](const Finding& f) { return f.clock_hz != 0 ? static_cast<double>(f.cycle) / f.clock_hz : 0.0; };
+    std::map<std::string, std::size_t> seen_by_source;
+    for (const Finding& f : findings) {
+        const auto old = g_findings_at_ready_by_source.find(f.source);
+        if (++seen_by_source[f.source] <= (old != g_findings_at_ready_by_source.end() ? old->second : 0)) continue;
+        if (first == nullptr || seconds(f) < seconds(*first)) first = &f;
+    }
+    if (first != nullptr) detail = first->describe();
     if (detail.empty() && host != nullptr) {
         for (const auto& e : host->events()) {
             if (is_oracle_event(e.kind)) {

@@ -126,12 +126,15 @@ TEST(Fuzz, TargetReadsItsSettingsFromTheFileBesideIt) {
 
 // A board of several MCUs: the fuzzed ELF runs on the serial port's MCU
 // (seed 001's interpolator), the others get theirs from
-// AVRBENCH_FUZZ_FIRMWARE and run in the board's lockstep. The X carriage
-// starts at 3.5 mm (bench/boards/printer3d-seed001.yaml); a full circle
-// G2 I-5 J0 from there has its centre 5 mm to the left and reaches
-// 3.5 - 10 = -6.5 mm, past the travel's lower end: the drive board's motor
-// must carry it there (the interpolator has no soft limits). G1 X5 stays
-// inside. M400 keeps each input running until the move is done.
+// AVRBENCH_FUZZ_FIRMWARE and run in the board's lockstep. The carriages
+// start at X 3.5 mm, Y 2.5 mm (bench/boards/printer3d-seed001.yaml); a full
+// circle G2 I-5 J0 from there has its centre 5 mm to the left, and clockwise
+// it goes down first: Y crosses 0 a twelfth of the way round (2.5 = 5 sin
+// 30 deg; X is then at -1.5 + 5 cos 30 deg = 2.83 mm and only crosses 0 at
+// 72.5 deg), past the travel's lower end: the drive board's motor must
+// carry it there (the interpolator has no soft limits). The first finding
+// ends the input, so Y's is the one reported. G1 X5 stays inside. M400
+// keeps each input running until the move is done.
 TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
     const auto dir = test::scratch_dir("fuzz-multi");
     const std::string drive = test::firmware("printer3d_drive");
@@ -143,7 +146,7 @@ TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
     const auto circle = test::run_command(env + (dir / "circle").string(), dir, 60);
     EXPECT_NE(circle.exit_code, 0) << circle.err;
     EXPECT_NE(circle.err.find("FINDING"), std::string::npos) << circle.err;
-    EXPECT_NE(circle.err.find("x: axis-out-of-travel"), std::string::npos) << circle.err;
+    EXPECT_NE(circle.err.find("y: axis-out-of-travel"), std::string::npos) << circle.err;
     EXPECT_NE(circle.err.find("past the lower end of travel"), std::string::npos) << circle.err;
     std::ofstream(dir / "inside") << "G1 X5 F600\nM400\n";
     const auto inside = test::run_command(env + (dir / "inside").string(), dir, 60);
