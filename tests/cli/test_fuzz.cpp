@@ -8,7 +8,9 @@
 // the listing sends no keep-alive). The seed corpus holds well-formed lines
 // only; the overrun comes from the search. The same with AFL++ (--engine
 // afl, its own fork server in the target, the G-code mutator as its custom
-// mutator): 20 s. Wall-clock guards: 90 s per run.
+// mutator): 20 s. Seed 004's delta: the out-of-table angle with AFL++ in
+// 30 s, nothing in the improved build in 10 s (below). Wall-clock guards:
+// 90 s per run.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -85,6 +87,46 @@ TEST(Fuzz, AflFindsTheThesisParsersPlantedBugs) {
     EXPECT_GT(last, first) << "coverage must grow over the run\n" << out;
     EXPECT_TRUE(std::filesystem::exists(dir / "out/afl/main/fuzzer_stats"));
     EXPECT_TRUE(std::filesystem::exists(dir / "out/findings/finding-1.vcd"));
+}
+
+// Seed 004's planted bug (digest §4: no bounds check on offset - angle): a
+// target the arms reach but whose angle leaves a servo's 0..180 deg table.
+// The bench sees it two ways: the move oracle (a G1 answered ok that needs a
+// servo beyond its travel, parts/DeltaRobot) and, when the index lands
+// outside all three tables, a pulse no table holds. The seed corpus is the
+// thesis program's own moves (tests/fixtures/fuzz/firmware/delta-seed004-
+// corpus: positionMatrix rows, digest §3/§8.4, in mm), all inside the
+// travel. Measured before this test: all four AFL++ seeds tried found it
+// within 15 s (two campaigns sharing the two cores); 30 s here for the
+// ASan build.
+std::string fuzz_delta(const std::string& elf, const std::string& seconds, const std::filesystem::path& dir, int* exit_code) {
+    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --engine afl --elf " + test::firmware(elf) + " --board " +
+                                test::source_path("bench/boards/delta-seed004.yaml") + " --corpus " +
+                                test::source_path("tests/fixtures/fuzz/firmware/delta-seed004-corpus") + " --for " + seconds +
+                                " --seed 1 --out " + (dir / "out").string();
+    const auto r = test::run_command(command, dir, 90);
+    *exit_code = r.exit_code;
+    return r.out + r.err;
+}
+
+TEST(Fuzz, AflFindsTheDeltaThesisOutOfTableAngle) {
+    const auto dir = test::scratch_dir("fuzz-afl-delta-thesis");
+    int code = 0;
+    const std::string out = fuzz_delta("delta_thesis", "30s", dir, &code);
+    EXPECT_EQ(code, 1) << out;
+    const bool beyond_travel = out.find("robot: target-out-of-reach: arm ") != std::string::npos &&
+                               out.find(" beyond its servo's travel (") != std::string::npos;
+    const bool outside_tables = out.find(": servo-pulse-out-of-range: pulse of ") != std::string::npos;
+    EXPECT_TRUE(beyond_travel || outside_tables) << out;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/findings/finding-1.gcode"));
+}
+
+TEST(Fuzz, AflFindsNothingInTheImprovedDelta) {
+    const auto dir = test::scratch_dir("fuzz-afl-delta-improved");
+    int code = 0;
+    const std::string out = fuzz_delta("delta", "10s", dir, &code);
+    EXPECT_EQ(code, 0) << out;
+    EXPECT_NE(out.find("findings   0 distinct"), std::string::npos) << out;
 }
 
 TEST(Fuzz, AflFindsNothingInTheImprovedInterpolator) {
