@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace avrbench::test {
 
@@ -25,11 +26,20 @@ inline std::string slurp(const std::filesystem::path& path) {
     return ss.str();
 }
 
-// A fresh scratch directory per test, under the build tree's temp space.
+// The scratch directories the running test made; tests/support/
+// ScratchCleanup.cpp removes them when the test passes (a failed test's stay
+// for a look, as do all with AVRBENCH_KEEP_SCRATCH=1).
+inline std::vector<std::filesystem::path>& scratch_dirs_of_this_test() {
+    static std::vector<std::filesystem::path> dirs;
+    return dirs;
+}
+
+// A fresh scratch directory per test, in the system's temp space.
 inline std::filesystem::path scratch_dir(const std::string& name) {
     auto dir = std::filesystem::temp_directory_path() / ("avrbench-test-" + name + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
+    scratch_dirs_of_this_test().push_back(dir);
     return dir;
 }
 
