@@ -1,6 +1,5 @@
 #include "stimulus/CommandedTarget.hpp"
 
-#include <cctype>
 #include <cstdlib>
 #include <map>
 #include <string>
