@@ -25,6 +25,7 @@ extern "C" {
 #include "core/IntelHex.hpp"
 #include "core/Twi.hpp"
 #include "core/UserStop.hpp"
+#include "core/fixes/CompareOutputPins.hpp"
 #include "core/fixes/Fix.hpp"
 #include "core/fixes/Interrupts.hpp"
 
@@ -530,6 +531,17 @@ void Mcu::on_simavr_error(const char* message) {
         std::snprintf(detail, sizeof detail, "opcode 0x%04x is not an AVR instruction", opcode);
         add_finding(FindingKind::InvalidOpcode, pc, detail, true);
     }
+}
+
+bool Mcu::set_periodic_output_sink(Pin& pin, PeriodicOutputSink* sink) {
+    CompareOutputPins* pins = CompareOutputPins::of(avr_);
+    if (pins == nullptr) return false;
+    pins->set_sink(pin.port(), __builtin_ctz(pin.mask()), sink);
+    return true;
+}
+
+void Mcu::settle_periodic_outputs() {
+    if (CompareOutputPins* pins = CompareOutputPins::of(avr_)) pins->stop_all_waves();
 }
 
 Pin& Mcu::pin(std::string_view name) {

@@ -15,6 +15,7 @@
 #include "core/BootSection.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Finding.hpp"
+#include "core/PeriodicOutput.hpp"
 #include "core/Pin.hpp"
 #include "core/Scheduler.hpp"
 #include "core/SimavrFixes.hpp"
@@ -148,6 +149,16 @@ public:
 
     // "PB5" (also "B5"). Throws BadInput for a port the MCU does not have.
     Pin& pin(std::string_view name);
+    // Who takes `pin` as a periodic wave when a timer's compare output
+    // repeats on it (core/PeriodicOutput.hpp); nullptr removes the sink
+    // without ending a running wave (for teardown).
+    // False when the bench does not model this MCU's timers.
+    bool set_periodic_output_sink(Pin& pin, PeriodicOutputSink* sink);
+    // Ends every running wave, so that PINx, the pins' IRQs and their nets
+    // show the levels of now (for looking at the raw I/O space between runs;
+    // the firmware's own reads end them anyway). They begin again at the
+    // next period start.
+    void settle_periodic_outputs();
     // USART n. Throws BadInput when the MCU has no such USART.
     Uart& uart(int index = 0);
     Scheduler& scheduler() { return *scheduler_; }

@@ -1,5 +1,6 @@
 #include "core/Pin.hpp"
 
+#include "core/fixes/CompareOutputPins.hpp"
 #include "core/fixes/Interrupts.hpp"
 
 extern "C" {
@@ -46,6 +47,9 @@ bool Pin::internal_pull_up() const {
 bool Pin::is_output() const { return (avr_->data[port_->r_ddr] & mask_) != 0; }
 
 void Pin::on_change(Listener fn) {
+    // A wave on this pin (core/PeriodicOutput.hpp) was accepted for the
+    // listeners it had: end it, so the new one hears every edge.
+    if (CompareOutputPins* outputs = CompareOutputPins::of(avr_)) outputs->stop_all_waves();
     listeners_.push_back(std::move(fn));
     if (!notify_registered_) {
         notified_level_ = level();

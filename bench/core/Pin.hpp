@@ -42,6 +42,7 @@ public:
     // The firmware has the pin as an output (DDxn = 1).
     bool is_output() const;
     void on_change(Listener fn);
+    std::size_t listener_count() const { return listeners_.size(); }
 
     // The simavr IRQ of the pin, for hot-path observers (the trace recorder)
     // that register a plain C callback instead of a std::function.

@@ -42,6 +42,9 @@ Recorder::~Recorder() {
 }
 
 SignalId Recorder::trace_pin(Mcu& mcu, Pin& pin) {
+    // A pin handed out as a periodic wave would not tell this listener its
+    // edges: end the waves (they do not begin again while it listens).
+    mcu.settle_periodic_outputs();
     const SignalId id = timeline_.add_signal({mcu.name(), pin.name(), SignalKind::Wire, 1, mcu.frequency_hz()});
     const bool level = pin.level();
     timeline_.record(id, mcu.cycle(), level ? 1 : 0);
@@ -68,6 +71,7 @@ SignalId Recorder::trace_twi(Mcu& mcu, Twi& twi) {
 }
 
 std::vector<SignalId> Recorder::trace_part(Part& part) {
+    part.clock().settle_periodic_outputs();  // a heater following a wave publishes no edges
     std::vector<SignalId> ids;
     for (const auto& s : part.signals()) {
         ids.push_back(timeline_.add_signal({part.name(), s.name, s.real ? SignalKind::Real : SignalKind::Wire, 1,

@@ -9,8 +9,16 @@ extern "C" {
 }
 
 #include "core/fixes/Interrupts.hpp"
+#include "core/fixes/SimavrIrqHooks.hpp"
 
 namespace avrbench {
+
+namespace {
+Registry<avr_t, CompareOutputPins>& instances() {
+    static Registry<avr_t, CompareOutputPins> r;
+    return r;
+}
+}  // namespace
 
 struct CompareOutputPins::Port {
     CompareOutputPins* owner = nullptr;
@@ -18,7 +26,8 @@ struct CompareOutputPins::Port {
     std::uint8_t connected = 0;  // pins a connected OCnx drives
     std::uint8_t level = 0;      // their OCnx level
     std::uint8_t shared = 0;     // pins with more than one comparator (2560 PB7: OC0A, OC1C)
-    std::unique_ptr<IoWriteHook> port_write, pin_write, ddr_write;
+    std::uint8_t waving = 0;     // pins handed out as periodic waves
+    std::unique_ptr<IoWriteHook> port_write, pin_write, ddr_write, pcmsk_write;
     std::unique_ptr<IoReadHook> pin_read;
 
     std::uint8_t overridden(const avr_t* avr) const { return connected & avr->data[io->r_ddr]; }
@@ -28,9 +37,13 @@ struct CompareOutputPins::Port {
 };
 
 CompareOutputPins::CompareOutputPins(avr_t* avr)
-    : avr_(avr), pin_write_toggles_(part_facts(avr).pin_write_toggles) {}
+    : avr_(avr), pin_write_toggles_(part_facts(avr).pin_write_toggles) {
+    instances().add(avr, this);
+}
 
-CompareOutputPins::~CompareOutputPins() = default;
+CompareOutputPins::~CompareOutputPins() { instances().remove(avr_); }
+
+CompareOutputPins* CompareOutputPins::of(const avr_t* avr) { return instances().find(avr); }
 
 CompareOutputPins::Port* CompareOutputPins::port_for(avr_ioport_t* io) {
     for (auto& p : ports_) {
@@ -72,6 +85,7 @@ int CompareOutputPins::add(avr_regbit_t com_pin, avr_irq_t* compare_irq) {
 
 void CompareOutputPins::after_reset() {
     for (Driver& d : drivers_) {
+        if (d.waving) end_wave(static_cast<int>(&d - drivers_.data()), avr_->cycle);
         d.connected = false;
         d.level = false;
         avr_unconnect_irq(d.compare_irq, d.pin_irq);
@@ -127,6 +141,7 @@ void CompareOutputPins::update_pin(Port& port, std::uint8_t bit) {
 
 void CompareOutputPins::on_port_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
     auto* port = static_cast<Port*>(hook.context());
+    if (port->waving != 0) port->owner->stop_waves(*port);
     if (port->connected == 0) {
         hook.write_original(avr, addr, value);
         return;
@@ -143,6 +158,7 @@ void CompareOutputPins::on_port_write(IoWriteHook& hook, avr_t* avr, avr_io_addr
 
 void CompareOutputPins::on_pin_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
     auto* port = static_cast<Port*>(hook.context());
+    if (port->waving != 0) port->owner->stop_waves(*port);
     const std::uint8_t ovr = port->overridden(avr);
     if (ovr == 0) {
         hook.write_original(avr, addr, value);
@@ -165,6 +181,7 @@ void CompareOutputPins::on_pin_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_
 
 void CompareOutputPins::on_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
     auto* port = static_cast<Port*>(hook.context());
+    if (port->waving != 0) port->owner->stop_waves(*port);
     if (port->connected == 0) {
         hook.write_original(avr, addr, value);
         return;
@@ -179,10 +196,89 @@ void CompareOutputPins::on_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_
 
 std::uint8_t CompareOutputPins::on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr) {
     auto* port = static_cast<Port*>(hook.context());
+    if (port->waving != 0) port->owner->stop_waves(*port);
     const std::uint8_t value = hook.read_original(avr, addr);
     const std::uint8_t ovr = port->overridden(avr);
     // PINxn of an output reads the pin, i.e. OCnx while it is overridden.
     return ovr == 0 ? value : static_cast<std::uint8_t>((value & ~ovr) | (port->level & ovr));
+}
+
+// --- periodic waves -----------------------------------------------------------
+
+void CompareOutputPins::set_sink(avr_ioport_t* io, int bit, PeriodicOutputSink* sink) {
+    for (std::size_t i = 0; i < sinks_.size(); ++i) {
+        if (sinks_[i].io != io || sinks_[i].bit != bit) continue;
+        sinks_.erase(sinks_.begin() + static_cast<std::ptrdiff_t>(i));
+        break;
+    }
+    if (sink != nullptr) sinks_.push_back({io, static_cast<std::uint8_t>(bit), sink});
+}
+
+PeriodicOutputSink* CompareOutputPins::sink_for(const Driver& d) const {
+    for (const Sink& s : sinks_) {
+        if (s.io == d.port->io && s.bit == d.bit) return s.sink;
+    }
+    return nullptr;
+}
+
+bool CompareOutputPins::only_known_listeners(const Driver& d, const PeriodicOutputSink& sink) const {
+    // Nobody may watch the comparator's own IRQ, and on the pin only simavr's
+    // port module (its notify's parameter is the port) and the sink's listener.
+    if (irq_has_listeners(d.compare_irq)) return false;
+    const void* allowed[2] = {d.port->io, sink.listener_param()};
+    return irq_listeners_within(d.pin_irq, allowed, 2);
+}
+
+bool CompareOutputPins::begin_wave(int id, const PeriodicWave& wave, StopWave stop, void* timer) {
+    if (id < 0) return false;
+    Driver& d = drivers_[static_cast<std::size_t>(id)];
+    Port& port = *d.port;
+    const std::uint8_t mask = static_cast<std::uint8_t>(1u << d.bit);
+    if (d.waving || !d.connected || d.level != wave.start_level) return false;
+    if ((port.shared & mask) != 0 || (avr_->data[port.io->r_ddr] & mask) == 0) return false;
+    avr_ioport_t* io = port.io;
+    if (io->r_pcint != 0) {
+        // simavr 1.6's avr_ioport_irq_notify raises PCIFx when PCMSK has the pin's bit.
+        if ((avr_->data[io->r_pcint] & mask) != 0) return false;
+    }
+    PeriodicOutputSink* sink = sink_for(d);
+    if (sink == nullptr || !only_known_listeners(d, *sink)) return false;
+    if (!sink->begin_wave(wave)) return false;
+    if (io->r_pcint != 0 && !port.pcmsk_write) {
+        port.pcmsk_write = std::make_unique<IoWriteHook>(avr_, io->r_pcint, &on_pcmsk_write, &port);
+    }
+    d.waving = true;
+    d.stop = stop;
+    d.timer = timer;
+    port.waving = static_cast<std::uint8_t>(port.waving | mask);
+    return true;
+}
+
+void CompareOutputPins::end_wave(int id, Cycle at) {
+    if (id < 0) return;
+    Driver& d = drivers_[static_cast<std::size_t>(id)];
+    if (!d.waving) return;
+    d.waving = false;
+    d.port->waving = static_cast<std::uint8_t>(d.port->waving & ~(1u << d.bit));
+    if (PeriodicOutputSink* sink = sink_for(d)) sink->end_wave(at);
+}
+
+void CompareOutputPins::stop_all_waves() {
+    for (Driver& d : drivers_) {
+        if (d.waving) d.stop(d.timer, avr_->cycle);
+    }
+}
+
+void CompareOutputPins::stop_waves(Port& port) {
+    for (Driver& d : drivers_) {
+        if (d.waving && d.port == &port) d.stop(d.timer, avr_->cycle);
+    }
+}
+
+void CompareOutputPins::on_pcmsk_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
+    auto* port = static_cast<Port*>(hook.context());
+    if (port->waving != 0) port->owner->stop_waves(*port);
+    hook.write_original(avr, addr, value);
 }
 
 }  // namespace avrbench

@@ -19,6 +19,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/PeriodicOutput.hpp"
 #include "core/fixes/Fix.hpp"
 
 struct avr_irq_t;
@@ -43,6 +44,23 @@ public:
     // IRQs straight to their pins again, and every COMnx is zero.
     void after_reset();
 
+    // Periodic waves (core/PeriodicOutput.hpp). The instance on `avr`'s
+    // timers, or nullptr when the bench does not model them.
+    static CompareOutputPins* of(const avr_t* avr);
+    // Who takes pin `bit` of `io` as a wave; nullptr removes the sink (for a
+    // board's teardown: a running wave goes on without telling anyone).
+    void set_sink(avr_ioport_t* io, int bit, PeriodicOutputSink* sink);
+    // The timer that owns driver `id` ends its wave and catches the pin up to
+    // `now` when the pin is about to be observed (its port written, PINx read).
+    using StopWave = void (*)(void* timer, Cycle now);
+    // Hands driver `id`'s pin out as `wave` if every condition in
+    // PeriodicOutput.hpp holds and the sink takes it.
+    bool begin_wave(int id, const PeriodicWave& wave, StopWave stop, void* timer);
+    // The wave ended at period boundary `at` (the driver is at its start level).
+    void end_wave(int id, Cycle at);
+    // Has every timer end its waves now (Mcu::settle_periodic_outputs).
+    void stop_all_waves();
+
 private:
     struct Port;
     struct Driver {
@@ -52,7 +70,22 @@ private:
         avr_irq_t* pin_irq = nullptr;
         bool connected = false;
         bool level = false;
+        bool waving = false;
+        StopWave stop = nullptr;
+        void* timer = nullptr;
     };
+    struct Sink {
+        avr_ioport_t* io = nullptr;
+        std::uint8_t bit = 0;
+        PeriodicOutputSink* sink = nullptr;
+    };
+
+    PeriodicOutputSink* sink_for(const Driver& d) const;
+    bool only_known_listeners(const Driver& d, const PeriodicOutputSink& sink) const;
+    // Ends the waves on `port`'s pins before the firmware or the port module
+    // looks at them.
+    void stop_waves(Port& port);
+    static void on_pcmsk_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value);
 
     Port* port_for(avr_ioport_t* io);
     void update_pin(Port& port, std::uint8_t bit);
@@ -69,6 +102,7 @@ private:
     bool pin_write_toggles_;
     std::vector<std::unique_ptr<Port>> ports_;
     std::vector<Driver> drivers_;
+    std::vector<Sink> sinks_;
 };
 
 }  // namespace avrbench

@@ -360,7 +360,18 @@ public:
     TimerModel& operator=(const TimerModel&) = delete;
 
     // Brings the counter to cycle `now`, running every timer clock up to it.
+    // A periodic wave on the compare outputs ends first (at the last period
+    // boundary), and the pins are driven edge by edge from there.
     void sync(Cycle now) {
+        const bool ended = waving_ && end_waves(now);
+        sync_counter(now);
+        if (ended) arm();
+    }
+
+    // CompareOutputPins::StopWave: the pin is about to be observed.
+    static void stop_wave(void* self, Cycle now) { static_cast<TimerModel*>(self)->sync(now); }
+
+    void sync_counter(Cycle now) {
         if (now <= at_) return;
         if (!ticking()) {
             at_ = now;
@@ -573,6 +584,14 @@ private:
             }
         }
 
+        if (dry_run_ != nullptr) {
+            for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+                if (level[i] == oc_[i]) continue;
+                oc_[i] = level[i];
+                dry_run_->edge(i, t, level[i]);
+            }
+            return;  // its flags are set already (maybe_quiesce checked them)
+        }
         CycleAt stamp(avr_, t);
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
             if (level[i] != oc_[i]) {
@@ -673,18 +692,104 @@ private:
         }
         if (tov && !flag_set(t_->overflow)) return;
         if (icf && !flag_set(t_->icr)) return;
+        bool outputs = false;
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
             if (!has_comp_[i]) continue;
-            if (com_[i] != 0) return;
+            if (com_[i] != 0) {
+                if (!connected(i) || driver_[i] < 0) return;
+                outputs = true;
+            }
             if (ocr_[i] != ocr_register(i)) return;
             const bool matches = mode_.wave == Wave::Normal || ocr_[i] <= top_value;
             if (matches && !flag_set(t_->comp[i].interrupt)) return;
         }
+        if (outputs && !begin_waves(period)) return;
         quiescent_ = true;
         period_ = period;
         anchor_at_ = at_;
         anchor_value_ = value_;
         anchor_dir_ = dir_;
+    }
+
+    // --- periodic waves on the compare outputs (core/PeriodicOutput.hpp) ----------
+
+    // One period run on the counter without touching pins or flags.
+    struct DryRun {
+        Cycle start = 0;
+        PeriodicWave waves[AVR_TIMER_COMP_COUNT];
+        bool overflow = false;  // more edges than a wave holds
+        void edge(int i, Cycle t, bool level) {
+            PeriodicWave& w = waves[i];
+            if (w.edge_count == PeriodicWave::kMaxEdges) {
+                overflow = true;
+                return;
+            }
+            w.edges[w.edge_count++] = {t - start, level};
+        }
+    };
+
+    // At a period start (at_): hands every connected compare output out as a
+    // wave, or none. Needs the prescaler at clk_I/O / 2^k (whole cycles).
+    bool begin_waves(std::uint64_t period_clocks) {
+        if (den_ != 1 || block_compare_) return false;
+        const Cycle period_cycles = static_cast<Cycle>(period_clocks) << shift_;
+        DryRun run;
+        run.start = at_;
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            run.waves[i].start = at_;
+            run.waves[i].period = period_cycles;
+            run.waves[i].start_level = oc_[i];
+        }
+        // Save the counter, run one period dry, check it came back, restore.
+        const std::uint16_t value = value_;
+        const std::int8_t dir = dir_;
+        const Cycle at = at_;
+        bool oc[AVR_TIMER_COMP_COUNT];
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) oc[i] = oc_[i];
+        dry_run_ = &run;
+        const Cycle end = at_ + period_cycles;
+        while (at_ < end) {
+            const Cycle t = tick_cycle(tick_index(at_) + distance());
+            if (t > end) break;
+            advance(tick_index(t) - tick_index(at_) - 1);
+            event(t);
+        }
+        dry_run_ = nullptr;
+        bool periodic = at_ == end && value_ == value && dir_ == dir && !run.overflow && !block_compare_;
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            periodic = periodic && oc_[i] == oc[i];
+            oc_[i] = oc[i];
+        }
+        value_ = value;
+        dir_ = dir;
+        at_ = at;
+        next_valid_ = false;
+        period_start_ = true;
+        if (!periodic) return false;
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            if (!has_comp_[i] || com_[i] == 0) continue;
+            if (pins_->begin_wave(driver_[i], run.waves[i], &stop_wave, this)) continue;
+            for (int j = 0; j < i; ++j) {
+                if (has_comp_[j] && com_[j] != 0) pins_->end_wave(driver_[j], at_);
+            }
+            return false;
+        }
+        waving_ = true;
+        return true;
+    }
+
+    // Skips to the last period boundary at or before `now` and ends the waves
+    // there. Returns true (for sync's `ended`).
+    bool end_waves(Cycle now) {
+        if (now > at_) skip_whole_periods(now);
+        waving_ = false;
+        quiescent_ = false;
+        next_valid_ = false;
+        CycleAt stamp(avr_, at_);
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            if (has_comp_[i] && com_[i] != 0) pins_->end_wave(driver_[i], at_);
+        }
+        return true;
     }
 
     // Set, and staying set: an enabled vector will soon clear it (and would
@@ -781,6 +886,7 @@ private:
     }
 
     void reset_state() {
+        waving_ = false;  // CompareOutputPins::after_reset ended the waves
         next_valid_ = false;
         avr_cycle_timer_cancel(avr_, &on_event, this);
         avr_cycle_timer_cancel(avr_, &on_noise_canceler, this);
@@ -973,6 +1079,8 @@ private:
     bool rearmed_ = false;
     bool period_start_ = false;  // the last event wrapped (or turned at TOP)
     bool quiescent_ = false;
+    bool waving_ = false;          // quiescent with the compare outputs handed out as waves
+    DryRun* dry_run_ = nullptr;    // inside begin_waves: event() records instead of acting
     std::uint64_t period_ = 1;
     Cycle anchor_at_ = 0;
     std::uint16_t anchor_value_ = 0;
