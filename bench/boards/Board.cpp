@@ -385,6 +385,7 @@ McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {
     auto& watch = port_watches_[&mcu];
     if (!watch) watch = std::make_unique<McuPortWatch>(mcu);
     watch->add(terminal);
+    terminal.register_as_sink();
     return terminal;
 }
 

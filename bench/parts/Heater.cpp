@@ -83,7 +83,41 @@ void Heater::start() {
     clock().scheduler().at(last_sample_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
 }
 
-Cycle Heater::on_cycles() const { return on_total_ + (on_ ? clock().cycle() - on_since_ : 0); }
+namespace {
+constexpr double kMaxAveragedPeriod_s = 2.5e-3;  // see Heater.hpp
+}
+
+Cycle Heater::on_cycles() const {
+    const Cycle now = clock().cycle();
+    if (following_) return on_total_ + wave_on_cycles(wave_from_, now);
+    return on_total_ + (on_ ? now - on_since_ : 0);
+}
+
+Cycle Heater::wave_on_cycles(Cycle a, Cycle b) const {
+    if (b <= a) return 0;
+    const Cycle high = wave_.high_cycles_until(b) - wave_.high_cycles_until(a);
+    return gate_active_level_ ? high : (b - a) - high;
+}
+
+bool Heater::gate_on_now() const {
+    const bool level = waving_ ? wave_.level_at(clock().cycle()) : input_level(gate_pin_);
+    return level == gate_active_level_;
+}
+
+bool Heater::begin_input_wave(std::size_t pin, const PeriodicWave& wave) {
+    if (pin != gate_pin_ || signals_watched()) return false;
+    if (static_cast<double>(wave.period) > kMaxAveragedPeriod_s * clock().frequency_hz()) return false;
+    waving_ = true;
+    wave_ = wave;
+    update();
+    return true;
+}
+
+void Heater::end_input_wave(std::size_t pin, Cycle) {
+    if (pin != gate_pin_ || !waving_) return;
+    waving_ = false;
+    update();
+}
 
 double Heater::energy_J() const {
     return static_cast<double>(on_cycles()) / clock().frequency_hz() * power_on_W_;
@@ -104,10 +138,30 @@ void Heater::on_input(std::size_t pin, bool) {
 }
 
 void Heater::update() {
-    const bool gate_on = input_level(gate_pin_) == gate_active_level_;
-    const bool on = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on);
-    if (on == on_) return;
     const Cycle now = clock().cycle();
+    const bool follow = waving_ && fault_state_ == Fault::None;
+    if (following_) {
+        on_total_ += wave_on_cycles(wave_from_, now);
+        wave_from_ = now;
+        if (follow) return;
+        following_ = false;
+        on_ = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on_now());
+        on_since_ = now;
+        plant_->set_heat_source_power(source_, on_ ? power_on_W_ : 0.0);
+        publish(sig_on_, on_ ? 1 : 0);
+        return;
+    }
+    if (follow) {
+        if (on_) on_total_ += now - on_since_;
+        following_ = true;
+        wave_from_ = now;
+        const double duty = static_cast<double>(wave_on_cycles(wave_.start, wave_.start + wave_.period)) /
+                            static_cast<double>(wave_.period);
+        plant_->set_heat_source_power(source_, power_on_W_ * duty);
+        return;
+    }
+    const bool on = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on_now());
+    if (on == on_) return;
     if (on_) on_total_ += now - on_since_;
     on_ = on;
     on_since_ = now;

@@ -16,6 +16,12 @@ void PartPin::receive(const Resolution& resolution) {
     if (role_ == TerminalRole::Input) part_.on_input(index_, level_);
 }
 
+bool PartPin::begin_wave(const PeriodicWave& wave) {
+    return role_ == TerminalRole::Input && part_.begin_input_wave(index_, wave);
+}
+
+void PartPin::end_wave(Cycle at) { part_.end_input_wave(index_, at); }
+
 void PartPin::set_drive(const Drive& drive) {
     if (drive == drive_) return;
     drive_ = drive;

@@ -41,6 +41,8 @@ public:
     Mcu* clock_mcu() const override;
     Drive drive_state() const override { return drive_; }
     void receive(const Resolution& resolution) override;
+    bool begin_wave(const PeriodicWave& wave) override;
+    void end_wave(Cycle at) override;
 
     const std::string& name() const { return name_; }
     // The level the net settled to (what an input reads; 0 while floating).
@@ -178,6 +180,20 @@ protected:
         (void)pin;
         (void)level;
     }
+    // A periodic wave arrives on input `pin` in place of its edges
+    // (core/PeriodicOutput.hpp); false refuses. Until end_input_wave,
+    // input_level(pin) keeps the wave's start level.
+    virtual bool begin_input_wave(std::size_t pin, const PeriodicWave& wave) {
+        (void)pin;
+        (void)wave;
+        return false;
+    }
+    virtual void end_input_wave(std::size_t pin, Cycle at) {
+        (void)pin;
+        (void)at;
+    }
+    // Somebody (the trace recorder) records this part's signals.
+    bool signals_watched() const { return !signal_listeners_.empty(); }
     void drive_output(std::size_t pin, bool level) { pins_[pin]->set_level(level); }
     void pull_output(std::size_t pin, bool level, double ohms) { pins_[pin]->set_weak(level, ohms); }
     void release_output(std::size_t pin) { pins_[pin]->set_released(); }

@@ -20,6 +20,36 @@ McuPinTerminal::McuPinTerminal(Mcu& mcu, Pin& pin) : mcu_(mcu), pin_(pin), level
     });
 }
 
+McuPinTerminal::~McuPinTerminal() {
+    if (registered_as_sink_) mcu_.set_periodic_output_sink(pin_, nullptr);
+}
+
+void McuPinTerminal::register_as_sink() { registered_as_sink_ = mcu_.set_periodic_output_sink(pin_, this); }
+
+bool McuPinTerminal::begin_wave(const PeriodicWave& wave) {
+    // Only this terminal listens on the pin; every other terminal of the net
+    // follows the wave, on this clock.
+    if (pin_.listener_count() != 1 || net() == nullptr) return false;
+    const auto& terminals = net()->terminals();
+    for (const Terminal* t : terminals) {
+        if (t != this && t->clock_mcu() != &mcu_) return false;
+    }
+    for (std::size_t i = 0; i < terminals.size(); ++i) {
+        if (terminals[i] == this || terminals[i]->begin_wave(wave)) continue;
+        for (std::size_t j = 0; j < i; ++j) {
+            if (terminals[j] != this) terminals[j]->end_wave(wave.start);
+        }
+        return false;
+    }
+    return true;
+}
+
+void McuPinTerminal::end_wave(Cycle at) {
+    for (Terminal* t : net()->terminals()) {
+        if (t != this) t->end_wave(at);
+    }
+}
+
 void McuPinTerminal::refresh() {
     const Drive now = drive_state();
     if (now == drive_) return;

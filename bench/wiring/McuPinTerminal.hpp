@@ -31,17 +31,30 @@ class IoReadHook;
 // logic level for the usual 1-10 kohm resistors.
 inline constexpr double kInternalPullUpOhm = 35e3;
 
-class McuPinTerminal final : public Terminal {
+// Also the pin's PeriodicOutputSink: a timer's repeating compare output is
+// handed to the net's other terminals as a wave when every one of them is a
+// part input that follows it (a heater's gate) on this MCU's clock and
+// nothing else listens on the pin.
+class McuPinTerminal final : public Terminal, public PeriodicOutputSink {
 public:
     McuPinTerminal(Mcu& mcu, Pin& pin);
+    ~McuPinTerminal() override;
+    McuPinTerminal(const McuPinTerminal&) = delete;
+    McuPinTerminal& operator=(const McuPinTerminal&) = delete;
     std::string label() const override { return mcu_.name() + "." + pin_.name(); }
     TerminalRole role() const override { return TerminalRole::Bidirectional; }
     Mcu* clock_mcu() const override { return &mcu_; }
     Drive drive_state() const override;
     void receive(const Resolution& resolution) override;
+    bool begin_wave(const PeriodicWave& wave) override;
+    void end_wave(Cycle at) override;
+    const void* listener_param() const override { return &pin_; }
 
     Mcu& mcu() const { return mcu_; }
     Pin& pin() const { return pin_; }
+    // Offers this terminal to the MCU as the pin's PeriodicOutputSink (the
+    // board does, once the net is complete).
+    void register_as_sink();
     // The firmware may have changed the pin's direction or pull-up: the net
     // resolves again only if what the pin drives did change (every PORT write
     // of a step pulse comes here).
@@ -52,6 +65,7 @@ private:
     Pin& pin_;
     bool level_;   // the pin's level as last raised
     Drive drive_;  // what the net last heard this pin drive
+    bool registered_as_sink_ = false;
 };
 
 // One per MCU with pins on nets.

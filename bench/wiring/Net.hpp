@@ -12,6 +12,7 @@
 
 #include "core/Finding.hpp"
 #include "core/Mcu.hpp"
+#include "core/PeriodicOutput.hpp"
 #include "wiring/Drive.hpp"
 
 namespace avrbench {
@@ -36,6 +37,15 @@ public:
     // The net settled to `resolution` (delivered to every terminal, the
     // drivers included, whenever the resolution changes).
     virtual void receive(const Resolution& resolution) = 0;
+    // An MCU pin on the net repeats a periodic wave (core/PeriodicOutput.hpp)
+    // instead of delivering its edges; true if this terminal follows it. The
+    // net's resolution keeps the wave's start level meanwhile.
+    virtual bool begin_wave(const PeriodicWave& wave) {
+        (void)wave;
+        return false;
+    }
+    // The wave ended at period boundary `at` (the clock shows `at`).
+    virtual void end_wave(Cycle at) { (void)at; }
 
     Net* net() const { return net_; }
 
