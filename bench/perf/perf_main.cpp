@@ -269,6 +269,7 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
 void run_motor_overhead(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 void run_printer_lockstep(const std::string& firmware_dir, const std::string& source_dir, int repeats);
+void run_fast_forward(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 
 int perf_main(int argc, char** argv) {
     CLI::App app{"avrbench_perf: bench vs bare simavr on the same ELFs"};
@@ -290,11 +291,17 @@ int perf_main(int argc, char** argv) {
     app.add_option("--seconds", external_seconds, "its simulated time (default 5)");
     std::size_t compare_edges = 0;
     app.add_option("--compare-edges", compare_edges, "only the comparison rules, on this many edges per signal");
+    bool only_fast_forward = false;
+    app.add_flag("--fast-forward", only_fast_forward, "only idle fast-forward on boards (plain vs skipping, same end, same timeline)");
     bool only_printer = false;
     app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lockstep with lookahead, strict, one MCU)");
     std::vector<double> rss_seconds;
     app.add_option("--rss", rss_seconds, "peak RSS of the CLI streaming a 1 M events/s VCD for these simulated seconds");
     CLI11_PARSE(app, argc, argv);
+    if (only_fast_forward) {
+        run_fast_forward(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
+        return 0;
+    }
     if (only_printer) {
         run_printer_lockstep(firmware_dir, AVRBENCH_SOURCE_DIR, repeats);
         return 0;
@@ -409,6 +416,7 @@ int perf_main(int argc, char** argv) {
                 cpu_without, cpu_with, cpu_with / cpu_without);
     if (!only_thermal) run_motor_overhead(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
     if (!only_thermal) run_printer_lockstep(firmware_dir, AVRBENCH_SOURCE_DIR, repeats);
+    if (!only_thermal) run_fast_forward(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
     return 0;
 }
 
