@@ -105,7 +105,7 @@ bool Heater::gate_on_now() const {
 }
 
 bool Heater::begin_input_wave(std::size_t pin, const PeriodicWave& wave) {
-    if (pin != gate_pin_ || signals_watched()) return false;
+    if (pin != gate_pin_ || signals_watched() || fault_state_ != Fault::None) return false;
     if (static_cast<double>(wave.period) > kMaxAveragedPeriod_s * clock().frequency_hz()) return false;
     waving_ = true;
     wave_ = wave;
@@ -129,6 +129,9 @@ void Heater::inject(Fault fault, Cycle at_cycle) {
 }
 
 void Heater::apply_fault(const std::string& fault) {
+    // Back to the gate's edges first (the wave ends at its last period
+    // boundary; the edges since then arrive): a fault is not followed in a wave.
+    if (waving_) clock().settle_periodic_outputs();
     fault_state_ = fault == "disconnected" ? Fault::Disconnected : fault == "stuck_on" ? Fault::StuckOn : Fault::None;
     update();
 }

@@ -27,13 +27,21 @@ struct HeaterRun {
 // OC2A, Timer2 fast PWM at clk/64 (a period of 256 * 64 = 16384 cycles,
 // 1.024 ms). `waves`: the gate may be handed out as a wave; otherwise every
 // edge goes through the net.
-HeaterRun run_heater(bool waves, bool skip_idle_loops) {
+HeaterRun run_heater(bool waves, bool skip_idle_loops, bool faults = false) {
     auto board = test::ramps_board("ramps_teacup");
     Mcu& mcu = board->mcu("mega");
     mcu.set_skip_idle_loops(skip_idle_loops);
     if (!waves) mcu.set_periodic_output_sink(mcu.pin("PB4"), nullptr);
     auto& heater = board->part_as<Heater>("hotend_heater");
     auto& plant = board->part_as<ThermalPlant>("hotend");
+    if (faults) {
+        // The MOSFET fails short at 0.6 s and is repaired at 0.8 s; the heater
+        // circuit opens at 1.5 s.
+        const double f = mcu.frequency_hz();
+        heater.inject(Heater::Fault::StuckOn, static_cast<Cycle>(0.6 * f));
+        heater.inject(Heater::Fault::None, static_cast<Cycle>(0.8 * f));
+        heater.inject(Heater::Fault::Disconnected, static_cast<Cycle>(1.5 * f));
+    }
     board->run_for_seconds(0.01);
     mcu.uart(0).send("M42 P10 S64\n");
     board->run_for_seconds(1.0);
@@ -70,6 +78,19 @@ TEST(HeaterWaves, OnTimeIsTheGatesAndTemperaturesStayWithinTheAveragingBound) {
     EXPECT_NEAR(edges.block_degC, waves.block_degC, 0.005);
     EXPECT_NEAR(edges.sensor_degC, waves.sensor_degC, 0.005);
     EXPECT_GT(waves.block_degC, 25.5);  // it did heat: ~24 J into 16.7 J/K
+}
+
+TEST(HeaterWaves, FaultsTakeEffectAtTheirCycleWhetherOrNotTheGateIsAWave) {
+    const HeaterRun edges = run_heater(false, true, true), waves = run_heater(true, true, true);
+    EXPECT_TRUE(waves.followed_first);    // repaired at 0.8 s: following again at 1.01 s
+    EXPECT_FALSE(waves.followed_second);  // disconnected from 1.5 s on
+    EXPECT_EQ(edges.on_cycles, waves.on_cycles);
+    // By hand: 65/256 from the command (~0.01 s) to 0.6 s, on for 0.2 s,
+    // 65/256 to ~1.01 s, 201/256 to 1.5 s, then off: 16e6 * (0.59 * 65/256 +
+    // 0.2 + 0.21 * 65/256 + 0.49 * 201/256) = 13.6 M cycles.
+    EXPECT_NEAR(static_cast<double>(waves.on_cycles), 16e6 * (0.59 * 65.0 / 256 + 0.2 + 0.21 * 65.0 / 256 + 0.49 * 201.0 / 256),
+                16e6 * 0.01);
+    EXPECT_NEAR(edges.block_degC, waves.block_degC, 0.005);
 }
 
 TEST(HeaterWaves, SkippingIdleLoopsChangesNothing) {

@@ -766,6 +766,7 @@ private:
         next_valid_ = false;
         period_start_ = true;
         if (!periodic) return false;
+        CycleAt stamp(avr_, at_);  // sinks see the wave's start, not the end of the instruction
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
             if (!has_comp_[i] || com_[i] == 0) continue;
             if (pins_->begin_wave(driver_[i], run.waves[i], &stop_wave, this)) continue;
