@@ -53,5 +53,8 @@ std::unique_ptr<Fix> install_timer_flags(avr_t* avr);
 // WGM modes, OCnx pins overriding PORTxn, input capture, prescalers) in place
 // of simavr's avr_timer handlers, on the megaAVRs it knows.
 std::unique_ptr<Fix> install_timer_model(avr_t* avr);
+// Timer events of a steady period are replayed from a record of one period
+// (TimerModel.cpp); on by default. Off only to compare (TimerReplay.*).
+void set_timer_replay(bool on);
 
 }  // namespace avrbench

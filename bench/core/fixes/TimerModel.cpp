@@ -59,6 +59,8 @@
 // timer whose only effect would be to set again flags that are already set
 // (grbl's idle Timer1: CTC at clk/1, OCR1A small, interrupt disabled) stops
 // scheduling until a flag is cleared or a register written.
+#include <array>
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <string_view>
@@ -396,6 +398,7 @@ public:
     void reschedule() {
         quiescent_ = false;
         next_valid_ = false;
+        forget_replay();
         arm();
     }
 
@@ -584,26 +587,46 @@ private:
             }
         }
 
-        if (dry_run_ != nullptr) {
-            for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
-                if (level[i] == oc_[i]) continue;
-                oc_[i] = level[i];
-                dry_run_->edge(i, t, level[i]);
-            }
-            return;  // its flags are set already (maybe_quiesce checked them)
+        Outcome out;
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            out.level[i] = level[i];
+            if (matched[i]) out.raises = static_cast<std::uint8_t>(out.raises | (1u << i));
         }
+        if (tov) out.raises = static_cast<std::uint8_t>(out.raises | kRaiseOverflow);
+        if (icf) out.raises = static_cast<std::uint8_t>(out.raises | kRaiseCapture);
+        if (dry_run_ != nullptr) {
+            for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) oc_[i] = level[i];
+            dry_run_->add(t, out, value_, dir_, period_start_);
+            return;
+        }
+        apply(t, out);
+    }
+
+    // What one timer clock does, besides counting: the OCnx levels after it,
+    // and the flags it sets (bits 0-2: OCFnA..C, then TOVn, ICFn).
+    static constexpr std::uint8_t kRaiseOverflow = 1u << 3;
+    static constexpr std::uint8_t kRaiseCapture = 1u << 4;
+    struct Outcome {
+        bool level[AVR_TIMER_COMP_COUNT] = {};
+        std::uint8_t raises = 0;
+    };
+
+    // Listeners see cycle t: pins first, then the flags in the order
+    // OCFnA, OCFnB, OCFnC, TOVn, ICFn.
+    void apply(Cycle t, const Outcome& out) {
         CycleAt stamp(avr_, t);
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
-            if (level[i] != oc_[i]) {
-                oc_[i] = level[i];
+            if (out.level[i] != oc_[i]) {
+                oc_[i] = out.level[i];
                 pins_->set(driver_[i], connected(i), oc_[i]);
             }
         }
+        if (out.raises == 0) return;
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
-            if (matched[i]) avr_raise_interrupt(avr_, &t_->comp[i].interrupt);
+            if ((out.raises >> i) & 1) avr_raise_interrupt(avr_, &t_->comp[i].interrupt);
         }
-        if (tov) avr_raise_interrupt(avr_, &t_->overflow);
-        if (icf) avr_raise_interrupt(avr_, &t_->icr);
+        if ((out.raises & kRaiseOverflow) != 0) avr_raise_interrupt(avr_, &t_->overflow);
+        if ((out.raises & kRaiseCapture) != 0) avr_raise_interrupt(avr_, &t_->icr);
     }
 
     // What a compare match does to OCnx (Tables 15-2..15-4, 16-1..16-3).
@@ -650,46 +673,157 @@ private:
 
     static avr_cycle_count_t on_event(avr_t*, avr_cycle_count_t when, void* param) {
         auto* self = static_cast<TimerModel*>(param);
+        Cycle next_replayed = 0;
+        if (self->replay_.valid && !self->quiescent_ && self->at_ < when && self->replay_event(when, next_replayed)) {
+            return next_replayed;
+        }
         self->in_event_ = true;
         self->rearmed_ = false;
         self->sync(when);
         self->in_event_ = false;
         // A listener that wrote a timer register has synced the model past
         // `when` (arm() left the cycle timer to us): no period start to check.
-        if (!self->rearmed_ && self->period_start_ && self->at_ == when) self->maybe_quiesce();
+        if (!self->rearmed_ && self->period_start_ && self->at_ == when) {
+            self->maybe_quiesce();
+            if (!self->quiescent_) self->maybe_record();
+        }
         const Cycle next = self->next_event_cycle();
         return next > when ? next : 0;
     }
+
+    // --- replaying a steady period ---------------------------------------------------
+    // A timer whose registers nobody writes repeats the same events every
+    // period. After two period starts without a write, one period is run dry
+    // (run_period_dry) and from then on each event is taken from that record:
+    // the counter's state after it, its pin levels and flags (apply(), as
+    // event() does), the distance to the next. Any register write, prescaler
+    // reset or reset forgets the record (reschedule(), reset_state()).
+    // Exactness: TimerReplay.* (every firmware, with and without).
+    void forget_replay() {
+        replay_.valid = false;
+        replay_.tried = false;
+        steady_periods_ = 0;
+    }
+
+    // At a period start (at_), from the slow path.
+    void maybe_record() {
+        if (replay_.valid || replay_.tried || !replay_enabled().load(std::memory_order_relaxed) || !ticking() ||
+            den_ != 1) {
+            return;
+        }
+        if (++steady_periods_ < 2) return;
+        replay_.tried = true;  // once per configuration
+        bool tov = false, icf = false;
+        const std::uint64_t period = period_clocks(tov, icf);
+        if (period == 0) return;
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            if (has_comp_[i] && ocr_[i] != ocr_register(i)) return;
+        }
+        // A compare output that toggles comes back after two periods.
+        Cycle cycles = static_cast<Cycle>(period) << shift_;
+        if (!run_period_dry(cycles, replay_.run)) {
+            cycles *= 2;
+            if (!run_period_dry(cycles, replay_.run)) return;
+        }
+        if (replay_.run.count == 0) return;
+        replay_.valid = true;
+        replay_.anchor = at_;
+        replay_.period = cycles;
+        replay_.next_index = 0;
+        replay_.next_cycle = at_ + replay_.run.events[0].offset;
+        replay_.raises = 0;
+        for (std::size_t k = 0; k < replay_.run.count; ++k) {
+            replay_.raises = static_cast<std::uint8_t>(replay_.raises | replay_.run.events[k].out.raises);
+        }
+    }
+
+    // One of the flags in `raises` has its interrupt enabled (then the timer
+    // cannot be quiescent: maybe_quiesce would find the same).
+    bool any_enabled(std::uint8_t raises) const {
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            if (((raises >> i) & 1) && avr_regbit_get(avr_, t_->comp[i].interrupt.enable) != 0) return true;
+        }
+        if ((raises & kRaiseOverflow) != 0 && avr_regbit_get(avr_, t_->overflow.enable) != 0) return true;
+        return (raises & kRaiseCapture) != 0 && avr_regbit_get(avr_, t_->icr.enable) != 0;
+    }
+
+    // The event at `when` from the record; false if the record has none there.
+    bool replay_event(Cycle when, Cycle& next_out) {
+        const DryRun& run = replay_.run;
+        std::size_t k = replay_.next_index;
+        if (when != replay_.next_cycle) {
+            // The previous event ran on the slow path (a sync caught up with it).
+            const Cycle into = (when - replay_.anchor) % replay_.period;
+            const Cycle offset = into == 0 ? replay_.period : into;
+            k = 0;
+            while (k < run.count && run.events[k].offset != offset) ++k;
+            if (k == run.count) return false;
+        }
+        const DryEvent& e = run.events[k];
+        in_event_ = true;
+        rearmed_ = false;
+        value_ = e.value;
+        dir_ = e.dir;
+        at_ = when;
+        block_compare_ = false;
+        period_start_ = e.period_start;
+        next_cache_ = k + 1 < run.count ? when + (run.events[k + 1].offset - e.offset)
+                                        : when + (replay_.period - e.offset) + run.events[0].offset;
+        next_valid_ = true;
+        replay_.next_index = k + 1 < run.count ? k + 1 : 0;
+        replay_.next_cycle = next_cache_;
+        apply(when, e.out);
+        in_event_ = false;
+        if (!rearmed_ && period_start_ && at_ == when && !any_enabled(replay_.raises)) maybe_quiesce();
+        const Cycle next = next_event_cycle();
+        next_out = next > when ? next : 0;
+        return true;
+    }
+
+    static std::atomic<bool>& replay_enabled() {
+        static std::atomic<bool> on{true};
+        return on;
+    }
+
+public:
+    static void set_replay_enabled(bool on) { replay_enabled().store(on, std::memory_order_relaxed); }
+
+private:
 
     // Idle periodic timers whose every effect is already in place: stop
     // scheduling (see the file comment). All of one period's matches, TOVn
     // and ICFn must have their flags set with their interrupts disabled, no
     // OCnx connected, nothing buffered.
+    // Timer clocks per period in the present mode (0: none), and whether a
+    // period sets TOVn and ICFn.
+    std::uint64_t period_clocks(bool& tov, bool& icf) const {
+        const std::uint16_t top_value = top();
+        tov = true;
+        icf = false;
+        switch (mode_.wave) {
+            case Wave::Normal:
+                return static_cast<std::uint64_t>(max_value()) + 1;
+            case Wave::Ctc:
+                tov = top_value == max_value();
+                icf = mode_.top == TopFrom::Icr;
+                return static_cast<std::uint64_t>(top_value) + 1;
+            case Wave::Fast:
+                icf = mode_.top == TopFrom::Icr;
+                return static_cast<std::uint64_t>(top_value) + 1;
+            case Wave::PhaseCorrect:
+            case Wave::PhaseFrequencyCorrect:
+                icf = mode_.top == TopFrom::Icr;
+                return 2ull * top_value;
+        }
+        return 0;
+    }
+
     void maybe_quiesce() {
         if (!ticking() || block_compare_) return;
         const std::uint16_t top_value = top();
-        std::uint64_t period = 0;
         bool tov = true, icf = false;
-        switch (mode_.wave) {
-            case Wave::Normal:
-                period = static_cast<std::uint64_t>(max_value()) + 1;
-                break;
-            case Wave::Ctc:
-                period = static_cast<std::uint64_t>(top_value) + 1;
-                tov = top_value == max_value();
-                icf = mode_.top == TopFrom::Icr;
-                break;
-            case Wave::Fast:
-                period = static_cast<std::uint64_t>(top_value) + 1;
-                icf = mode_.top == TopFrom::Icr;
-                break;
-            case Wave::PhaseCorrect:
-            case Wave::PhaseFrequencyCorrect:
-                if (top_value == 0) return;
-                period = 2ull * top_value;
-                icf = mode_.top == TopFrom::Icr;
-                break;
-        }
+        const std::uint64_t period = period_clocks(tov, icf);
+        if (period == 0) return;
         if (tov && !flag_set(t_->overflow)) return;
         if (icf && !flag_set(t_->icr)) return;
         bool outputs = false;
@@ -713,34 +847,38 @@ private:
 
     // --- periodic waves on the compare outputs (core/PeriodicOutput.hpp) ----------
 
-    // One period run on the counter without touching pins or flags.
+    // One period's timer events, run on the counter without touching pins or
+    // flags: at most one per compare unit per slope, TOP and BOTTOM.
+    struct DryEvent {
+        Cycle offset = 0;  // cycles after the period's start, 0 < offset <= period
+        Outcome out;
+        std::uint16_t value = 0;  // TCNTn after it
+        std::int8_t dir = 1;
+        bool period_start = false;
+    };
     struct DryRun {
+        static constexpr std::size_t kMaxEvents = 8;
         Cycle start = 0;
-        PeriodicWave waves[AVR_TIMER_COMP_COUNT];
-        bool overflow = false;  // more edges than a wave holds
-        void edge(int i, Cycle t, bool level) {
-            PeriodicWave& w = waves[i];
-            if (w.edge_count == PeriodicWave::kMaxEdges) {
+        std::size_t count = 0;
+        std::array<DryEvent, kMaxEvents> events{};
+        bool overflow = false;
+        void add(Cycle t, const Outcome& out, std::uint16_t value, std::int8_t dir, bool period_start) {
+            if (count == kMaxEvents) {
                 overflow = true;
                 return;
             }
-            w.edges[w.edge_count++] = {t - start, level};
+            events[count++] = {t - start, out, value, dir, period_start};
         }
     };
 
-    // At a period start (at_): hands every connected compare output out as a
-    // wave, or none. Needs the prescaler at clk_I/O / 2^k (whole cycles).
-    bool begin_waves(std::uint64_t period_clocks) {
+    // From a period start (at_): one period of `period_cycles`, dry. True if
+    // it ends in the state it began (counter, direction, OCnx levels); the
+    // model's state is as before either way.
+    bool run_period_dry(Cycle period_cycles, DryRun& run) {
         if (den_ != 1 || block_compare_) return false;
-        const Cycle period_cycles = static_cast<Cycle>(period_clocks) << shift_;
-        DryRun run;
         run.start = at_;
-        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
-            run.waves[i].start = at_;
-            run.waves[i].period = period_cycles;
-            run.waves[i].start_level = oc_[i];
-        }
-        // Save the counter, run one period dry, check it came back, restore.
+        run.count = 0;
+        run.overflow = false;
         const std::uint16_t value = value_;
         const std::int8_t dir = dir_;
         const Cycle at = at_;
@@ -765,11 +903,34 @@ private:
         at_ = at;
         next_valid_ = false;
         period_start_ = true;
-        if (!periodic) return false;
+        block_compare_ = false;
+        return periodic;
+    }
+
+    // At a period start (at_): hands every connected compare output out as a
+    // wave, or none. Needs the prescaler at clk_I/O / 2^k (whole cycles).
+    bool begin_waves(std::uint64_t period_clocks) {
+        const Cycle period_cycles = static_cast<Cycle>(period_clocks) << shift_;
+        DryRun run;
+        if (!run_period_dry(period_cycles, run)) return false;
+        PeriodicWave waves[AVR_TIMER_COMP_COUNT];
+        for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
+            PeriodicWave& w = waves[i];
+            w.start = at_;
+            w.period = period_cycles;
+            w.start_level = oc_[i];
+            bool level = oc_[i];
+            for (std::size_t k = 0; k < run.count; ++k) {
+                if (run.events[k].out.level[i] == level) continue;
+                level = run.events[k].out.level[i];
+                if (w.edge_count == PeriodicWave::kMaxEdges) return false;
+                w.edges[w.edge_count++] = {run.events[k].offset, level};
+            }
+        }
         CycleAt stamp(avr_, at_);  // sinks see the wave's start, not the end of the instruction
         for (int i = 0; i < AVR_TIMER_COMP_COUNT; ++i) {
             if (!has_comp_[i] || com_[i] == 0) continue;
-            if (pins_->begin_wave(driver_[i], run.waves[i], &stop_wave, this)) continue;
+            if (pins_->begin_wave(driver_[i], waves[i], &stop_wave, this)) continue;
             for (int j = 0; j < i; ++j) {
                 if (has_comp_[j] && com_[j] != 0) pins_->end_wave(driver_[j], at_);
             }
@@ -887,6 +1048,7 @@ private:
     }
 
     void reset_state() {
+        forget_replay();
         waving_ = false;  // CompareOutputPins::after_reset ended the waves
         next_valid_ = false;
         avr_cycle_timer_cancel(avr_, &on_event, this);
@@ -1081,6 +1243,18 @@ private:
     bool period_start_ = false;  // the last event wrapped (or turned at TOP)
     bool quiescent_ = false;
     bool waving_ = false;          // quiescent with the compare outputs handed out as waves
+    struct Replay {
+        bool valid = false;
+        bool tried = false;     // recorded or failed since the last register write
+        Cycle anchor = 0;       // a period start
+        Cycle period = 0;       // cycles (two timer periods when an output toggles)
+        DryRun run;
+        std::size_t next_index = 0;  // the event the cycle timer is armed for
+        Cycle next_cycle = 0;
+        std::uint8_t raises = 0;     // every flag the period sets
+    };
+    Replay replay_;
+    unsigned steady_periods_ = 0;  // period starts since a register was last written
     DryRun* dry_run_ = nullptr;    // inside begin_waves: event() records instead of acting
     std::uint64_t period_ = 1;
     Cycle anchor_at_ = 0;
@@ -1159,6 +1333,8 @@ private:
 };
 
 }  // namespace
+
+void set_timer_replay(bool on) { TimerModel::set_replay_enabled(on); }
 
 std::unique_ptr<Fix> install_timer_model(avr_t* avr) {
     Family family;
