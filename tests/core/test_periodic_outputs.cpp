@@ -17,6 +17,7 @@ extern "C" {
 #include "core/ElfImage.hpp"
 #include "core/Mcu.hpp"
 #include "core/PeriodicOutput.hpp"
+#include "support/EveryFirmware.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {
@@ -116,10 +117,7 @@ struct RunResult {
 
 McuOptions options_for(const std::string& name, const ElfImage& elf) {
     McuOptions options;
-    if (elf.embedded_mcu().empty()) {
-        options.mcu_type = name.find("mega") != std::string::npos ? "atmega2560" : "atmega328p";
-        options.frequency_hz = 16'000'000;
-    }
+    test::set_board_mcu(name, elf, options);
     return options;
 }
 
@@ -153,17 +151,8 @@ RunResult run(const std::string& name, bool accept_waves, Cycle cycles) {
     return r;
 }
 
-std::vector<std::string> all_firmware() {
-    std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(AVRBENCH_FIRMWARE_DIR)) {
-        if (entry.path().extension() == ".elf") names.push_back(entry.path().stem().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
 TEST(PeriodicOutputs, WavesAreTheEdgesTheTimerDrivesOnEveryFirmware) {
-    const auto names = all_firmware();
+    const auto names = test::all_firmware();
     ASSERT_GT(names.size(), 100u);
     std::size_t firmware_with_waves = 0;
     for (const auto& name : names) {

@@ -18,6 +18,7 @@ extern "C" {
 
 #include "core/Errors.hpp"
 #include "core/Mcu.hpp"
+#include "support/EveryFirmware.hpp"
 #include "support/Paths.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/Timeline.hpp"
@@ -25,16 +26,9 @@ extern "C" {
 namespace avrbench {
 namespace {
 
-struct EndState {
-    Cycle cycle = 0;
-    std::uint32_t pc = 0;
-    std::vector<std::uint8_t> data;  // registers, I/O, RAM
-    std::vector<std::uint8_t> eeprom;
-    std::vector<TimelineEvent> events;
-    std::vector<std::string> findings;
-    std::uint64_t steps = 0;
-    std::uint64_t idle_jumps = 0;
-};
+using test::all_firmware;
+using test::expect_same_end;
+using EndState = test::TracedEnd;
 
 enum class Loop { Reference, Stepper, StepperSkippingIdleLoops };
 
@@ -42,55 +36,7 @@ EndState run(const std::string& name, Loop loop) {
     McuOptions options;
     options.reference_run_loop = loop == Loop::Reference;
     options.skip_idle_loops = loop == Loop::StepperSkippingIdleLoops;
-    const ElfImage elf = ElfImage::load(test::firmware(name));
-    if (elf.embedded_mcu().empty()) {
-        // Arduino sketches and other ELFs without .mmcu: the board they were built for.
-        options.mcu_type = name.find("mega") != std::string::npos ? "atmega2560" : "atmega328p";
-        options.frequency_hz = 16'000'000;
-    }
-    Mcu mcu(elf, options);
-    Timeline timeline;
-    Recorder recorder(timeline);
-    recorder.trace_pins(mcu, "all");
-    try {
-        recorder.trace_uart_tx(mcu, mcu.uart(0));
-        mcu.uart(0).send("G1 X1\n?\nM105\nhello\n");
-    } catch (const BadInput&) {
-        // an MCU without USART0
-    }
-    mcu.run_until(mcu.frequency_hz() / 50);  // 20 ms
-    EndState s;
-    s.cycle = mcu.cycle();
-    s.pc = mcu.pc_bytes();
-    const avr_t* avr = mcu.avr();
-    s.data.assign(avr->data, avr->data + avr->ramend + 1);
-    s.events = timeline.events();
-    for (const auto& f : mcu.findings()) s.findings.push_back(f.describe());
-    s.steps = mcu.steps();
-    s.idle_jumps = mcu.idle_jumps();
-    return s;
-}
-
-void expect_same_end(const EndState& a, const EndState& b, const std::string& name) {
-    EXPECT_EQ(a.cycle, b.cycle) << name;
-    EXPECT_EQ(a.pc, b.pc) << name;
-    EXPECT_TRUE(a.data == b.data) << name << ": registers, I/O or RAM differ";
-    EXPECT_EQ(a.findings, b.findings) << name;
-    ASSERT_EQ(a.events.size(), b.events.size()) << name;
-    for (std::size_t i = 0; i < a.events.size(); ++i) {
-        const bool same = a.events[i].cycle == b.events[i].cycle && a.events[i].signal == b.events[i].signal &&
-                          a.events[i].value.bits == b.events[i].value.bits;
-        ASSERT_TRUE(same) << name << ": event " << i << " differs";
-    }
-}
-
-std::vector<std::string> all_firmware() {
-    std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(AVRBENCH_FIRMWARE_DIR)) {
-        if (entry.path().extension() == ".elf") names.push_back(entry.path().stem().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
+    return test::run_traced(name, options);
 }
 
 TEST(RunLoop, SimavrStepEndsWhereAvrRunEndsOnEveryFirmware) {
