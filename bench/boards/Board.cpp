@@ -378,6 +378,18 @@ void Board::build_twi_buses() {
     }
 }
 
+void Board::set_periodic_waves(bool on) {
+    periodic_waves_ = on;
+    for (const auto& t : mcu_terminals_) {
+        if (on) {
+            t->register_as_sink();
+        } else {
+            t->mcu().settle_periodic_outputs();  // a running wave ends here
+            t->unregister_as_sink();
+        }
+    }
+}
+
 McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {
     mcu_terminals_.push_back(std::make_unique<McuPinTerminal>(mcu, pin));
     McuPinTerminal& terminal = *mcu_terminals_.back();
@@ -385,7 +397,7 @@ McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {
     auto& watch = port_watches_[&mcu];
     if (!watch) watch = std::make_unique<McuPortWatch>(mcu);
     watch->add(terminal);
-    terminal.register_as_sink();
+    if (periodic_waves_) terminal.register_as_sink();
     return terminal;
 }
 

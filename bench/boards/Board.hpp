@@ -53,6 +53,10 @@ public:
     }
     // "uno.PD2", or a label name from the board file.
     Pin& pin(const std::string& endpoint_or_label);
+    // Whether MCU pins hand a repeating timer output to their nets as one
+    // periodic wave (core/PeriodicOutput.hpp; on by default). Off: every edge
+    // goes through the net (`avrbench run --no-periodic-waves`).
+    void set_periodic_waves(bool on);
     // Drives an MCU pin from outside (a scenario's stimulus) as a push-pull
     // source on the pin's net, or lets go of it; a pin on no net gets one.
     void drive_pin(const std::string& endpoint_or_label, bool level);
@@ -95,6 +99,7 @@ private:
     std::vector<std::unique_ptr<McuPinTerminal>> mcu_terminals_;
     std::map<const Pin*, std::unique_ptr<Terminal>> stimuli_;
     std::vector<std::unique_ptr<Net>> nets_;
+    bool periodic_waves_ = true;
     std::vector<std::unique_ptr<TwiBus>> twi_buses_;
     Lockstep lockstep_;
 };

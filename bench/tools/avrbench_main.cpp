@@ -85,6 +85,7 @@ struct RunArgs {
     std::string line_timeout;  // --line-timeout: overrides the board's
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
     bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
+    bool no_periodic_waves = false;     // --no-periodic-waves: every PWM edge through the nets
 };
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
@@ -325,6 +326,7 @@ BoardRun prepare_board_run(const RunArgs& args) {
     Bench& bench = *run.bench;
     Board& board = bench.board();
     for (Mcu* m : board.mcus()) m->set_skip_idle_loops(!args.no_idle_skip);
+    if (args.no_periodic_waves) board.set_periodic_waves(false);
     if (board.spec().serial.empty() && (!uart_in.empty() || !run.uart_out.empty() || job)) {
         throw BadInput(args.board + ": the board declares no serial port (needed by --gcode, --dxf, --uart-in, --uart-out)");
     }
@@ -837,6 +839,9 @@ int main(int argc, char** argv) {
     run_cmd->add_flag("-q,--quiet", run.quiet, "no progress bar");
     run_cmd->add_flag("--no-idle-skip", run.no_idle_skip,
                       "run every pass of the firmware's idle loops instead of jumping over them (same results, slower)");
+    run_cmd->add_flag("--no-periodic-waves", run.no_periodic_waves,
+                      "deliver every edge of a timer PWM through its net even when nothing records it "
+                      "(heaters follow each edge instead of the mean power; slower)");
 
     CheckArgs check;
     CLI::App* check_cmd = app.add_subcommand("check", "run scenario files: stimulus, expectations, golden comparison");

@@ -26,6 +26,11 @@ McuPinTerminal::~McuPinTerminal() {
 
 void McuPinTerminal::register_as_sink() { registered_as_sink_ = mcu_.set_periodic_output_sink(pin_, this); }
 
+void McuPinTerminal::unregister_as_sink() {
+    if (registered_as_sink_) mcu_.set_periodic_output_sink(pin_, nullptr);
+    registered_as_sink_ = false;
+}
+
 bool McuPinTerminal::begin_wave(const PeriodicWave& wave) {
     // Only this terminal listens on the pin; every other terminal of the net
     // follows the wave, on this clock.

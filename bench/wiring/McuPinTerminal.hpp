@@ -55,6 +55,7 @@ public:
     // Offers this terminal to the MCU as the pin's PeriodicOutputSink (the
     // board does, once the net is complete).
     void register_as_sink();
+    void unregister_as_sink();
     // The firmware may have changed the pin's direction or pull-up: the net
     // resolves again only if what the pin drives did change (every PORT write
     // of a step pulse comes here).

@@ -184,3 +184,36 @@ TEST(CliRun, ElfWithoutMmcuRunsWithMcuAndFreq) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// heat_wait on RAMPS 1.4 (firmware/boards/heat_wait): the bed's Timer4 fast
+// PWM at clk/1 with OCR4C = 0 is "a narrow spike for each MAX+1 timer clock
+// cycle" (2560 §17.9.3): high 1 cycle in 256. Nothing records the bed pin
+// here, so it reaches the bed heater as a periodic wave and the summary's
+// "W now" is its mean power: the bed_12v preset's 12 V on 1.2 ohm = 120 W,
+// x 1/256 = 0.47 W. With --no-periodic-waves every spike goes through the
+// net and the summary shows the instantaneous power, 0 W (the pin is low in
+// 255 of 256 cycles; the run ends on a low one). Either way the bed gets
+// 0.47 J in the second: 3 mK on its 158 J/K, so 25.00 degC on both.
+TEST(CliRunPeriodicWaves, ADutyZeroBedHeatsWithItsMeanPowerUnlessWavesAreOff) {
+    const auto dir = test::scratch_dir("periodic-waves");
+    const std::string base =
+        AVRBENCH_CLI + std::string(" run -q --board ramps-1.4 ") + test::firmware("heat_wait") + " --for 1s";
+    const auto waves = test::run_command(base, dir);
+    const auto edges = test::run_command(base + " --no-periodic-waves", dir);
+    ASSERT_EQ(waves.exit_code, 0) << waves.out << waves.err;
+    ASSERT_EQ(edges.exit_code, 0) << edges.out << edges.err;
+    EXPECT_NE(waves.out.find("thermal    bed: block 25.00 degC, sensor 25.00 degC, heater 0.5 W now"), std::string::npos)
+        << waves.out;
+    EXPECT_NE(edges.out.find("thermal    bed: block 25.00 degC, sensor 25.00 degC, heater 0.0 W now"), std::string::npos)
+        << edges.out;
+    // The hot end heater's OC2A sits at duty 255 (cold: the controller asks
+    // for full power), a constant-high wave: 40 W either way.
+    EXPECT_NE(waves.out.find("heater 40.0 W now"), std::string::npos) << waves.out;
+    EXPECT_NE(edges.out.find("heater 40.0 W now"), std::string::npos) << edges.out;
+}
+
+}  // namespace
+}  // namespace avrbench
