@@ -89,7 +89,7 @@ constexpr double kMaxAveragedPeriod_s = 2.5e-3;  // see Heater.hpp
 
 Cycle Heater::on_cycles() const {
     const Cycle now = clock().cycle();
-    if (following_) return on_total_ + wave_on_cycles(wave_from_, now);
+    if (waving_) return on_total_ + wave_on_cycles(wave_from_, now);
     return on_total_ + (on_ ? now - on_since_ : 0);
 }
 
@@ -107,16 +107,27 @@ bool Heater::gate_on_now() const {
 bool Heater::begin_input_wave(std::size_t pin, const PeriodicWave& wave) {
     if (pin != gate_pin_ || signals_watched() || fault_state_ != Fault::None) return false;
     if (static_cast<double>(wave.period) > kMaxAveragedPeriod_s * clock().frequency_hz()) return false;
+    const Cycle now = clock().cycle();
+    if (on_) on_total_ += now - on_since_;
     waving_ = true;
     wave_ = wave;
-    update();
+    wave_from_ = now;
+    const double duty = static_cast<double>(wave_on_cycles(wave.start, wave.start + wave.period)) /
+                        static_cast<double>(wave.period);
+    plant_->set_heat_source_power(source_, power_on_W_ * duty);
     return true;
 }
 
 void Heater::end_input_wave(std::size_t pin, Cycle) {
     if (pin != gate_pin_ || !waving_) return;
+    const Cycle now = clock().cycle();
+    on_total_ += wave_on_cycles(wave_from_, now);
     waving_ = false;
-    update();
+    // The gate's level at the period boundary, from the net again.
+    on_ = gate_on_now();
+    on_since_ = now;
+    plant_->set_heat_source_power(source_, on_ ? power_on_W_ : 0.0);
+    publish(sig_on_, on_ ? 1 : 0);
 }
 
 double Heater::energy_J() const {
@@ -141,28 +152,8 @@ void Heater::on_input(std::size_t pin, bool) {
 }
 
 void Heater::update() {
+    if (waving_) return;  // no edges arrive meanwhile, and a fault ends the wave first
     const Cycle now = clock().cycle();
-    const bool follow = waving_ && fault_state_ == Fault::None;
-    if (following_) {
-        on_total_ += wave_on_cycles(wave_from_, now);
-        wave_from_ = now;
-        if (follow) return;
-        following_ = false;
-        on_ = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on_now());
-        on_since_ = now;
-        plant_->set_heat_source_power(source_, on_ ? power_on_W_ : 0.0);
-        publish(sig_on_, on_ ? 1 : 0);
-        return;
-    }
-    if (follow) {
-        if (on_) on_total_ += now - on_since_;
-        following_ = true;
-        wave_from_ = now;
-        const double duty = static_cast<double>(wave_on_cycles(wave_.start, wave_.start + wave_.period)) /
-                            static_cast<double>(wave_.period);
-        plant_->set_heat_source_power(source_, power_on_W_ * duty);
-        return;
-    }
     const bool on = fault_state_ == Fault::StuckOn || (fault_state_ == Fault::None && gate_on_now());
     if (on == on_) return;
     if (on_) on_total_ += now - on_since_;

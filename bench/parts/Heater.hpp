@@ -44,9 +44,9 @@ public:
     std::string_view type() const override { return "heater"; }
     void start() override;
 
-    bool on() const { return following_ ? gate_on_now() : on_; }
+    bool on() const { return waving_ ? gate_on_now() : on_; }
     // The gate is a periodic wave the heater follows with its mean power.
-    bool follows_wave() const { return following_; }
+    bool follows_wave() const { return waving_; }
     const ThermalPlant& plant() const { return *plant_; }
     double power_on_W() const { return power_on_W_; }  // dissipation while on
     double power_W() const { return on() ? power_on_W_ : 0.0; }
@@ -83,8 +83,10 @@ private:
     Cycle sample_cycles_;
     Cycle last_sample_ = 0;
     Cycle on_at_last_sample_ = 0;
-    bool waving_ = false;     // the gate is a periodic wave
-    bool following_ = false;  // ... and the heater follows it (no fault): on_ means nothing
+    // The gate is a periodic wave the heater follows (never with a fault:
+    // a fault ends the wave first, and no wave begins during one); on_ and
+    // on_since_ mean nothing meanwhile.
+    bool waving_ = false;
     PeriodicWave wave_;
     Cycle wave_from_ = 0;     // on-time up to here is in on_total_
 };
