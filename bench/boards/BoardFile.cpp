@@ -10,12 +10,14 @@
 #include <cctype>
 #include <charconv>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <optional>
 #include <set>
 #include <sstream>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 #include "core/McuPins.hpp"
 #include "core/Units.hpp"
 
@@ -137,11 +139,30 @@ std::string find_board_file(const std::string& name_or_path) {
 
 BoardSpec load_board_file(const std::string& name_or_path) {
     const std::string path = find_board_file(name_or_path);
-    std::ifstream in(path);
-    if (!in) throw BadInput(path + ": cannot read");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parse_board_text(ss.str(), path);
+    return parse_board_text(read_input_file(path, "board file", kMaxBoardFileBytes), path);
+}
+
+std::vector<StandardBoard> list_standard_boards() {
+    std::map<std::string, StandardBoard> found;
+    for (const auto& dir : standard_board_dirs()) {
+        std::error_code ec;
+        for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+            const std::filesystem::path& file = entry.path();
+            if (file.extension() != ".yaml" || !entry.is_regular_file(ec)) continue;
+            const std::string name = file.stem().string();
+            if (found.count(name) != 0) continue;  // an earlier folder's board of that name wins
+            StandardBoard board{name, file.string(), "", ""};
+            try {
+                board.description = load_board_file(file.string()).description;
+            } catch (const BadInput& e) {
+                board.error = e.what();
+            }
+            found.emplace(name, std::move(board));
+        }
+    }
+    std::vector<StandardBoard> boards;
+    for (auto& [name, board] : found) boards.push_back(std::move(board));
+    return boards;
 }
 
 namespace {
@@ -232,11 +253,7 @@ BoardSpec load_base(const YAML::Node& node, const std::string& path, int depth) 
     } catch (const BadInput& e) {
         throw BadInput(loc + ": extends " + e.what());
     }
-    std::ifstream in(file);
-    if (!in) throw BadInput(file + ": cannot read");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parse_board(ss.str(), file, depth + 1);
+    return parse_board(read_input_file(file, "board file", kMaxBoardFileBytes), file, depth + 1);
 }
 
 }  // namespace

@@ -107,4 +107,15 @@ std::vector<std::string> standard_board_dirs();
 std::vector<std::string> standard_bootloader_dirs();
 BoardSpec parse_board_text(const std::string& text, const std::string& path);
 
+// The standard boards a bare name can select (`avrbench boards`): each name
+// once, from the first of standard_board_dirs() that has it, sorted by name.
+// A file that does not load is listed with its one-line error.
+struct StandardBoard {
+    std::string name;
+    std::string path;
+    std::string description;
+    std::string error;  // "" when the file loads
+};
+std::vector<StandardBoard> list_standard_boards();
+
 }  // namespace avrbench

@@ -92,11 +92,16 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     install_simavr_log_router();
     mcu_type_ = !options_.mcu_type.empty() ? options_.mcu_type : elf_.embedded_mcu();
     frequency_hz_ = options_.frequency_hz != 0 ? options_.frequency_hz : elf_.embedded_frequency_hz();
+    // Both missing are named in one message, so one correction suffices.
+    if (mcu_type_.empty() && frequency_hz_ == 0) {
+        throw BadInput(elf_.path() + ": no MCU type and no clock frequency: the ELF has no .mmcu section; give both with "
+                                     "--mcu and --freq (e.g. --mcu atmega328p --freq 16MHz) or run it on a board (--board)");
+    }
     if (mcu_type_.empty()) {
-        throw BadInput(elf_.path() + ": no MCU type: the ELF has no .mmcu section; give one with --mcu (e.g. --mcu atmega328p)");
+        throw BadInput(elf_.path() + ": no MCU type: the ELF names none (no .mmcu section, or no MCU tag in it); give one with --mcu (e.g. --mcu atmega328p)");
     }
     if (frequency_hz_ == 0) {
-        throw BadInput(elf_.path() + ": no clock frequency: the ELF has no .mmcu section; give one with --freq (e.g. --freq 16MHz)");
+        throw BadInput(elf_.path() + ": no clock frequency: the ELF gives none (no .mmcu section, or no frequency tag in it); give one with --freq (e.g. --freq 16MHz)");
     }
     avr_ = avr_make_mcu_by_name(mcu_type_.c_str());
     if (avr_ == nullptr) throw BadInput("unknown MCU '" + mcu_type_ + "' (simavr has no core by that name)");

@@ -9,10 +9,19 @@
 //                        is of a kind listed there is not a crash, so a job
 //                        is not stopped and restarted for the same bug again
 //
+//   AVRBENCH_FUZZ_CRASH_DIR  set: a finding does not stop libFuzzer. The
+//                        input is written to <dir>/crash-<hash of its bytes>
+//                        (where libFuzzer would put it), its one line printed,
+//                        and the campaign goes on in this one process: a
+//                        campaign that `avrbench fuzz` runs in-process, whose
+//                        course depends on -seed and -runs only, not on the
+//                        machine's speed. Unset: a finding aborts, and
+//                        libFuzzer (in fork mode, -ignore_crashes) keeps the
+//                        input as crash-*.
+//
 // Per input the process forks; the child runs the input and leaves the edge
 // map and the outcome in memory shared with the parent, which copies the map
-// into libFuzzer's extra counters. A finding aborts, and libFuzzer keeps the
-// input as crash-*.
+// into libFuzzer's extra counters.
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -44,6 +53,17 @@ struct Shared {
 __attribute__((section("__libfuzzer_extra_counters"), used)) std::uint8_t g_counters[kMapSize];
 
 Shared* g_shared = nullptr;
+
+// crash-<FNV-1a of the bytes, 16 hex digits>: one file per distinct input.
+void save_crash(const char* dir, const std::uint8_t* data, std::size_t size) {
+    std::uint64_t hash = 0xcbf29ce484222325ull;
+    for (std::size_t i = 0; i < size; ++i) hash = (hash ^ data[i]) * 0x100000001b3ull;
+    char name[32];
+    std::snprintf(name, sizeof name, "/crash-%016llx", static_cast<unsigned long long>(hash));
+    std::ofstream out(std::string(dir) + name, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    if (!out) std::fprintf(stderr, "fuzz_firmware: cannot write %s%s\n", dir, name);
+}
 
 }  // namespace
 
@@ -101,6 +121,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             }
         }
         std::fprintf(stderr, "%s\n", line);
+        if (const char* dir = std::getenv("AVRBENCH_FUZZ_CRASH_DIR"); dir != nullptr && *dir != '\0') {
+            save_crash(dir, data, size);
+            return -1;
+        }
         std::abort();
     }
     return 0;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <cstring>
 #include <fcntl.h>
@@ -45,11 +46,22 @@ std::string self_dir() {
     return ec ? std::string(".") : exe.parent_path().string();
 }
 
+// A helper program or library of `avrbench fuzz`: beside avrbench in a build
+// tree, in <prefix>/libexec/avrbench where it is installed. "" if neither.
+std::string find_helper(const std::string& name) {
+    for (const fs::path& dir : {fs::path(self_dir()), fs::path(self_dir()) / ".." / "libexec" / "avrbench"}) {
+        std::error_code ec;
+        if (fs::is_regular_file(dir / name, ec)) return (dir / name).lexically_normal().string();
+    }
+    return "";
+}
+
 std::string find_target(const std::string& name, const char* override_variable) {
     if (const char* env = std::getenv(override_variable)) return env;
-    const std::string beside = self_dir() + "/" + name;
-    if (fs::exists(beside)) return beside;
-    throw BadInput(name + " not found beside avrbench (" + beside + "); the build makes it (bench/CMakeLists.txt)");
+    if (std::string found = find_helper(name); !found.empty()) return found;
+    throw BadInput(name + " not found beside avrbench (" + self_dir() + ") or in " + self_dir() +
+                   "/../libexec/avrbench; the build makes it (bench/CMakeLists.txt; without Debian's libfuzzer-14-dev "
+                   "only --engine afl is built)");
 }
 
 // A program on PATH (the AFL++ tools), or BadInput naming the package.
@@ -184,20 +196,40 @@ struct Campaign {
     std::string artifact_dir;
 };
 
+// "60 s" or "20000 executions (at most 300 s)".
+std::string budget_text(const FuzzArgs& args, double seconds) {
+    char text[96];
+    if (args.runs != 0) {
+        std::snprintf(text, sizeof text, "%lu executions (at most %.0f s)", args.runs, seconds);
+    } else {
+        std::snprintf(text, sizeof text, "%.0f s", seconds);
+    }
+    return text;
+}
+
 Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>& env, const fs::path& out,
                             const fs::path& corpus, const fs::path& findings, double seconds, const std::string& family) {
     Campaign campaign;
     campaign.target = {find_target("avrbench-fuzz-firmware", "AVRBENCH_FUZZ_TARGET"), true};
     campaign.artifact_dir = findings.string();
+    // One job runs in this one process (the target keeps going after a
+    // finding, AVRBENCH_FUZZ_CRASH_DIR): its course depends on --seed and
+    // --runs, never on how fast the machine is. Several jobs: libFuzzer's
+    // fork mode, which restarts a job after each crash.
+    const bool in_process = args.jobs <= 1;
     std::vector<std::string> argv = {campaign.target.path,
                                      corpus.string(),
                                      "-max_total_time=" + std::to_string(static_cast<long>(seconds)),
-                                     "-fork=" + std::to_string(std::max(1, args.jobs)),
-                                     "-ignore_crashes=1",
                                      "-max_len=512",
                                      "-dict=" + (out / "gcode.dict").string(),
                                      "-artifact_prefix=" + findings.string() + "/",
                                      "-seed=" + std::to_string(args.seed)};
+    if (in_process) {
+        argv.push_back("-print_final_stats=1");
+    } else {
+        argv.insert(argv.end(), {"-fork=" + std::to_string(args.jobs), "-ignore_crashes=1"});
+    }
+    if (args.runs != 0) argv.push_back("-runs=" + std::to_string(args.runs));
     const std::string log = (out / "fuzz.log").string();
     // Kinds of finding already reported in this campaign: a job does not
     // stop (and restart) for a kind it or another job already found.
@@ -205,19 +237,24 @@ Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>
     fs::remove(seen);
     std::vector<std::string> campaign_env = env;
     campaign_env.push_back("AVRBENCH_FUZZ_SEEN=" + seen);
-    std::printf("avrbench fuzz: %s on %s (family %s) for %.0f s, %d job(s); libFuzzer log %s\n", args.elf.c_str(),
-                args.board.c_str(), family.c_str(), seconds, std::max(1, args.jobs), log.c_str());
+    if (in_process) campaign_env.push_back("AVRBENCH_FUZZ_CRASH_DIR=" + findings.string());
+    std::printf("avrbench fuzz: %s on %s (family %s) for %s, %d job(s); libFuzzer log %s\n", args.elf.c_str(),
+                args.board.c_str(), family.c_str(), budget_text(args, seconds).c_str(), std::max(1, args.jobs), log.c_str());
     std::fflush(stdout);
     run_logged(argv, campaign_env, log);
 
-    // libFuzzer's fork-mode status lines: "#<execs>: cov: .. ft: <features> ..".
+    // libFuzzer's status lines: "#<execs>: cov: .. ft: <features> .." in fork
+    // mode, "#<execs>\t<EVENT> ft: <features> .." in one process (no "cov:":
+    // the bench's code is not instrumented, the firmware's edges are features).
     std::vector<std::pair<unsigned long, unsigned long>> progress;
     {
         std::istringstream lines(slurp(log));
         std::string line;
         while (std::getline(lines, line)) {
             unsigned long runs = 0, cov = 0, features = 0;
-            if (std::sscanf(line.c_str(), "#%lu: cov: %lu ft: %lu", &runs, &cov, &features) == 3) {
+            char event[16];
+            if (std::sscanf(line.c_str(), "#%lu: cov: %lu ft: %lu", &runs, &cov, &features) == 3 ||
+                std::sscanf(line.c_str(), "#%lu %15s ft: %lu", &runs, event, &features) == 3) {
                 progress.emplace_back(runs, features);
             }
         }
@@ -267,13 +304,13 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
                                    "LSAN_OPTIONS=symbolize=0"});
     if (!args.raw) {
         // The structure-aware G-code mutator (bench/fuzz/afl_gcode_mutator.cpp) beside AFL++'s own havoc.
-        const std::string mutator = self_dir() + "/libavrbench-afl-gcode-mutator.so";
-        if (fs::exists(mutator)) afl_env.push_back("AFL_CUSTOM_MUTATOR_LIBRARY=" + mutator);
+        const std::string mutator = find_helper("libavrbench-afl-gcode-mutator.so");
+        if (!mutator.empty()) afl_env.push_back("AFL_CUSTOM_MUTATOR_LIBRARY=" + mutator);
     }
     const int jobs = std::max(1, args.jobs);
-    std::printf("avrbench fuzz: %s on %s (family %s) for %.0f s, AFL++ with %d instance(s) on %s; logs %s/*.log\n",
-                args.elf.c_str(), args.board.c_str(), family.c_str(), seconds, jobs, sync.string().c_str(),
-                out.string().c_str());
+    std::printf("avrbench fuzz: %s on %s (family %s) for %s, AFL++ with %d instance(s) on %s; logs %s/*.log\n",
+                args.elf.c_str(), args.board.c_str(), family.c_str(), budget_text(args, seconds).c_str(), jobs,
+                sync.string().c_str(), out.string().c_str());
     std::fflush(stdout);
     std::vector<pid_t> instances;
     for (int i = 0; i < jobs; ++i) {
@@ -287,6 +324,11 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
                                          "-s", std::to_string(args.seed + static_cast<unsigned>(i)),
                                          "-x", (out / "gcode.dict").string(),
                                          "--", campaign.target.path, "@@"};
+        if (args.runs != 0) {
+            // Each instance's share of the executions (AFL++'s -E).
+            const unsigned long share = std::max(1ul, args.runs / static_cast<unsigned long>(jobs));
+            argv.insert(argv.begin() + 1, {"-E", std::to_string(share)});
+        }
         instances.push_back(spawn_logged(argv, afl_env, (out / ("afl-" + name + ".log")).string()));
     }
     // Coverage of the seeds alone, with AFL++'s own count, while the instances start.
@@ -393,11 +435,13 @@ int fuzz_command(const FuzzArgs& args) {
                                           "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
                                           "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
                                           std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
+    const auto started = std::chrono::steady_clock::now();
     Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
                                              : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
+    const double campaign_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const Target& target = campaign.target;
-    std::printf("  executions %lu (%.0f per second)\n", campaign.executions,
-                static_cast<double>(campaign.executions) / seconds);
+    std::printf("  executions %lu in %.1f s (%.0f per second)\n", campaign.executions, campaign_s,
+                campaign_s > 0 ? static_cast<double>(campaign.executions) / campaign_s : 0.0);
     std::printf("  coverage   firmware edge %s %lu at the start, %lu at the end\n",
                 campaign.target.libfuzzer ? "features" : "tuples (AFL++'s edges)", campaign.coverage_start,
                 campaign.coverage_end);

@@ -9,7 +9,8 @@ namespace avrbench {
 struct FuzzArgs {
     std::string elf;
     std::string board;
-    std::string duration = "60s";  // wall-clock time of the campaign
+    std::string duration = "60s";  // wall-clock time of the campaign (with --runs: its guard)
+    unsigned long runs = 0;        // executions of the campaign (0: until --for ends)
     std::string bound = "5s";      // simulated time one input may take
     std::string out = "fuzz-out";
     std::string family;  // "" = the board's

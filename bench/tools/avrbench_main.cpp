@@ -652,6 +652,23 @@ int run_command(const RunArgs& args) {
     return kExitOk;
 }
 
+// `avrbench boards`: the standard boards a bare name selects, with their descriptions.
+int boards_command() {
+    const std::vector<StandardBoard> boards = list_standard_boards();
+    if (boards.empty()) {
+        throw BadInput("no standard boards found (looked in: $AVRBENCH_BOARDS_DIR, <prefix>/share/avrbench/boards, the source tree)");
+    }
+    std::size_t width = 0;
+    for (const auto& b : boards) width = std::max(width, b.name.size());
+    std::printf("Standard boards (run --board NAME, or `board: NAME` in a scenario); files in %s\n",
+                std::filesystem::path(boards.front().path).parent_path().string().c_str());
+    for (const auto& b : boards) {
+        std::printf("  %-*s  %s\n", static_cast<int>(width), b.name.c_str(),
+                    b.error.empty() ? b.description.c_str() : ("(does not load: " + b.error + ")").c_str());
+    }
+    return kExitOk;
+}
+
 struct CamArgs {
     std::string dxf;
     std::string out;            // .nc file ("" = beside the DXF)
@@ -857,6 +874,8 @@ int main(int argc, char** argv) {
     update_cmd->add_option("--firmware-dir", golden.firmware_dir, "where bare firmware names resolve");
     update_cmd->add_flag("--force", golden.force, "write the golden even when the run fails its steps or expectations");
 
+    CLI::App* boards_cmd = app.add_subcommand("boards", "list the standard boards (names for --board and scenarios) with their descriptions");
+
     CamArgs cam;
     CLI::App* cam_cmd = app.add_subcommand("cam", "seed 002's CAM: a DXF drawing (lines, arcs, circles) to G-code");
     cam_cmd->add_option("dxf", cam.dxf, "the drawing, machine millimetres from home")->required();
@@ -868,7 +887,10 @@ int main(int argc, char** argv) {
     CLI::App* fuzz_cmd = app.add_subcommand("fuzz", "coverage-guided G-code fuzzing of a firmware on a board (libFuzzer or AFL++; docs/FUZZING.md)");
     fuzz_cmd->add_option("--elf", fuzz.elf, "the firmware")->required();
     fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name; --elf runs on its serial port's MCU")->required();
-    fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s)");
+    fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s; with --runs its upper bound)");
+    fuzz_cmd->add_option("--runs", fuzz.runs,
+                         "executions of the campaign: with one job and a --seed, the same inputs on any machine "
+                         "(libFuzzer -runs, AFL++ -E)");
     fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");
     fuzz_cmd->add_option("--out", fuzz.out, "corpus, reproducers, runs and the libFuzzer log (default fuzz-out)");
     fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, teacup, generic (default: the board's)");
@@ -901,6 +923,7 @@ int main(int argc, char** argv) {
         if (check_cmd->parsed()) code = check_command(check, false);
         if (update_cmd->parsed()) code = check_command(golden, true);
         if (cam_cmd->parsed()) code = cam_command(cam);
+        if (boards_cmd->parsed()) code = boards_command();
         if (fuzz_cmd->parsed()) code = fuzz_command(fuzz);
     } catch (const BadInput& e) {
         std::fflush(stdout);

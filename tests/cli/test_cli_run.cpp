@@ -142,7 +142,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadInputCase{"not_avr", "run " + std::string(AVRBENCH_CLI), "not an AVR ELF"},
         BadInputCase{"unknown_mcu", "run " + test::firmware("blink_timer1") + " --mcu atmega9999",
                      "unknown MCU 'atmega9999'"},
-        BadInputCase{"no_mmcu", "run " + test::firmware("blink_timer1_nommcu"), "give one with --mcu"},
+        // Both options missing are named in one message, so one correction suffices.
+        BadInputCase{"no_mmcu", "run " + test::firmware("blink_timer1_nommcu"), "give both with --mcu and --freq"},
+        BadInputCase{"no_mmcu_freq_given", "run " + test::firmware("blink_timer1_nommcu") + " --freq 16MHz", "give one with --mcu"},
+        BadInputCase{"no_mmcu_mcu_given", "run " + test::firmware("blink_timer1_nommcu") + " --mcu atmega328p", "give one with --freq"},
         BadInputCase{"bad_duration", "run " + test::firmware("blink_timer1") + " --for 2parsecs", "--for"},
         BadInputCase{"bad_freq", "run " + test::firmware("blink_timer1") + " --freq fast", "--freq"},
         BadInputCase{"missing_uart_in", "run " + test::firmware("uart_echo") + " --uart-in /nonexistent/in.txt",
