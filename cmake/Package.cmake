@@ -30,6 +30,13 @@ if(NOT gzip_result EQUAL 0)
 endif()
 install(FILES ${CMAKE_SOURCE_DIR}/cmake/package/copyright ${AVRBENCH_PACKAGE_DOC}/changelog.gz
         DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT cli)
+# The manual page, compressed the same way.
+configure_file(${CMAKE_SOURCE_DIR}/cmake/package/avrbench.1 ${AVRBENCH_PACKAGE_DOC}/avrbench.1 COPYONLY)
+execute_process(COMMAND gzip -9nf ${AVRBENCH_PACKAGE_DOC}/avrbench.1 RESULT_VARIABLE gzip_result)
+if(NOT gzip_result EQUAL 0)
+  message(FATAL_ERROR "gzip of ${AVRBENCH_PACKAGE_DOC}/avrbench.1 failed")
+endif()
+install(FILES ${AVRBENCH_PACKAGE_DOC}/avrbench.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT cli)
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME avrbench)
