@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <filesystem>
@@ -24,10 +25,7 @@
 namespace avrbench {
 namespace {
 
-std::string where(const std::string& path, const YAML::Node& node) {
-    const auto mark = node.Mark();
-    return path + ":" + std::to_string(mark.line >= 0 ? mark.line + 1 : 0);
-}
+std::string where(const std::string& path, const YAML::Node& node) { return yaml_where(path, node); }
 
 std::string scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
     if (!node.IsScalar()) throw BadInput(where(path, node) + ": " + what + " must be a single value");
@@ -52,7 +50,7 @@ Endpoint parse_endpoint(const YAML::Node& node, const std::string& path) {
 }
 
 void check_name(const std::string& name, const std::string& location, const char* what, std::set<std::string>& seen) {
-    if (!valid_name(name)) throw BadInput(location + ": '" + name + "' is not a valid " + what + " name");
+    if (!valid_name(name)) throw BadInput(location + ": " + quoted_text(name) + " is not a valid " + what + " name");
     if (!seen.insert(name).second) throw BadInput(location + ": duplicate name '" + name + "'");
 }
 
@@ -127,6 +125,8 @@ std::vector<std::string> standard_bootloader_dirs() {
 std::string find_board_file(const std::string& name_or_path) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(name_or_path, ec)) return name_or_path;
+    // There, but a FIFO, a device or a folder: say which.
+    if (std::filesystem::exists(name_or_path, ec)) check_input_file(name_or_path, "board file", kMaxBoardFileBytes);
     const bool bare = !name_or_path.empty() && name_or_path.find('/') == std::string::npos &&
                       std::filesystem::path(name_or_path).extension() != ".yaml";
     if (!bare) throw BadInput(name_or_path + ": no such board file");
@@ -258,19 +258,21 @@ BoardSpec load_base(const YAML::Node& node, const std::string& path, int depth) 
 
 }  // namespace
 
-BoardSpec parse_board_text(const std::string& text, const std::string& path) { return parse_board(text, path, 0); }
+BoardSpec parse_board_text(const std::string& text, const std::string& path) {
+    try {
+        return parse_board(text, path, 0);
+    } catch (const YAML::Exception& e) {
+        // A node of another shape than the one read (a list where a map
+        // belongs, ...) that no check above caught: still the user's file.
+        throw BadInput(escaped(path) + ":" + std::to_string(e.mark.line + 1) + ": unexpected YAML here (" + escaped(e.msg) + ")");
+    }
+}
 
 namespace {
 
 BoardSpec parse_board(const std::string& text, const std::string& path, int depth) {
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw BadInput(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-    }
-    if (!root.IsMap()) throw BadInput(path + ":1: a board file is a map with mcus, parts, nets");
-    check_unique_keys(root, path);
+    const YAML::Node root = load_yaml(text, path);
+    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a board file is a map with mcus, parts, nets");
 
     BoardSpec spec;
     spec.path = path;
@@ -285,7 +287,18 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
     }
     std::optional<BoardSpec> base;
     if (root["extends"]) base = load_base(root["extends"], path, depth);
-    if (root["board"]) spec.name = scalar(root["board"], path, "board");
+    if (root["board"]) {
+        // A name people type and the summary prints: letters, digits, '_', '-', '.'.
+        spec.name = scalar(root["board"], path, "board");
+        const bool printable_name = !spec.name.empty() && spec.name.size() <= 64 &&
+                                    std::all_of(spec.name.begin(), spec.name.end(), [](char c) {
+                                        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+                                    });
+        if (!printable_name) {
+            throw BadInput(where(path, root["board"]) + ": board name " + quoted_text(spec.name) +
+                           " is not 1 to 64 letters, digits, '_', '-' or '.'");
+        }
+    }
     if (root["description"]) spec.description = scalar(root["description"], path, "description");
 
     std::set<std::string> names;
@@ -294,6 +307,10 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
     }
     if (mcus && !mcus.IsMap()) throw BadInput(where(path, mcus) + ": 'mcus' must be a map of MCU name to type and clock");
+    if (mcus && mcus.size() > kMaxMcusPerBoard) {
+        throw BadInput(where(path, mcus) + ": " + std::to_string(mcus.size()) + " MCUs; a board holds at most " +
+                       std::to_string(kMaxMcusPerBoard) + " (their lockstep costs grow with the square of the count)");
+    }
     for (const auto& kv : mcus) {
         McuDecl m;
         m.name = kv.first.Scalar();
@@ -323,7 +340,8 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         spec.mcus.push_back(std::move(m));
     }
 
-    if (const YAML::Node parts = root["parts"]) {
+    // An empty section (`parts:` with nothing under it) is a board without parts.
+    if (const YAML::Node parts = root["parts"]; parts && !parts.IsNull()) {
         if (!parts.IsMap()) throw BadInput(where(path, parts) + ": 'parts' must be a map of part name to its settings");
         for (const auto& kv : parts) {
             PartDecl p;
@@ -344,7 +362,7 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
-    if (const YAML::Node nets = root["nets"]) {
+    if (const YAML::Node nets = root["nets"]; nets && !nets.IsNull()) {
         if (!nets.IsMap()) throw BadInput(where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
         std::set<std::string> net_names;
         for (const auto& kv : nets) {
@@ -362,13 +380,16 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
-    if (const YAML::Node serial = root["serial"]) {
+    if (const YAML::Node serial = root["serial"]; serial && !serial.IsNull()) {
         if (!serial.IsMap()) throw BadInput(where(path, serial) + ": 'serial' must be a map of port name to its settings");
         for (const auto& kv : serial) {
             SerialDecl s;
             s.name = kv.first.Scalar();
             s.location = where(path, kv.first);
             check_name(s.name, s.location, "serial port", names);
+            if (!kv.second.IsMap()) {
+                throw BadInput(where(path, kv.second) + ": serial port '" + s.name + "' must be a map {mcu, usart, flow, ...}");
+            }
             for (const auto& field : kv.second) {
                 const std::string key = field.first.Scalar();
                 const std::string loc = where(path, field.first);
@@ -405,7 +426,7 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
-    if (const YAML::Node labels = root["labels"]) {
+    if (const YAML::Node labels = root["labels"]; labels && !labels.IsNull()) {
         if (!labels.IsMap()) throw BadInput(where(path, labels) + ": 'labels' must be a map of name to endpoint");
         std::set<std::string> label_names;
         for (const auto& kv : labels) {
@@ -435,6 +456,10 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         for (const auto& m : spec.mcus) check_name(m.name, m.location, "MCU", all_names);
         for (const auto& p : spec.parts) check_name(p.name, p.location, "part", all_names);
         for (const auto& s2 : spec.serial) check_name(s2.name, s2.location, "serial port", all_names);
+        if (spec.mcus.size() > kMaxMcusPerBoard) {
+            throw BadInput(escaped(path) + ":1: with its base board, " + std::to_string(spec.mcus.size()) +
+                           " MCUs; a board holds at most " + std::to_string(kMaxMcusPerBoard));
+        }
     }
     std::set<std::string> used_endpoints;
     for (const auto& n : spec.nets) {

@@ -78,6 +78,11 @@ struct LabelDecl {
     std::string location;
 };
 
+// MCUs on one board at most (docs/BOARDS.md): the lockstep compares every
+// core's horizon with every other's, so a run's cost grows with the square of
+// the count; seed 001's printer has five.
+inline constexpr std::size_t kMaxMcusPerBoard = 16;
+
 struct BoardSpec {
     std::string path;
     std::string name;

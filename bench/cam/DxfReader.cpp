@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include <dl_creationadapter.h>
 #include <dl_dxf.h>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 
 namespace avrbench {
 namespace {
@@ -50,11 +52,11 @@ public:
 }  // namespace
 
 DxfReadResult read_dxf(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": no such file");
+    // Read by the bench (a regular file, bounded) and handed to dxflib as a stream.
+    std::istringstream stream(read_input_file(path, "DXF drawing", kMaxDxfFileBytes));
     Collector collector;
     DL_Dxf dxf;
-    if (!dxf.in(path, &collector)) throw BadInput(path + ": cannot be read as DXF");
+    if (!dxf.in(stream, &collector)) throw BadInput(escaped(path) + ": cannot be read as DXF");
     collector.result.drawing.source = path;
     for (const auto& s : collector.result.drawing.segments) {
         for (double v : {s.start.x, s.start.y, s.end.x, s.end.y, s.centre.x, s.centre.y}) {

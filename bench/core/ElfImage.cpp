@@ -1,6 +1,7 @@
 #include "core/ElfImage.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <gelf.h>
 #include <libelf.h>
 #include <unistd.h>
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string_view>
 #include <vector>
 
@@ -18,6 +20,8 @@ extern "C" {
 }
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
+#include "core/Units.hpp"
 #include "core/SimavrLog.hpp"
 
 namespace avrbench {
@@ -34,12 +38,25 @@ constexpr std::uint32_t kSignatureBase = 0x840000;
 constexpr std::uint32_t kMaxFlashBytes = 4u << 20;
 constexpr std::uint32_t kMaxEepromBytes = 64u << 10;
 constexpr std::size_t kMaxFuseBytes = 6;  // simavr's avr_t::fuse[6]
+// Symbol and string tables are read whole; Marlin 2 with debug info has ~1 MiB.
+constexpr std::uint64_t kMaxSymbolTableBytes = 64u << 20;
 
 // .mmcu tag numbers (simavr's avr_mcu_section.h, the format firmware writes).
 enum MmcuTag : std::uint8_t {
-    kTagName = 1, kTagFrequency = 2, kTagVcc = 3, kTagAvcc = 4, kTagAref = 5,
-    kTagConsole = 11, kTagExternalPull = 17,
+    kTagEnd = 0, kTagName = 1, kTagFrequency = 2, kTagVcc = 3, kTagAvcc = 4, kTagAref = 5,
+    kTagLowFuse = 6, kTagHighFuse = 7, kTagExtendedFuse = 8, kTagSignature = 9, kTagCommand = 10,
+    kTagConsole = 11, kTagVcdFile = 12, kTagVcdPeriod = 13, kTagVcdTrace = 14, kTagVcdPortPin = 15,
+    kTagVcdIrq = 16, kTagExternalPull = 17,
 };
+// avr_mmcu_vcd_trace_t minus its tag and length: mask (1), what (a 2-byte
+// AVR pointer), name[32].
+constexpr std::uint8_t kVcdTraceTagBytes = 35;
+
+std::string hex(unsigned value) {
+    char text[16];
+    std::snprintf(text, sizeof text, "%X", value);
+    return text;
+}
 
 std::uint32_t le32(const std::uint8_t* p) {
     return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
@@ -67,16 +84,22 @@ struct ElfHandle {
 
 }  // namespace
 
-ElfImage ElfImage::load(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw BadInput(path + ": no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": not a regular file");
-
+ElfImage ElfImage::load(const std::string& path_given) {
+    // Only the ELF's headers, the sections named below and the loadable
+    // segments are read (libelf reads on demand): a file of gigabytes, a
+    // sparse one or one with huge debug sections costs no more memory than
+    // its program.
+    const std::string path = escaped(path_given);
     install_simavr_log_router();
     if (elf_version(EV_CURRENT) == EV_NONE) throw BadInput("libelf: version mismatch");
     ElfHandle h;
-    h.fd = open(path.c_str(), O_RDONLY);
+    // A regular file, named as what it is otherwise (a FIFO is never opened for a blocking read).
+    check_input_file(path_given, "firmware ELF", std::numeric_limits<std::uint64_t>::max());
+    h.fd = open(path_given.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
     if (h.fd < 0) throw BadInput(path + ": cannot open: " + std::strerror(errno));
+    struct stat st {};
+    if (fstat(h.fd, &st) != 0 || !S_ISREG(st.st_mode)) throw BadInput(path + ": not a regular file");
+    const auto file_size = static_cast<std::uint64_t>(st.st_size);
     h.elf = elf_begin(h.fd, ELF_C_READ, nullptr);
     if (h.elf == nullptr || elf_kind(h.elf) != ELF_K_ELF) throw BadInput(path + ": not an ELF file");
     GElf_Ehdr ehdr;
@@ -87,16 +110,14 @@ ElfImage ElfImage::load(const std::string& path) {
     }
     if (gelf_getclass(h.elf) != ELFCLASS32) throw BadInput(path + ": not an AVR ELF (not ELF32)");
 
-    std::size_t file_size = 0;
-    if (elf_rawfile(h.elf, &file_size) == nullptr ||
-        ehdr.e_shoff + static_cast<std::uint64_t>(ehdr.e_shnum) * ehdr.e_shentsize > file_size ||
+    if (ehdr.e_shoff + static_cast<std::uint64_t>(ehdr.e_shnum) * ehdr.e_shentsize > file_size ||
         ehdr.e_phoff + static_cast<std::uint64_t>(ehdr.e_phnum) * ehdr.e_phentsize > file_size) {
         throw BadInput(path + ": malformed ELF: truncated (its headers reach past the end of the file)");
     }
     if (ehdr.e_type != ET_EXEC) throw BadInput(path + ": not an AVR executable (an object file or library? link it first)");
 
     ElfImage image;
-    image.path_ = path;
+    image.path_ = path_given;
     image.flash_ = std::make_shared<std::vector<std::uint8_t>>();
     image.eeprom_ = std::make_shared<std::vector<std::uint8_t>>();
 
@@ -129,6 +150,14 @@ ElfImage ElfImage::load(const std::string& path) {
             mmcu = &mmcu_bytes;
         }
         if (shdr.sh_type != SHT_SYMTAB) continue;
+        // A symbol table, and the string table it names, are read whole: bounded.
+        GElf_Shdr strings{};
+        Elf_Scn* string_section = elf_getscn(h.elf, shdr.sh_link);
+        if (shdr.sh_size > kMaxSymbolTableBytes || string_section == nullptr || gelf_getshdr(string_section, &strings) == nullptr ||
+            strings.sh_size > kMaxSymbolTableBytes) {
+            throw BadInput(path + ": malformed ELF: a symbol table or its names larger than " +
+                           std::to_string(kMaxSymbolTableBytes >> 20) + " MiB, or without its string table");
+        }
         if (shdr.sh_entsize != sizeof(Elf32_Sym)) {
             throw BadInput(path + ": malformed ELF: symbol table entries of " + std::to_string(shdr.sh_entsize) +
                            " bytes (ELF32 symbols are " + std::to_string(sizeof(Elf32_Sym)) + ")");
@@ -163,23 +192,36 @@ ElfImage ElfImage::load(const std::string& path) {
         }
     }
 
-    load_segments(h.elf, path, image);
+    load_segments(h.elf, h.fd, file_size, path, image);
     if (mmcu != nullptr) parse_mmcu(*mmcu, path, image);
     return image;
 }
 
 // Flash, EEPROM, fuses and lock bits from the loadable segments, each at its
 // load address in the linker's flat AVR address map.
-void ElfImage::load_segments(Elf* elf, const std::string& path, ElfImage& image) {
-    std::size_t file_size = 0;
-    const char* raw = elf_rawfile(elf, &file_size);
+void ElfImage::load_segments(Elf* elf, int fd, std::uint64_t file_size, const std::string& path, ElfImage& image) {
     std::size_t count = 0;
-    if (raw == nullptr || elf_getphdrnum(elf, &count) != 0) throw BadInput(path + ": malformed ELF: unreadable program headers");
+    if (elf_getphdrnum(elf, &count) != 0) throw BadInput(path + ": malformed ELF: unreadable program headers");
     if (count == 0) throw BadInput(path + ": not an AVR executable (no loadable segments)");
     struct Piece {
         std::uint32_t address;
         const std::uint8_t* bytes;
         std::uint32_t size;
+    };
+    // The bytes of the segments that are memory (flash, EEPROM, fuses, lock
+    // bits), read when a segment's place is known: each is within an AVR
+    // memory's size, so this is bounded too.
+    std::vector<std::vector<std::uint8_t>> contents;
+    contents.reserve(count);
+    const auto read_segment = [&](const GElf_Phdr& ph) {
+        std::vector<std::uint8_t>& bytes = contents.emplace_back(static_cast<std::size_t>(ph.p_filesz));
+        std::size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t n = pread(fd, bytes.data() + done, bytes.size() - done, static_cast<off_t>(ph.p_offset + done));
+            if (n <= 0) throw BadInput(path + ": cannot read a segment: " + (n < 0 ? std::strerror(errno) : "the file ended"));
+            done += static_cast<std::size_t>(n);
+        }
+        return bytes.data();
     };
     std::vector<Piece> flash, eeprom;
     for (std::size_t i = 0; i < count; ++i) {
@@ -190,9 +232,10 @@ void ElfImage::load_segments(Elf* elf, const std::string& path, ElfImage& image)
             throw BadInput(path + ": malformed ELF: segment " + std::to_string(i) + " lies outside the file");
         }
         const std::uint64_t start = ph.p_paddr, end = ph.p_paddr + ph.p_filesz;
-        const Piece piece{static_cast<std::uint32_t>(start), reinterpret_cast<const std::uint8_t*>(raw + ph.p_offset),
-                          static_cast<std::uint32_t>(ph.p_filesz)};
         auto inside = [&](std::uint64_t base, std::uint64_t limit) { return start >= base && end <= base + limit; };
+        const bool memory = inside(0, kMaxFlashBytes) || inside(kEepromBase, kMaxEepromBytes) ||
+                            (start == kFuseBase && ph.p_filesz <= kMaxFuseBytes) || (start == kLockBase && ph.p_filesz <= 1);
+        const Piece piece{static_cast<std::uint32_t>(start), memory ? read_segment(ph) : nullptr, static_cast<std::uint32_t>(ph.p_filesz)};
         char where[96];
         std::snprintf(where, sizeof where, "segment %zu (load address 0x%llx, %llu bytes)", i,
                       static_cast<unsigned long long>(start), static_cast<unsigned long long>(ph.p_filesz));
@@ -262,7 +305,16 @@ void ElfImage::parse_mmcu(const std::vector<std::uint8_t>& section, const std::s
                 image.embedded_mcu_.assign(reinterpret_cast<const char*>(p), n);
                 break;
             }
-            case kTagFrequency: need(4, "frequency"); image.embedded_frequency_hz_ = le32(p); break;
+            case kTagFrequency: {
+                need(4, "frequency");
+                const std::uint32_t hz = le32(p);
+                if (hz < kMinClockHz || hz > kMaxClockHz) {
+                    throw BadInput(path + ": .mmcu section: frequency " + std::to_string(hz) +
+                                   " Hz is outside 1 Hz .. 64 MHz (the range --freq accepts)");
+                }
+                image.embedded_frequency_hz_ = hz;
+                break;
+            }
             case kTagVcc: need(4, "VCC"); image.vcc_mv_ = le32(p); break;
             case kTagAvcc: need(4, "AVCC"); image.avcc_mv_ = le32(p); break;
             case kTagAref: need(4, "AREF"); image.aref_mv_ = le32(p); break;
@@ -277,17 +329,58 @@ void ElfImage::parse_mmcu(const std::vector<std::uint8_t>& section, const std::s
                 const auto address = static_cast<std::uint16_t>(p[0] | (p[1] << 8));
                 // simavr hooks it as an I/O register write: data addresses 0x20..0xff.
                 if (address < 0x20 || address > 0xff) {
-                    throw BadInput(path + ": malformed .mmcu section: console register 0x" + std::to_string(address) + " is not an I/O register");
+                    throw BadInput(path + ": malformed .mmcu section: console register 0x" + hex(address) + " is not an I/O register");
                 }
                 image.console_register_ = address;
                 break;
             }
-            default:
-                // VCD trace tags: the bench's recorder is the one trace; the
-                // simavr command register: not supported (ignored).
+            case kTagLowFuse:
+            case kTagHighFuse:
+            case kTagExtendedFuse:
+                // Ignored: the fuses come from the ELF's .fuse segment
+                // (avr-libc's FUSES), as avrdude would program them.
+                need(1, "fuse");
                 break;
+            case kTagSignature:
+                // Ignored: the signature is the MCU type's own.
+                need(3, "signature");
+                break;
+            case kTagCommand: {
+                // Ignored (the bench has no command register; the firmware's
+                // writes to it stay plain I/O writes), but it must name one.
+                need(2, "command register");
+                const auto address = static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+                if (address < 0x20 || address > 0xff) {
+                    throw BadInput(path + ": malformed .mmcu section: command register 0x" + hex(address) + " is not an I/O register");
+                }
+                break;
+            }
+            case kTagVcdFile:
+            case kTagVcdPeriod:
+                // Ignored: --vcd names the file; every change is recorded.
+                break;
+            case kTagVcdTrace:
+            case kTagVcdPortPin:
+            case kTagVcdIrq:
+                // Ignored: the bench's recorder is the trace (--trace, boards).
+                // The struct is {mask, 2-byte address, 32-byte name} on AVR.
+                if (length != kVcdTraceTagBytes) {
+                    throw BadInput(path + ": malformed .mmcu section: a VCD trace tag of " + std::to_string(length) +
+                                   " bytes (simavr's avr_mmcu_vcd_trace_t has " + std::to_string(kVcdTraceTagBytes) + ")");
+                }
+                break;
+            case kTagEnd:
+                break;
+            default:
+                // A tag simavr 1.6 does not define: the bench cannot know what it asks for.
+                throw BadInput(path + ": malformed .mmcu section: unknown tag " + std::to_string(tag) + " at byte " +
+                               std::to_string(at) + " (simavr 1.6's avr_mcu_section.h defines 0 to 17)");
         }
         at = payload + length;
+    }
+    if (at != section.size()) {
+        throw BadInput(path + ": malformed .mmcu section: " + std::to_string(section.size() - at) +
+                       " byte(s) after its last tag (a tag is at least 2 bytes)");
     }
 }
 

@@ -53,7 +53,7 @@ public:
     elf_firmware_t simavr_firmware() const;
 
 private:
-    static void load_segments(Elf* elf, const std::string& path, ElfImage& image);
+    static void load_segments(Elf* elf, int fd, std::uint64_t file_size, const std::string& path, ElfImage& image);
     static void parse_mmcu(const std::vector<std::uint8_t>& section, const std::string& path, ElfImage& image);
 
     std::string path_;

@@ -34,6 +34,11 @@ std::string size_text(std::uint64_t bytes) {
 
 struct Fd {
     int fd = -1;
+    Fd() = default;
+    Fd(Fd&& other) noexcept : fd(other.fd) { other.fd = -1; }
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    Fd& operator=(Fd&&) = delete;
     ~Fd() {
         if (fd >= 0) ::close(fd);
     }
@@ -63,7 +68,7 @@ std::string escaped(const std::string& text) {
     return out;
 }
 
-std::string quoted(const std::string& text) {
+std::string quoted_text(const std::string& text) {
     std::string out = "'";
     for (char c : escaped(text)) {
         if (c == '\'') out.push_back('\\');
@@ -73,7 +78,10 @@ std::string quoted(const std::string& text) {
     return out;
 }
 
-std::string read_input_file(const std::string& path, const std::string& what, std::uint64_t max_bytes) {
+namespace {
+
+// Opens and checks `path` as above; the descriptor and the file's size.
+Fd open_checked(const std::string& path, const std::string& what, std::uint64_t max_bytes, std::uint64_t& size) {
     const std::string name = what + ": " + escaped(path);
     if (path.empty()) throw BadInput(what + ": an empty file name");
     Fd file;
@@ -85,17 +93,30 @@ std::string read_input_file(const std::string& path, const std::string& what, st
     struct stat st {};
     if (::fstat(file.fd, &st) != 0) throw BadInput(name + ": cannot read: " + std::strerror(errno));
     if (!S_ISREG(st.st_mode)) throw BadInput(name + ": is " + kind_of(st.st_mode) + ", not a regular file");
-    const auto size = static_cast<std::uint64_t>(st.st_size);
+    size = static_cast<std::uint64_t>(st.st_size);
     if (size > max_bytes) {
         throw BadInput(name + ": " + size_text(size) + " is more than a " + what + " may be (" + size_text(max_bytes) +
                        "; docs/CLI.md, \"Limits\")");
     }
+    return file;
+}
+
+}  // namespace
+
+void check_input_file(const std::string& path, const std::string& what, std::uint64_t max_bytes) {
+    std::uint64_t size = 0;
+    open_checked(path, what, max_bytes, size);
+}
+
+std::string read_input_file(const std::string& path, const std::string& what, std::uint64_t max_bytes) {
+    std::uint64_t size = 0;
+    const Fd file = open_checked(path, what, max_bytes, size);
     std::string bytes(static_cast<std::size_t>(size), '\0');
     std::size_t done = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::read(file.fd, bytes.data() + done, bytes.size() - done);
         if (n < 0 && errno == EINTR) continue;
-        if (n < 0) throw BadInput(name + ": cannot read: " + std::strerror(errno));
+        if (n < 0) throw BadInput(what + ": " + escaped(path) + ": cannot read: " + std::strerror(errno));
         if (n == 0) break;  // shrank while reading: what was there
         done += static_cast<std::size_t>(n);
     }

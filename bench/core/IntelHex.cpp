@@ -1,10 +1,11 @@
 #include "core/IntelHex.hpp"
 
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <map>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 
 namespace avrbench {
 
@@ -20,8 +21,7 @@ int hex_digit(char c) {
 }  // namespace
 
 std::vector<HexChunk> read_intel_hex(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(path + ": cannot open the Intel HEX file");
+    std::istringstream in(read_input_file(path, "Intel HEX file", kMaxBootloaderFileBytes));
 
     std::map<std::uint32_t, std::uint8_t> bytes;  // address -> byte, to find overlaps and merge
     std::uint32_t base = 0;

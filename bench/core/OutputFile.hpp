@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace avrbench {
 
@@ -43,5 +44,27 @@ private:
 
 // The whole file in one call.
 void write_output_file(const std::string& path, std::string_view content, const std::string& what);
+
+// The files one command reads and writes, checked together before it runs:
+// no two outputs may be the same file (a VCD's .gtkw save file counts as an
+// output), and no output may be one of the inputs - so `--vcd x --uart-out x`
+// or `cam plot.nc` never overwrites what it reads or writes. "The same file":
+// the same inode when it exists (hard and symbolic links included), else the
+// same absolute, normalized path.
+class RunFiles {
+public:
+    void input(const std::string& path, const std::string& what);
+    // Also check_output_path().
+    void output(const std::string& path, const std::string& what);
+    // Throws BadInput "<what>: <path> is also <other what>" for the first clash.
+    void check() const;
+
+private:
+    struct Entry {
+        std::string path, what, key;
+        bool is_output;
+    };
+    std::vector<Entry> files_;
+};
 
 }  // namespace avrbench

@@ -60,6 +60,12 @@ std::int64_t parse_integer(std::string_view text, std::string_view what, std::in
 std::int64_t checked_integer(double value, std::string_view what, std::int64_t min_value, std::int64_t max_value);
 
 // Hertz from "16MHz", "20 MHz", "32768Hz", or a bare number of Hz.
+// MCU clocks the bench accepts, wherever they come from (--freq, a board
+// file, an ELF's .mmcu section): no AVR is specified above 32 MHz (XMEGA);
+// 64 MHz leaves room for overclocking experiments and keeps a second of
+// simulated time bounded.
+inline constexpr std::uint32_t kMinClockHz = 1;
+inline constexpr std::uint32_t kMaxClockHz = 64'000'000;
 std::uint32_t parse_frequency_hz(std::string_view text, std::string_view what);
 
 }  // namespace avrbench

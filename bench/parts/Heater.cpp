@@ -18,7 +18,7 @@ std::vector<ParamSpec> Heater::param_specs() {
         {.name = "supply", .type = PT::Quantity, .dimension = D::Voltage, .source = "preset",
          .help = "heater supply voltage"},
         {.name = "resistance", .type = PT::Quantity, .dimension = D::Resistance, .source = "preset",
-         .help = "heater element resistance"},
+         .help = "heater element resistance", .min = 1e-3},  // no heater element is below a milliohm
         {.name = "series_resistance", .type = PT::Quantity, .dimension = D::Resistance, .default_value = "0ohm",
          .source = "assumed: negligible", .help = "MOSFET on-resistance plus wiring"},
         {.name = "gate_active", .type = PT::Choice, .default_value = "high", .choices = {"high", "low"},
@@ -68,7 +68,7 @@ Heater::Heater(std::string name, Mcu& clock, const ParamValues& params)
 void Heater::connect_port(std::size_t, Part& provider) {
     plant_ = &dynamic_cast<ThermalPlant&>(provider);
     try {
-        source_ = plant_->add_heat_source(node_);
+        source_ = plant_->add_heat_source(node_, power_on_W_);
     } catch (const BadInput& e) {
         throw BadInput("part '" + name() + "': " + e.what());
     }

@@ -21,7 +21,7 @@ std::vector<ParamSpec> ThermalPlant::param_specs() {
         {.name = "initial", .type = PT::Quantity, .dimension = D::Temperature,
          .help = "temperature of every node at power-on (default: ambient)"},
         {.name = "heat_capacity", .type = PT::Quantity, .dimension = D::HeatCapacity, .source = "preset",
-         .help = "heat capacity of the block"},
+         .help = "heat capacity of the block", .min = 1e-3},  // a thermistor bead alone is ~10 mJ/K
         {.name = "ambient_conductance", .type = PT::Quantity, .dimension = D::ThermalConductance, .source = "preset",
          .help = "block to ambient, fan off"},
         {.name = "ambient_conductance_fan", .type = PT::Quantity, .dimension = D::ThermalConductance,
@@ -123,8 +123,13 @@ void ThermalPlant::connect_port(std::size_t, Part& provider) {
 
 std::string ThermalPlant::summary() {
     char line[200];
-    std::snprintf(line, sizeof line, "thermal    %s: block %.2f degC, sensor %.2f degC, heater %.1f W now", name().c_str(),
-                  block_degC(), sensor_degC(), heater_power_W());
+    const double block = block_degC(), sensor = sensor_degC();
+    if (diverged_ || !std::isfinite(block) || !std::isfinite(sensor)) {
+        std::snprintf(line, sizeof line, "thermal    %s: the model's temperatures are not finite numbers (see findings)", name().c_str());
+        return line;
+    }
+    std::snprintf(line, sizeof line, "thermal    %s: block %.2f degC, sensor %.2f degC, heater %.1f W now", name().c_str(), block,
+                  sensor, heater_power_W());
     return line;
 }
 
@@ -140,6 +145,16 @@ void ThermalPlant::advance() {
         last_cycle_ = now;
     }
     const double block = network_.temperature(block_);
+    if (!std::isfinite(block)) {
+        // The heating-rate check at construction keeps the model finite; should
+        // parameters still combine past it, that is a finding (this code runs
+        // inside simavr's callbacks, where no exception may pass), and the
+        // summary says "not a number" instead of printing one.
+        if (!diverged_) report(FindingKind::Overheat, "the block's temperature is no longer a finite number "
+                                                      "(parameters outside any physical range?)");
+        diverged_ = true;
+        return;
+    }
     if (!overheated_ && block > max_degC_) {
         overheated_ = true;
         char detail[120];
@@ -172,12 +187,24 @@ void ThermalPlant::set_ambient_degC(double degC) {
     network_.set_ambient(degC);
 }
 
-int ThermalPlant::add_heat_source(const std::string& node) {
+int ThermalPlant::add_heat_source(const std::string& node, double max_power_W) {
     int n = -1;
     if (node == "block") n = block_;
     if (node == "surface") n = surface_;
     if (n < 0) throw BadInput("plant '" + name() + "' has no node '" + node + "' to heat (block" +
                               (surface_ >= 0 ? ", surface" : "") + ")");
+    // Plausibility of the pair: a 40 W cartridge heats the E3D preset's 16.7
+    // J/K block at 2.4 K/s, a 120 W bed its 158 J/K at 0.8 K/s; a heater that
+    // would heat its node faster than kMaxHeatingRate names parameters no
+    // bench holds (and drives the model's temperatures past any meaning).
+    const double rate_K_per_s = max_power_W / network_.heat_capacity(n);
+    if (!(rate_K_per_s <= kMaxHeatingRate_K_per_s)) {
+        char text[200];
+        std::snprintf(text, sizeof text, "%.3g W into the %s node of plant '%s' (%.3g J/K) heats it at %.3g K/s, more than %.0f K/s: "
+                      "not a physical combination (check supply, resistance, heat_capacity)",
+                      max_power_W, node.c_str(), name().c_str(), network_.heat_capacity(n), rate_K_per_s, kMaxHeatingRate_K_per_s);
+        throw BadInput(text);
+    }
     sources_.emplace_back(n, 0.0);
     return static_cast<int>(sources_.size()) - 1;
 }

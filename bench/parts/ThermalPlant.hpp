@@ -50,7 +50,10 @@ public:
 
     // Inputs. Each advances the model to now with the old value first.
     // A heat source is one heater's contribution to one node ("block" or "surface").
-    int add_heat_source(const std::string& node);
+    // A heater of at most `max_power_W` on "block" or "surface"; BadInput if
+    // the pair would heat that node faster than kMaxHeatingRate_K_per_s.
+    int add_heat_source(const std::string& node, double max_power_W);
+    static constexpr double kMaxHeatingRate_K_per_s = 1000;
     void set_heat_source_power(int source, double watts);
     void set_fan_speed(double fraction);          // 0..1 of full speed
     void set_filament_feed_mm_per_s(double rate); // filament entering the melt zone
@@ -86,6 +89,7 @@ private:
     int block_ = -1, surface_ = -1, sensor_ = -1;
     double g_ambient_, g_ambient_fan_, filament_J_per_K_mm_;
     double max_degC_;
+    bool diverged_ = false;  // a temperature stopped being a finite number (reported once)
     double fan_speed_ = 0, feed_mm_per_s_ = 0;
     bool detached_ = false;
     bool overheated_ = false;

@@ -1,14 +1,17 @@
 #include "stimulus/PtyBridge.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/inotify.h>
 #include <termios.h>
 #include <unistd.h>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 
 namespace avrbench {
 namespace {
@@ -16,6 +19,25 @@ namespace {
 // Output the host has not read is kept up to this much; beyond it the oldest
 // is dropped (and counted), so a host that never reads cannot grow memory.
 constexpr std::size_t kMaxPendingBytes = 1 << 20;
+// What the host sent and the firmware has not taken yet: at most this much
+// is read from the pty; the rest waits in the kernel's pty buffer and then
+// blocks the host's writes, as a USB-serial bridge's small receive buffer
+// throttles a real host (an FT232R holds 256 bytes, the Linux tty 4 KiB).
+constexpr std::size_t kMaxQueuedToFirmware = 4096;
+
+// --pty-link may replace a symbolic link to a pseudo-terminal (one a former
+// run left), never a file or a link to anything else.
+void check_link_path(const std::string& link) {
+    struct stat st {};
+    if (::lstat(link.c_str(), &st) != 0) return;  // free
+    if (S_ISLNK(st.st_mode)) {
+        char target[256] = {};
+        const ssize_t n = ::readlink(link.c_str(), target, sizeof target - 1);
+        if (n > 0 && std::string(target, static_cast<std::size_t>(n)).rfind("/dev/pts/", 0) == 0) return;
+    }
+    throw BadInput("--pty-link: " + escaped(link) +
+                   " exists and is not a link to a pseudo-terminal (/dev/pts/N): avrbench replaces only such links");
+}
 
 }  // namespace
 
@@ -47,13 +69,14 @@ PtyBridge::PtyBridge(Uart& uart, const std::string& link_path) : uart_(uart), li
         inotify_ = -1;
     }
     if (!link_.empty()) {
+        check_link_path(link_);
         ::unlink(link_.c_str());
         if (::symlink(path_.c_str(), link_.c_str()) != 0) {
             const std::string why = std::strerror(errno);
             ::close(master_);
             if (slave_keepalive_ >= 0) ::close(slave_keepalive_);
             if (inotify_ >= 0) ::close(inotify_);
-            throw BadInput(link_ + ": cannot link it to " + path_ + ": " + why);
+            throw BadInput(escaped(link_) + ": cannot link it to " + path_ + ": " + why);
         }
     }
     uart_.on_transmit([this](Cycle, std::uint8_t byte) {
@@ -102,8 +125,9 @@ std::size_t PtyBridge::pump() {
     flush();
     std::string in;
     char buf[4096];
-    for (;;) {
-        const ssize_t n = ::read(master_, buf, sizeof buf);
+    while (uart_.pending_rx() + in.size() < kMaxQueuedToFirmware) {
+        const std::size_t room = kMaxQueuedToFirmware - uart_.pending_rx() - in.size();
+        const ssize_t n = ::read(master_, buf, std::min(room, sizeof buf));
         if (n <= 0) break;  // nothing (EAGAIN), or no host (EIO)
         in.append(buf, static_cast<std::size_t>(n));
     }

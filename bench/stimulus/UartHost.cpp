@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 #include "core/Mcu.hpp"
 #include "core/Scheduler.hpp"
 
@@ -271,14 +272,7 @@ UartHost::~UartHost() {
 
 void UartHost::load_file(const std::string& path) {
     if (options_.raw_bytes) throw std::logic_error("UartHost: raw_bytes mode sends no lines; use send_bytes()");
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw BadInput(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw BadInput(path + ": cannot read (a directory)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(path + ": cannot read");
-    std::ostringstream text;
-    text << in.rdbuf();
-    const std::string bytes = text.str();
+    const std::string bytes = read_input_file(path, "G-code file", kMaxGcodeFileBytes);
     auto parsed = parse_gcode(checked_gcode_text(bytes, path), path);
     lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
     pump();

@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +23,7 @@
 #include "cam/Records.hpp"
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 #include "tools/FirmwareArgs.hpp"
 #include "tools/FuzzCommand.hpp"
 #include "core/Mcu.hpp"
@@ -110,12 +113,23 @@ std::vector<PortFile> port_files(const std::vector<std::string>& items, const ch
     return out;
 }
 
-std::string read_file(const std::string& path, const char* what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(std::string(what) + ": " + path + ": cannot open");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+// --uart-in's bytes: a regular file, or "-" for standard input (a pipe on
+// purpose, read to its end), both at most kMaxUartInputBytes.
+std::string read_uart_input(const std::string& path) {
+    if (path != "-") return read_input_file(path, "--uart-in", kMaxUartInputBytes);
+    std::string bytes;
+    char buffer[65536];
+    for (;;) {
+        const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw BadInput(std::string("--uart-in -: cannot read standard input: ") + std::strerror(errno));
+        if (n == 0) return bytes;
+        bytes.append(buffer, static_cast<std::size_t>(n));
+        if (bytes.size() > kMaxUartInputBytes) {
+            throw BadInput("--uart-in -: standard input holds more than " + std::to_string(kMaxUartInputBytes >> 20) +
+                           " MiB (docs/CLI.md, \"Limits\")");
+        }
+    }
 }
 
 class ProgressBar {
@@ -215,14 +229,26 @@ void print_findings(const std::vector<Finding>& findings) {
     for (const auto& line : summarize_findings(findings)) std::printf("    %s\n", line.c_str());
 }
 
-// Every output path of a run, checked before the run starts.
-void check_run_outputs(const RunArgs& args, const std::vector<PortFile>& uart_out) {
-    if (!args.vcd.empty()) {
-        check_output_path(args.vcd, "--vcd");
-        check_output_path(with_extension(args.vcd, ".gtkw"), "--vcd (its gtkwave save file)");
+// Every file a run reads and writes, checked together before the run starts
+// (core/OutputFile.hpp, RunFiles): each output a file of its own, none an input.
+void check_run_files(const RunArgs& args, const std::vector<PortFile>& uart_in, const std::vector<PortFile>& uart_out,
+                     const std::vector<std::string>& more_inputs = {}) {
+    RunFiles files;
+    files.input(args.elf, "the firmware ELF");
+    for (const auto& f : more_inputs) files.input(f, "an input of the board");
+    if (!args.gcode.empty()) files.input(args.gcode, "--gcode");
+    if (!args.dxf.empty()) files.input(args.dxf, "--dxf");
+    for (const auto& pf : uart_in) {
+        if (pf.path != "-") files.input(pf.path, "--uart-in");
     }
-    if (!args.report.empty()) check_output_path(args.report, "--report");
-    for (const auto& pf : uart_out) check_output_path(pf.path, "--uart-out");
+    if (!args.vcd.empty()) {
+        files.output(args.vcd, "--vcd");
+        files.output(with_extension(args.vcd, ".gtkw"), "--vcd's gtkwave save file");
+    }
+    if (!args.report.empty()) files.output(args.report, "--report");
+    for (const auto& pf : uart_out) files.output(pf.path, "--uart-out");
+    if (!args.nc.empty()) files.output(args.nc, "--nc");
+    files.check();
 }
 
 void print_text_tail(const std::string& text, std::size_t max_lines) {
@@ -314,13 +340,15 @@ BoardRun prepare_board_run(const RunArgs& args) {
     run.settle_ps = parse_duration_ps(args.settle, "--settle");
     const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
     run.uart_out = port_files(args.uart_out, "--uart-out");
-    check_run_outputs(args, run.uart_out);
-    std::vector<std::pair<std::string, std::string>> uart_in_bytes;  // port -> bytes
-    for (const auto& pf : uart_in) uart_in_bytes.emplace_back(pf.port, read_file(pf.path, "--uart-in"));
-    if (!args.gcode.empty()) {
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(args.gcode, ec)) throw BadInput("--gcode: " + args.gcode + ": no such file");
+    {
+        std::vector<std::string> board_inputs = {spec.path};
+        for (const auto& [mcu, elf] : firmware) board_inputs.push_back(elf);
+        for (const auto& m : spec.mcus) board_inputs.push_back(m.bootloader);
+        check_run_files(args, uart_in, run.uart_out, board_inputs);
     }
+    std::vector<std::pair<std::string, std::string>> uart_in_bytes;  // port -> bytes
+    for (const auto& pf : uart_in) uart_in_bytes.emplace_back(pf.port, read_uart_input(pf.path));
+    if (!args.gcode.empty()) check_input_file(args.gcode, "--gcode", kMaxGcodeFileBytes);
 
     run.bench = std::make_unique<Bench>(std::move(spec), firmware);
     Bench& bench = *run.bench;
@@ -353,10 +381,7 @@ BoardRun prepare_board_run(const RunArgs& args) {
         run.host = &bench.host(decl.name, o);
         if (args.gcode_bytes) {
             // The file's bytes as lines, as avrbench fuzz sent them: binary bytes included.
-            std::ifstream in(args.gcode, std::ios::binary);
-            std::ostringstream bytes;
-            bytes << in.rdbuf();
-            run.host->add_lines(bytes.str());
+            run.host->add_lines(read_input_file(args.gcode, "--gcode", kMaxGcodeFileBytes));
         } else {
             run.host->load_file(args.gcode);
         }
@@ -376,10 +401,7 @@ BoardRun prepare_board_run(const RunArgs& args) {
         Drawing drawing = read_dxf(args.dxf).drawing;
         align_segments(drawing, 0.01);
         const GcodeProgram gcode = emit_gcode(drawing, 0.01, feed);
-        if (!args.nc.empty()) {
-            check_output_path(args.nc, "--nc");
-            write_output_file(args.nc, gcode.text, "--nc");
-        }
+        if (!args.nc.empty()) write_output_file(args.nc, gcode.text, "--nc");
         RecordOptions options;
         options.improved = args.records == "improved";
         const RecordProgram program = records_from_gcode(gcode.text, options, args.dxf);
@@ -582,9 +604,9 @@ int run_command(const RunArgs& args) {
             }
         }
     }
-    check_run_outputs(args, uart_out);
+    check_run_files(args, uart_in, uart_out);
     std::string uart_in_bytes;
-    if (!uart_in.empty()) uart_in_bytes = read_file(uart_in.front().path, "--uart-in");
+    if (!uart_in.empty()) uart_in_bytes = read_uart_input(uart_in.front().path);
 
     Mcu mcu(elf, options);
     Timeline timeline;
@@ -663,8 +685,8 @@ int boards_command() {
     std::printf("Standard boards (run --board NAME, or `board: NAME` in a scenario); files in %s\n",
                 std::filesystem::path(boards.front().path).parent_path().string().c_str());
     for (const auto& b : boards) {
-        std::printf("  %-*s  %s\n", static_cast<int>(width), b.name.c_str(),
-                    b.error.empty() ? b.description.c_str() : ("(does not load: " + b.error + ")").c_str());
+        std::printf("  %-*s  %s\n", static_cast<int>(width), escaped(b.name).c_str(),
+                    escaped(b.error.empty() ? b.description : "(does not load: " + b.error + ")").c_str());
     }
     return kExitOk;
 }
@@ -678,6 +700,11 @@ struct CamArgs {
 
 // DXF -> aligned segments -> G-code (seed 002's CAD2G, docs/CNC.md).
 int cam_command(const CamArgs& args) {
+    const std::string out = args.out.empty() ? with_extension(args.dxf, ".nc") : args.out;
+    RunFiles files;
+    files.input(args.dxf, "the drawing");
+    files.output(out, args.out.empty() ? "the G-code (the DXF's name with .nc)" : "-o");
+    files.check();
     DxfReadResult read = read_dxf(args.dxf);
     const double tolerance_mm = parse_quantity(args.tolerance, Dimension::Length, "--tolerance") * 1e3;
     if (!(tolerance_mm >= 0 && tolerance_mm <= 10)) throw BadInput("--tolerance: must be from 0 to 10 mm");
@@ -686,8 +713,6 @@ int cam_command(const CamArgs& args) {
     const GcodeProgram before = emit_gcode(read.drawing, tolerance_mm, feed);
     const ChainStats stats = align_segments(read.drawing, tolerance_mm);
     const GcodeProgram after = emit_gcode(read.drawing, tolerance_mm, feed);
-    const std::string out = args.out.empty() ? with_extension(args.dxf, ".nc") : args.out;
-    check_output_path(out, "-o");
     write_output_file(out, after.text, "-o");
     std::printf("avrbench cam: %s\n", args.dxf.c_str());
     std::printf("  entities   %zu (lines, arcs, circles); %u others skipped\n", read.drawing.segments.size(),
@@ -774,9 +799,9 @@ int check_command(const CheckArgs& args, bool update_golden) {
                 continue;
             }
         } catch (const BadInput& e) {
-            results.push_back(error_result(path, e.what()));
+            results.push_back(error_result(path, escaped(e.what())));
             std::fflush(stdout);
-            std::fprintf(stderr, "avrbench: error: %s\n", e.what());
+            std::fprintf(stderr, "avrbench: error: %s\n", escaped(e.what()).c_str());
         }
         std::fputs(results.back().text().c_str(), stdout);
     }
@@ -798,6 +823,20 @@ int check_command(const CheckArgs& args, bool update_golden) {
     }
     std::printf("%zu passed, %zu failed\n", results.size() - failed - errors, failed + errors);
     return errors > 0 ? kExitBadInput : failed > 0 ? kExitFinding : kExitOk;
+}
+
+// `--vcd ''` is a mistake, not "no VCD": an option that takes a value and
+// was given an empty one is bad usage, for every option of every command.
+void reject_empty_values(const CLI::App& app) {
+    for (const CLI::App* command : app.get_subcommands()) {
+        for (const CLI::Option* option : command->get_options()) {
+            if (option->count() == 0 || option->get_type_size() == 0) continue;  // not given, or a flag
+            for (const std::string& value : option->results()) {
+                if (value.empty()) throw BadInput(option->get_name() + ": an empty value");
+            }
+        }
+        reject_empty_values(*command);
+    }
 }
 
 }  // namespace
@@ -913,12 +952,13 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "avrbench: usage error: %s (see avrbench --help)\n", e.what());
+        std::fprintf(stderr, "avrbench: usage error: %s (see avrbench --help)\n", escaped(e.what()).c_str());
         return kExitBadInput;
     }
     install_user_stop_handlers();
     int code = 0;
     try {
+        reject_empty_values(app);
         if (run_cmd->parsed()) code = run_command(run);
         if (check_cmd->parsed()) code = check_command(check, false);
         if (update_cmd->parsed()) code = check_command(golden, true);
@@ -926,12 +966,14 @@ int main(int argc, char** argv) {
         if (boards_cmd->parsed()) code = boards_command();
         if (fuzz_cmd->parsed()) code = fuzz_command(fuzz);
     } catch (const BadInput& e) {
+        // Escaped: a message that quotes a user's string stays one line and
+        // never drives the terminal (core/InputFile.hpp).
         std::fflush(stdout);
-        std::fprintf(stderr, "avrbench: error: %s\n", e.what());
+        std::fprintf(stderr, "avrbench: error: %s\n", escaped(e.what()).c_str());
         code = kExitBadInput;
     } catch (const std::exception& e) {
         std::fflush(stdout);
-        std::fprintf(stderr, "avrbench: internal error: %s\n", e.what());
+        std::fprintf(stderr, "avrbench: internal error: %s\n", escaped(e.what()).c_str());
         code = kExitInternal;
     }
     // A summary that could not be written is a failed run (a full disk, a closed pipe).

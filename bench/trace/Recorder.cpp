@@ -11,6 +11,7 @@ extern "C" {
 }
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 #include "core/McuPins.hpp"
 #include "core/Twi.hpp"
 
@@ -42,6 +43,8 @@ Recorder::~Recorder() {
 }
 
 SignalId Recorder::trace_pin(Mcu& mcu, Pin& pin) {
+    // Traced already (`--trace PB5,PB5`, or a pin the board traces too): one signal.
+    if (const long existing = timeline_.find(mcu.name(), pin.name()); existing >= 0) return static_cast<SignalId>(existing);
     // A pin handed out as a periodic wave would not tell this listener its
     // edges: end the waves (they do not begin again while it listens).
     mcu.settle_periodic_outputs();
@@ -125,7 +128,7 @@ std::vector<SignalId> Recorder::trace_pins(Mcu& mcu, const std::string& spec) {
             names.push_back(upper);
         }
     }
-    if (names.empty()) throw BadInput("no pins in '" + spec + "'");
+    if (names.empty()) throw BadInput("no pins in " + quoted_text(spec));
     std::vector<SignalId> ids;
     for (const auto& name : names) ids.push_back(trace_pin(mcu, mcu.pin(name)));
     return ids;

@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 
 namespace avrbench {
 namespace {
@@ -159,12 +162,17 @@ void write_timeline_text(const Timeline& timeline, const TimelineHeader& header,
 // belongs in a golden of selected signals (golden_signals) or a window rule.
 constexpr std::uint64_t kMaxGoldenEvents = 50'000'000;
 
-ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source) {
+ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source, double stop_after_s) {
     ParsedTimeline parsed;
     std::istringstream in(text);
     std::string line;
     int line_no = 0;
-    auto fail = [&](const std::string& what) { throw BadInput(source + ":" + std::to_string(line_no) + ": " + what); };
+    auto fail = [&](const std::string& what) { throw BadInput(escaped(source) + ":" + std::to_string(line_no) + ": " + escaped(what)); };
+    // Every word of a line is read or the line is refused: nothing is dropped.
+    auto no_more = [&](std::istringstream& words, const char* what) {
+        std::string extra;
+        if (words >> extra) fail("'" + extra + "' after " + what + " (one item per line)");
+    };
     auto next_line = [&]() -> bool {
         while (std::getline(in, line)) {
             ++line_no;
@@ -189,9 +197,21 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
         if (v > (std::uint64_t{1} << 53)) fail("cycle count " + s + " is past any run's end");
         return v;
     };
+    // Where this signal's events stop being kept: its clock's cycle at the
+    // golden's own end (an event after it is malformed) and at stop_after_s
+    // (the run compared with it ended there: a later event is kept once, to
+    // show the difference, and the rest not even expanded).
+    Cycle end_bound = std::numeric_limits<Cycle>::max(), stop_bound = std::numeric_limits<Cycle>::max();
+    bool stopped = false;  // this signal passed stop_bound
     auto record = [&](Cycle cycle, const std::string& value) {
         // 10^6 s at 64 MHz is 6.4e13 cycles; 2^53 bounds the sums below too.
         if (cycle > (std::uint64_t{1} << 53)) fail("cycle " + std::to_string(cycle) + " is past any run's end");
+        if (cycle > end_bound) fail("cycle " + std::to_string(cycle) + " is after the timeline's end");
+        if (stopped) {
+            last_cycle = cycle;
+            return;
+        }
+        stopped = cycle > stop_bound;
         if (++events > kMaxGoldenEvents) {
             fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
         }
@@ -212,15 +232,17 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
         std::string word;
         ls >> word;
         if (word == "bench") {
-            ls >> parsed.header.bench_version;
+            if (!(ls >> parsed.header.bench_version)) fail("'bench' needs the version that wrote the file");
+            no_more(ls, "the bench version");
         } else if (word == "input") {
             TimelineInput input;
-            ls >> input.role >> input.sha256;
+            if (!(ls >> input.role >> input.sha256)) fail("'input' needs a role, a SHA-256 and a path");
             std::getline(ls >> std::ws, input.path);
             parsed.header.inputs.push_back(input);
         } else if (word == "end") {
             std::string c, f;
-            ls >> c >> f;
+            if (!(ls >> c >> f)) fail("'end' needs a cycle and a clock in Hz");
+            no_more(ls, "the end cycle and clock");
             parsed.header.end_cycle = parse_cycles(c);
             const std::uint64_t hz = parse_u64(f);
             if (hz == 0 || hz > 64'000'000) fail("end clock " + f + " Hz is not 1 Hz .. 64 MHz");
@@ -228,7 +250,8 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             parsed.header.end_clock_hz = static_cast<std::uint32_t>(hz);
         } else if (word == "signal") {
             std::string name, kind, width, clock;
-            ls >> name >> kind >> width >> clock;
+            if (!(ls >> name >> kind >> width >> clock)) fail("'signal' needs scope.name, kind, width and clock");
+            no_more(ls, "the signal's clock");
             const auto dot = name.find('.');
             if (dot == std::string::npos) fail("signal '" + name + "' has no scope");
             SignalInfo info;
@@ -257,7 +280,15 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             const auto dot = name.find('.');
             current = dot == std::string::npos ? -1 : parsed.timeline.find(name.substr(0, dot), name.substr(dot + 1));
             if (current < 0) fail("events for undeclared signal '" + name + "'");
+            no_more(ls, "the signal's name");
             last_cycle = 0;
+            stopped = false;
+            // The bounds in this signal's clock (end cycle x clock / end clock, exact enough: whole cycles).
+            const double hz = parsed.timeline.signals()[static_cast<std::size_t>(current)].clock_hz;
+            end_bound = parsed.header.end_clock_hz == 0
+                            ? std::numeric_limits<Cycle>::max()
+                            : static_cast<Cycle>(std::ceil(static_cast<double>(parsed.header.end_cycle) * hz / parsed.header.end_clock_hz));
+            stop_bound = stop_after_s > 0 ? static_cast<Cycle>(std::ceil(stop_after_s * hz)) : std::numeric_limits<Cycle>::max();
         } else if (current < 0) {
             fail("unexpected '" + line + "'");
         } else if (word[0] == '*') {
@@ -266,8 +297,9 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             if (repeats > kMaxGoldenEvents) fail("repeat count " + word.substr(1) + " is more than the events a golden may hold");
             std::vector<std::pair<Cycle, std::string>> block;
             std::string delta, value;
-            while (ls >> delta >> value) {
-                if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs");
+            while (ls >> delta) {
+                if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs, not '" + delta + "'");
+                if (!(ls >> value)) fail("repeat block: '" + delta + "' has no value");
                 block.emplace_back(parse_cycles(delta.substr(1)), value);
             }
             if (block.empty()) fail("empty repeat block");
@@ -275,28 +307,39 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
             if (repeats > (kMaxGoldenEvents - events) / block.size()) {
                 fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
             }
+            Cycle block_cycles = 0;
+            for (const auto& [d, v] : block) block_cycles += d;
             for (std::uint64_t r = 0; r < repeats; ++r) {
                 for (const auto& [d, v] : block) record(last_cycle + d, v);
+                if (stopped) {
+                    // Past the compared run's end: what is left only moves the
+                    // clock on (and is checked against the timeline's end).
+                    const std::uint64_t left = repeats - r - 1;
+                    if (block_cycles != 0 && left > ((std::uint64_t{1} << 53) - last_cycle) / block_cycles) {
+                        fail("the repeat runs past any run's end");
+                    }
+                    last_cycle += left * block_cycles;
+                    if (last_cycle > end_bound) fail("cycle " + std::to_string(last_cycle) + " is after the timeline's end");
+                    break;
+                }
             }
         } else if (word[0] == '+') {
             std::string value;
-            ls >> value;
+            if (!(ls >> value)) fail("'" + word + "' has no value");
+            no_more(ls, "a change");
             record(last_cycle + parse_cycles(word.substr(1)), value);
         } else {
             std::string value;
-            ls >> value;
+            if (!(ls >> value)) fail("'" + word + "' has no value");
+            no_more(ls, "a change");
             record(parse_cycles(word), value);
         }
     }
     return parsed;
 }
 
-ParsedTimeline read_timeline_text(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(path + ": no such golden timeline");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parse_timeline_text(ss.str(), path);
+ParsedTimeline read_timeline_text(const std::string& path, double stop_after_s) {
+    return parse_timeline_text(read_input_file(path, "golden timeline", kMaxGoldenFileBytes), path, stop_after_s);
 }
 
 }  // namespace avrbench

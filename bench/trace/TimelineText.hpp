@@ -56,9 +56,14 @@ struct ParsedTimeline {
     TimelineHeader header;
     Timeline timeline;
 };
-// Throws BadInput "<source>:<line>: ..." on anything it does not understand.
-ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source);
-ParsedTimeline read_timeline_text(const std::string& path);
+// Throws BadInput "<source>:<line>: ..." on anything it does not understand:
+// every word of every line is read, or the line is refused. An event after
+// the timeline's own `end` is malformed. With stop_after_s > 0 (the end of
+// the run it will be compared with), each signal keeps its first event after
+// that time and no later one - not even expanded - so a golden that claims
+// more than the run could show costs no more than the run.
+ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source, double stop_after_s = 0);
+ParsedTimeline read_timeline_text(const std::string& path, double stop_after_s = 0);
 
 // Events of one signal with unchanged values removed, in time order.
 std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id);

@@ -1,5 +1,7 @@
 #include "trace/VcdReader.hpp"
 
+#include "core/InputFile.hpp"
+
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -286,12 +288,7 @@ const VcdVariable& VcdDump::at(std::string_view full_name) const {
 VcdDump parse_vcd(std::string_view text, const std::string& source) { return Parser(text, source).parse(); }
 
 VcdDump read_vcd(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot read VCD file '" + path + "': " + std::strerror(errno));
-    std::ostringstream content;
-    content << in.rdbuf();
-    if (in.bad()) throw std::runtime_error("cannot read VCD file '" + path + "'");
-    return parse_vcd(content.str(), path);
+    return parse_vcd(read_input_file(path, "VCD file", kMaxVcdFileBytes), path);
 }
 
 }  // namespace avrbench

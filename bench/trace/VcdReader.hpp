@@ -52,7 +52,7 @@ struct VcdDump {
 
 // `source` names the text in error messages (a path, or "<string>").
 VcdDump parse_vcd(std::string_view text, const std::string& source = "<string>");
-// Throws std::runtime_error naming `path` when it cannot be read.
+// Throws BadInput naming `path` when it cannot be read (core/InputFile.hpp).
 VcdDump read_vcd(const std::string& path);
 
 }  // namespace avrbench

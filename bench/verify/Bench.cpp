@@ -42,6 +42,7 @@ const char* to_string(IdleResult result) {
         case IdleResult::Halted: return "halted";
         case IdleResult::HostFailed: return "host failed";
         case IdleResult::Interrupted: return "interrupted";
+        case IdleResult::RecorderFull: return "recorder full";
     }
     return "?";
 }
@@ -213,6 +214,7 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
         if (all_finished && motion_settled) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
         if (user_stop_requested()) return IdleResult::Interrupted;
+        if (timeline_.overflowed()) return IdleResult::RecorderFull;
         // now < target, and afterwards now_ps() >= target (core/Time.hpp): progress.
         if (board_->run_until_ps(std::min(end, add_ps(now, slice))) == StopReason::Halted) return IdleResult::Halted;
     }
@@ -224,6 +226,7 @@ IdleResult Bench::run_to_ps(Picoseconds end_ps, const RunSlices& how) {
     // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
     while (now_ps() < end_ps) {
         if (user_stop_requested()) return IdleResult::Interrupted;
+        if (timeline_.overflowed()) return IdleResult::RecorderFull;
         const Picoseconds target = std::min(end_ps, add_ps(now_ps(), slice_ps));
         if (how.until_idle) {
             const IdleResult r = run_until_idle_ps(target - now_ps(), how.settle_ps);

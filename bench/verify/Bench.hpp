@@ -33,6 +33,7 @@ enum class IdleResult {
     Halted,      // every MCU halted (crash findings say why)
     HostFailed,  // a host stopped: no answer (timeout), ALARM, !!, ...
     Interrupted, // SIGINT/SIGTERM (core/UserStop.hpp)
+    RecorderFull,  // the timeline's cap was hit: the run can no longer be recorded whole, so it ends
 };
 
 const char* to_string(IdleResult result);

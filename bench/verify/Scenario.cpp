@@ -11,6 +11,7 @@
 #include "boards/YamlKeys.hpp"
 #include "core/Errors.hpp"
 #include "core/Finding.hpp"
+#include "core/InputFile.hpp"
 #include "core/McuPins.hpp"
 #include "core/Units.hpp"
 
@@ -19,9 +20,7 @@ namespace fs = std::filesystem;
 namespace avrbench {
 namespace {
 
-std::string where(const std::string& path, const YAML::Node& node) {
-    return path + ":" + std::to_string(node.Mark().line + 1);
-}
+std::string where(const std::string& path, const YAML::Node& node) { return yaml_where(path, node); }
 
 std::string scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
     if (!node.IsScalar()) throw BadInput(where(path, node) + ": " + what + " must be a single value");
@@ -279,21 +278,21 @@ std::vector<std::string> ScenarioSpec::stimulus_files() const {
     return out;
 }
 
+ScenarioSpec load_scenario_checked(const std::string& path, const std::string& firmware_dir);
+
 ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_dir) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw BadInput(path + ": no such scenario file");
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    if (!in.good() && !in.eof()) throw BadInput(path + ": cannot read");
-    YAML::Node root;
     try {
-        root = YAML::Load(ss.str());
+        return load_scenario_checked(path, firmware_dir);
     } catch (const YAML::Exception& e) {
-        throw BadInput(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+        // A node of another shape than the one read that no check caught.
+        throw BadInput(escaped(path) + ":" + std::to_string(e.mark.line + 1) + ": unexpected YAML here (" + escaped(e.msg) + ")");
     }
-    if (!root.IsMap()) throw BadInput(path + ":1: a scenario is a map with board, firmware, steps, expect");
-    check_unique_keys(root, path);
+}
+
+ScenarioSpec load_scenario_checked(const std::string& path, const std::string& firmware_dir) {
+    std::error_code ec;
+    const YAML::Node root = load_yaml(read_input_file(path, "scenario", kMaxScenarioFileBytes), path);
+    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a scenario is a map with board, firmware, steps, expect");
     static const std::set<std::string> kKeys = {"name",   "description", "board",  "firmware",       "time_limit", "host",
                                                 "steps",  "expect",      "golden", "golden_signals", "tolerances"};
     for (const auto& kv : root) {
@@ -309,9 +308,14 @@ ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_
                              : checked_name(fs::path(path).stem().string(), path + ":1");
     if (root["description"]) spec.description = scalar(root["description"], path, "description");
     if (!root["board"]) throw BadInput(path + ":1: the scenario needs 'board'");
-    spec.board_path = resolve(path, scalar(root["board"], path, "board"));
+    // A file beside the scenario (or a path relative to it), else a standard
+    // board's bare name (`board: arduino-uno`), from whatever folder avrbench runs in.
+    const std::string board_value = scalar(root["board"], path, "board");
+    spec.board_path = resolve(path, board_value);
+    const bool bare_board = board_value.find('/') == std::string::npos && fs::path(board_value).extension() != ".yaml";
     BoardSpec board;
     try {
+        if (bare_board && !fs::is_regular_file(spec.board_path, ec)) spec.board_path = find_board_file(board_value);
         board = load_board_file(spec.board_path);
     } catch (const BadInput& e) {
         // A missing board names the scenario line that points at it.

@@ -1,12 +1,15 @@
 // Running a loaded scenario: its steps on a Bench, then its expectations,
 // then the golden comparison (or update), then the optional HTML report.
 #include <chrono>
+#include <fstream>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 #include "core/FileHash.hpp"
 #include "core/UserStop.hpp"
 #include "trace/HtmlReport.hpp"
@@ -102,7 +105,7 @@ private:
                 }
             }
             const Picoseconds now = bench_.now_ps();
-            if (now >= deadline_ || host.failed() || user_stop_requested()) break;
+            if (now >= deadline_ || host.failed() || user_stop_requested() || bench_.timeline().overflowed()) break;
             if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kSlicePs))) == StopReason::Halted) break;
         }
         return "the firmware sent no line containing '" + s.text + "' by " + seconds_text(deadline_) +
@@ -112,7 +115,7 @@ private:
         Pin& pin = bench_.board().pin(s.pin);
         while (pin.level() != s.level) {
             const Picoseconds now = bench_.now_ps();
-            if (now >= deadline_ || user_stop_requested()) break;
+            if (now >= deadline_ || user_stop_requested() || bench_.timeline().overflowed()) break;
             if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kPinSlicePs))) == StopReason::Halted) break;
         }
         if (pin.level() == s.level) return "";
@@ -223,6 +226,43 @@ TimelineHeader golden_header(const ScenarioSpec& spec, const Mcu& first) {
     return header;
 }
 
+// `golden update` writes only a golden timeline, and only where goldens
+// live: a file named *.timeline inside the scenario's own folder tree, or
+// inside a folder named `golden` beside the scenario's folder or one of its
+// parents (tests/scenarios/x.yaml -> ../../golden/x.timeline); a file that is
+// already there must be a golden timeline. So a scenario, whoever wrote it,
+// can never make `golden update` overwrite another file.
+void check_golden_writable(const ScenarioSpec& spec) {
+    const std::string where = spec.path + ": golden " + escaped(spec.golden_path);
+    const fs::path golden = fs::weakly_canonical(fs::absolute(spec.golden_path));
+    if (golden.extension() != ".timeline") throw BadInput(where + ": golden update writes only files named *.timeline");
+    const fs::path scenario_folder = fs::weakly_canonical(fs::absolute(spec.path)).parent_path();
+    const auto inside = [](const fs::path& file, const fs::path& folder) {
+        const auto [f, d] = std::mismatch(file.begin(), file.end(), folder.begin(), folder.end());
+        return d == folder.end() && f != file.end();
+    };
+    bool allowed = inside(golden, scenario_folder);
+    for (fs::path folder = scenario_folder; !allowed; folder = folder.parent_path()) {
+        allowed = inside(golden, folder / "golden");
+        if (folder == folder.parent_path()) break;
+    }
+    if (!allowed) {
+        throw BadInput(where + ": golden update writes only inside the scenario's folder or a 'golden' folder beside it or "
+                               "one of its parents");
+    }
+    std::error_code ec;
+    if (fs::exists(golden, ec)) {
+        std::string first_line;
+        {
+            std::ifstream in(golden);
+            std::getline(in, first_line);
+        }
+        if (!fs::is_regular_file(golden, ec) || first_line.rfind("avrbench-timeline ", 0) != 0) {
+            throw BadInput(where + ": the file there is not a golden timeline; golden update will not overwrite it");
+        }
+    }
+}
+
 // Compares the run with the golden timeline (or writes it), adding what
 // differs to result.failures; returns the golden for the report.
 std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, const ScenarioRunOptions& options,
@@ -244,7 +284,8 @@ std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, cons
                                   " (create it with: avrbench golden update " + spec.path + ")");
         return std::nullopt;
     }
-    ParsedTimeline golden = read_timeline_text(spec.golden_path);
+    // Read no further than this run went: a golden claiming more costs no more than the run.
+    ParsedTimeline golden = read_timeline_text(spec.golden_path, bench.now_seconds());
     CompareOptions compare;
     compare.rules = spec.tolerances;
     compare.golden_end_cycle = golden.header.end_cycle;
@@ -297,6 +338,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     result.name = spec.name;
     result.path = spec.path;
     const auto wall_start = std::chrono::steady_clock::now();
+    if (options.update_golden && !spec.golden_path.empty()) check_golden_writable(spec);
     Bench bench(spec.board_path, spec.firmware);
     bind(spec, bench);
     if (spec.host_family || spec.host_line_timeout_ps) {
@@ -316,6 +358,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     for (const auto& step : spec.steps) {
         ++index;
         const std::string why = runner.run(step);
+        if (bench.timeline().overflowed()) break;  // ERROR below: the run can no longer be compared whole
         if (!why.empty()) {
             fail("step " + std::to_string(index) + " (" + step.location + ", " + step.kind + "): " + why);
             break;

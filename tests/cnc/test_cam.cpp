@@ -96,7 +96,7 @@ TEST(Cam, CliWritesTheProgramAndSaysWhatItSaved) {
     EXPECT_NE(r.out.find("commands   6 -> 4 (rapids 3 -> 1)"), std::string::npos) << r.out;
     const auto missing = test::run_command(std::string(AVRBENCH_CLI) + " cam " + (dir / "nope.dxf").string(), dir);
     EXPECT_EQ(missing.exit_code, 2);
-    EXPECT_EQ(missing.err, "avrbench: error: " + (dir / "nope.dxf").string() + ": no such file\n");
+    EXPECT_EQ(missing.err, "avrbench: error: DXF drawing: " + (dir / "nope.dxf").string() + ": no such file\n");
 }
 
 }  // namespace

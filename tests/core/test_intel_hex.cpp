@@ -69,7 +69,7 @@ TEST_F(IntelHexFile, NamesTheLineAndTheProblem) {
         read_intel_hex("/nonexistent/boot.hex");
         FAIL();
     } catch (const BadInput& e) {
-        EXPECT_EQ(std::string(e.what()), "/nonexistent/boot.hex: cannot open the Intel HEX file");
+        EXPECT_EQ(std::string(e.what()), "Intel HEX file: /nonexistent/boot.hex: no such file");
     }
 }
 

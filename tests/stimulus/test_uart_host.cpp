@@ -103,7 +103,7 @@ TEST(UartHost, MissingJobFileIsBadInputNamingIt) {
         b.host.load_file("/nonexistent/job.gcode");
         FAIL() << "no exception";
     } catch (const BadInput& e) {
-        EXPECT_STREQ(e.what(), "/nonexistent/job.gcode: no such file");
+        EXPECT_STREQ(e.what(), "G-code file: /nonexistent/job.gcode: no such file");
     }
 }
 

@@ -1,0 +1,537 @@
+#!/usr/bin/python3
+"""Hostile inputs against the avrbench CLI (issue 32's audit, kept as a test).
+
+Generates inputs of every class the audit found wanting - YAML alias cycles
+and expansion bombs, YAML of the wrong shape, FIFOs, devices, folders and
+sparse giants where a file belongs, outputs that name each other or an input,
+names with newlines and escape sequences, malformed golden lines and repeat
+bombs, malformed .mmcu sections, boards of hundreds of MCUs - runs the CLI on
+each (the sanitized build in ci/sanitize) and checks:
+
+  * bad input: exit 2 and exactly one line on stderr, "avrbench: error: ..."
+    (or "usage error"), nothing printed that drives the terminal;
+  * a legal input: the documented exit code;
+  * always: no sanitizer report, at most 5 s of CPU time and 200 MB of
+    memory (peak RSS), and no input or unrelated file modified.
+
+Deterministic: the cases are generated the same way every time; --sample N
+--seed S runs a seeded sample of them. Usage:
+
+  hostile.py --cli build/avrbench --firmware-dir build/firmware --source . --work DIR [--sample N] [--seed S] [--jobs J] [--list]
+"""
+import argparse
+import concurrent.futures
+import hashlib
+import os
+import random
+import resource
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import time
+
+CPU_LIMIT_S = 5.0
+RSS_LIMIT_KB = 200 * 1024
+WALL_GUARD_S = 120.0  # a guard against a hang only; CPU time is the measure
+
+
+class Case:
+    def __init__(self, name, args, expect=2, files=None, fifos=(), sparse=None, dirs=(), check_files=(), cwd=None,
+                 setup=None, says=""):
+        self.name = name
+        self.says = says            # a fragment the error line must hold (so a case fails for the right reason)
+        self.args = args            # argv after the CLI, with {w} for the case's folder
+        self.expect = expect        # exit code (2: bad input, one line on stderr)
+        self.files = files or {}    # relative path -> bytes or str
+        self.fifos = fifos          # relative paths made FIFOs
+        self.sparse = sparse or {}  # relative path -> (prefix bytes, size)
+        self.dirs = dirs
+        self.check_files = check_files  # relative paths that must be left unchanged (added to inputs)
+        self.cwd = cwd              # relative folder to run in ("" = the case folder)
+        self.setup = setup          # callable(folder) for anything else
+
+
+# --- building blocks --------------------------------------------------------
+
+UNO_BOARD = """board: hostile-uno
+description: an UNO for hostile inputs
+mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+serial:
+  host: {mcu: uno, usart: 0, flow: send_and_wait}
+labels:
+  led: uno.PB5
+"""
+
+
+def laughs(depth, width=10):
+    """A YAML "billion laughs": width^depth nodes from a few lines."""
+    lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
+    for i in range(1, depth):
+        lines.append(f"l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * width) + "]")
+    return lines, f"*l{depth - 1}"
+
+
+def board_with(extra_top="", description="plain", mcus=None, parts="", serial=None, labels=None, name="hostile"):
+    mcus = mcus if mcus is not None else "  uno: {type: atmega328p, clock: 16MHz}"
+    serial = serial if serial is not None else "  host: {mcu: uno, usart: 0, flow: send_and_wait}"
+    labels = labels if labels is not None else "  led: uno.PB5"
+    text = extra_top + f"board: {name}\ndescription: {description}\nmcus:\n{mcus}\n"
+    if parts:
+        text += "parts:\n" + parts + "\n"
+    text += f"serial:\n{serial}\nlabels:\n{labels}\n"
+    return text
+
+
+def scenario_with(board="board.yaml", firmware="{uno: fw.elf}", extra="", golden=None, steps="  - delay: 1ms"):
+    text = f"name: hostile\nboard: {board}\nfirmware: {firmware}\ntime_limit: 1s\nsteps:\n{steps}\n" + extra
+    if golden:
+        text += f"golden: {golden}\n"
+    return text
+
+
+def elf_with_mmcu(elf_bytes, payload):
+    """blink_timer1.elf with its .mmcu section's bytes replaced by `payload`
+    (padded to the section's size with a VCD-file tag, which the bench ignores)."""
+    data = bytearray(elf_bytes)
+    e_shoff, = struct.unpack_from("<I", data, 0x20)
+    e_shentsize, e_shnum, e_shstrndx = struct.unpack_from("<HHH", data, 0x2E)
+    def section(i):
+        return struct.unpack_from("<IIIIIIIIII", data, e_shoff + i * e_shentsize)
+    names_offset = section(e_shstrndx)[4]
+    for i in range(e_shnum):
+        sh = section(i)
+        name = data[names_offset + sh[0]:data.index(0, names_offset + sh[0])].decode()
+        if name == ".mmcu":
+            offset, size = sh[4], sh[5]
+            body = bytes(payload)
+            if len(body) > size:
+                raise ValueError("payload larger than .mmcu")
+            rest = size - len(body)
+            if rest == 1:
+                raise ValueError("cannot pad one byte")
+            if rest >= 2:
+                body += bytes([12, rest - 2]) + bytes(rest - 2)  # AVR_MMCU_TAG_VCD_FILENAME
+            data[offset:offset + size] = body
+            return bytes(data)
+    raise ValueError("no .mmcu section")
+
+
+def tag(number, payload):
+    return bytes([number, len(payload)]) + bytes(payload)
+
+
+NAME_TAG = tag(1, b"atmega328p\0")
+
+
+def freq_tag(hz):
+    return tag(2, struct.pack("<I", hz))
+
+
+# --- the cases -------------------------------------------------------------
+
+def cases(fw):
+    """Every hostile input, in a fixed order. `fw` maps firmware names to paths."""
+    out = []
+    blink = fw["blink_timer1"]
+    echo = fw["uart_echo"]
+    run_board = ["run", blink, "--board", "{w}/board.yaml", "--for", "1ms", "-q"]
+
+    # YAML: alias cycles, in board files and scenarios, in sequences and maps.
+    for where, key in (("description", "description"), ("labels", "labels"), ("serial", "serial"), ("top", "extra")):
+        for shape, text in (("seq", "&x [*x]"), ("map", "&x {a: *x}"), ("deep", "&x [[1, [2, *x]]]")):
+            if key == "description":
+                board = board_with(description=text)
+            elif key == "labels":
+                board = board_with(labels=f"  led: {text}")
+            elif key == "serial":
+                board = board_with(serial=f"  host: {text}")
+            else:
+                board = board_with(extra_top=f"x: {text}\n")
+            out.append(Case(f"yaml-cycle-board-{where}-{shape}", run_board, files={"board.yaml": board}, says="(a cycle)"))
+            out.append(Case(f"yaml-cycle-scenario-{where}-{shape}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                            files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
+                                   "s.yaml": scenario_with(extra=f"description: {text}\n" if key != "extra" else "")
+                                   .replace("name: hostile", "name: hostile\nx: " + text if key == "extra" else "name: hostile")},
+                            says="(a cycle)"))
+    # YAML: expansion bombs where the bench walks or converts.
+    for depth in (4, 6, 8, 10):
+        lines, alias = laughs(depth)
+        head = "\n".join(lines) + "\n"
+        bomb = "nodes (aliases of aliases?)" if depth >= 6 else ""
+        out.append(Case(f"yaml-laughs-board-description-{depth}", run_board, files={"board.yaml": head + board_with(description=alias)},
+                        says=bomb))
+        out.append(Case(f"yaml-laughs-board-params-{depth}", run_board,
+                        files={"board.yaml": head + board_with(parts=f"  sw: {{type: limit_switch, bounce: {alias}}}")}))
+        out.append(Case(f"yaml-laughs-board-top-{depth}", run_board, files={"board.yaml": head + board_with(extra_top=f"y: {alias}\n")}))
+        out.append(Case(f"yaml-laughs-scenario-{depth}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                        files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
+                               "s.yaml": head + scenario_with(extra=f"description: {alias}\n")}))
+    # YAML: nesting.
+    for depth in (100, 1000, 20000):
+        out.append(Case(f"yaml-nesting-{depth}", run_board,
+                        files={"board.yaml": board_with(description="[" * depth + "]" * depth)}))
+    # YAML of the wrong shape, section by section.
+    shapes = {"list": "[a, b]", "scalar": "hello", "number": "42", "null": "~", "nested": "{a: {b: [c]}}", "empty-map": "{}"}
+    sections = {"mcus": "\n  uno: {type: atmega328p, clock: 16MHz}", "parts": " {}", "nets": " {}",
+                "serial": "\n  host: {mcu: uno, usart: 0, flow: send_and_wait}", "labels": "\n  led: uno.PB5"}
+    for section in sections:
+        for shape, text in shapes.items():
+            board = "board: hostile\n" + "".join(
+                f"{name}: {text if name == section else value.strip() if value.startswith(' ') else value}\n"
+                for name, value in sections.items())
+            # An empty or null parts, nets, serial or labels section is a board without them.
+            legal = section != "mcus" and shape in ("null", "empty-map")
+            out.append(Case(f"yaml-shape-{section}-{shape}", run_board, expect=0 if legal else 2, files={"board.yaml": board}))
+    for entry, text in (("serial-port-list", "  host: [mcu, uno]"), ("serial-port-scalar", "  host: uno"),
+                        ("serial-port-nested", "  host: {mcu: [uno], usart: 0}")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(serial=text)}))
+    for entry, text in (("mcu-list", "  uno: [atmega328p, 16MHz]"), ("mcu-scalar", "  uno: atmega328p"),
+                        ("mcu-type-list", "  uno: {type: [atmega328p], clock: 16MHz}")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(mcus=text)}))
+    for entry, text in (("part-list", "  sw: [limit_switch]"), ("part-scalar", "  sw: limit_switch"),
+                        ("part-param-map", "  sw: {type: limit_switch, bounce: {a: 1}}")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(parts=text)}))
+    for entry, text in (("steps-map", "steps: {delay: 1ms}"), ("steps-scalar", "steps: delay"),
+                        ("step-list", "steps:\n  - [delay, 1ms]"), ("expect-map", "expect: {findings: 0}"),
+                        ("firmware-list", "firmware: [fw.elf]"), ("tolerances-map", "tolerances: {signals: x}")):
+        scenario = scenario_with().replace("steps:\n  - delay: 1ms\n", "")
+        if entry.startswith("firmware"):
+            scenario = scenario.replace("firmware: {uno: fw.elf}\n", "")
+        out.append(Case(f"yaml-shape-scenario-{entry}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                        files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(), "s.yaml": scenario + text + "\n"}))
+    # Names and identifiers: empty, control characters, escape sequences.
+    for label, name in (("empty", "''"), ("newline", '"a\\nb"'), ("ansi", '"\\e[31mred\\e[0m"'), ("space", '"a b"'),
+                        ("long", "x" * 300), ("unicode", '"\u00e9t\u00e9"')):
+        out.append(Case(f"name-board-{label}", run_board, files={"board.yaml": board_with(name=name)}))
+        out.append(Case(f"name-mcu-type-{label}", run_board,
+                        files={"board.yaml": board_with(mcus=f"  uno: {{type: {name}, clock: 16MHz}}")}))
+        out.append(Case(f"name-part-{label}", run_board,
+                        files={"board.yaml": board_with(parts=f"  {name}: {{type: limit_switch}}")}))
+        out.append(Case(f"name-description-{label}", run_board, expect=0,
+                        files={"board.yaml": board_with(description=name if label not in ("empty",) else "''")}))
+    for label, value in (("newline", "1\nms"), ("ansi", "1\x1b[2Jms"), ("nul-like", "1ms\x7f")):
+        out.append(Case(f"cli-for-{label}", ["run", blink, "--for", value, "-q"]))
+        out.append(Case(f"cli-mcu-{label}", ["run", blink, "--mcu", value, "-q"]))
+        out.append(Case(f"cli-elf-{label}", ["run", "{w}/fw" + value + ".elf", "-q"]))
+        out.append(Case(f"cli-trace-{label}", ["run", blink, "--trace", value, "--for", "1ms", "-q"]))
+    out.append(Case("cli-trace-duplicate", ["run", blink, "--trace", "PB5,PB5,pb5", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"],
+                    expect=0))
+    # Clocks outside 1 Hz .. 64 MHz, in boards.
+    for clock in ("0Hz", "64000001", "2147483648", "4294967295", "1e300Hz", "-16MHz", "nan"):
+        out.append(Case(f"board-clock-{clock}", run_board,
+                        files={"board.yaml": board_with(mcus=f"  uno: {{type: atmega328p, clock: {clock}}}")}))
+    # Too many MCUs.
+    for count in (17, 200):
+        mcus = "\n".join(f"  m{i}: {{type: atmega328p, clock: 16MHz}}" for i in range(count))
+        out.append(Case(f"board-{count}-mcus", run_board,
+                        files={"board.yaml": f"board: many\nmcus:\n{mcus}\n"}, says="a board holds at most 16"))
+    # Physics out of any range.
+    for label, heater, plant in (
+            ("tiny-resistance", "resistance: 1e-300ohm, supply: 12V", "heat_capacity: 16J/K"),
+            ("kilovolt-tiny-block", "resistance: 1ohm, supply: 1000V", "heat_capacity: 0.001J/K"),
+            ("kilovolt-small-block", "resistance: 0.01ohm, supply: 1000V", "heat_capacity: 1J/K")):
+        parts = (f"  plant: {{type: thermal_plant, preset: custom, {plant}, ambient_conductance: 0.1W/K, sensor_time_constant: 1s}}\n"
+                 f"  heat: {{type: heater, preset: custom, {heater}}}")
+        board = board_with(parts=parts).replace("labels:\n", "nets:\n  body: [heat.body, plant.body]\n  gate: [uno.PD6, heat.gate]\nlabels:\n")
+        out.append(Case(f"physics-{label}", run_board, files={"board.yaml": board},
+                        says="is outside 0.001" if label == "tiny-resistance" else "not a physical combination"))
+
+    # Input files that are not regular files, or too large.
+    specials = {"fifo": None, "dev-zero": "/dev/zero", "dev-urandom": "/dev/urandom", "dir": None, "missing": "{w}/nope"}
+    roles = {
+        "board": lambda p: ["run", blink, "--board", p, "--for", "1ms", "-q"],
+        "gcode": lambda p: ["run", echo, "--board", "{w}/board.yaml", "--gcode", p, "--for", "10ms", "-q"],
+        "uart-in-board": lambda p: ["run", echo, "--board", "{w}/board.yaml", "--uart-in", p, "--for", "1ms", "-q"],
+        "uart-in-bare": lambda p: ["run", echo, "--uart-in", p, "--for", "1ms", "-q"],
+        "scenario": lambda p: ["check", p],
+        "elf": lambda p: ["run", p, "--for", "1ms", "-q"],
+        "dxf": lambda p: ["cam", p, "-o", "{w}/out.nc"],
+        "golden": lambda p: ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+        "bootloader": lambda p: ["run", blink, "--board", "{w}/bl.yaml", "--for", "1ms", "-q"],
+    }
+    for role, make_args in roles.items():
+        for kind, path in specials.items():
+            files = {"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read()}
+            fifos, dirs = (), ()
+            target = path
+            says = {"fifo": "is a FIFO", "dev-zero": "character device", "dev-urandom": "character device",
+                    "dir": "folder", "missing": "no such"}[kind]
+            if kind == "fifo":
+                target, fifos = "{w}/special", ("special",)
+            elif kind == "dir":
+                target, dirs = "{w}/special", ("special",)
+            if role == "golden":
+                files["s.yaml"] = scenario_with(golden=target.replace("{w}/", ""))
+            if role == "bootloader":
+                files["bl.yaml"] = board_with(mcus=f"  uno: {{type: atmega328p, clock: 16MHz, bootloader: {target.replace('{w}', '.')}, "
+                                                    "fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}}")
+            # A golden that is not there fails the scenario (exit 1: "create it with golden update").
+            expect = 1 if role == "golden" and kind == "missing" else 2
+            if role in ("elf", "scenario", "dxf") and kind in ("dir",):
+                says = ""  # named by the command's own check first
+            out.append(Case(f"input-{role}-{kind}", make_args(target), expect=expect, files=files, fifos=fifos, dirs=dirs,
+                            says=says if expect == 2 else ""))
+        # A sparse file far over the role's cap (the ELF one is legal: see below).
+        if role not in ("elf",):
+            files = {"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read()}
+            target = "{w}/huge"
+            if role == "golden":
+                files["s.yaml"] = scenario_with(golden="huge")
+            if role == "bootloader":
+                files["bl.yaml"] = board_with(mcus="  uno: {type: atmega328p, clock: 16MHz, bootloader: ./huge, "
+                                                   "fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}}")
+            out.append(Case(f"input-{role}-sparse-2GiB", make_args(target), files=files, sparse={"huge": (b"x", 2 << 30)},
+                            says="is more than a"))
+    # A 2 GiB sparse ELF: blink_timer1.elf followed by zeros - a valid ELF, read
+    # only where its headers point: it runs.
+    out.append(Case("input-elf-sparse-2GiB", ["run", "{w}/huge.elf", "--for", "1ms", "-q"], expect=0,
+                    sparse={"huge.elf": (open(blink, "rb").read(), 2 << 30)}))
+    out.append(Case("input-uart-in-stdin-pipe", ["run", echo, "--uart-in", "-", "--for", "1ms", "-q"], expect=0))
+
+    # Outputs: two outputs on one file, an output on an input, empty names.
+    for label, extra in (
+            ("vcd-is-uart-out", ["--vcd", "{w}/x", "--uart-out", "{w}/x"]),
+            ("report-is-vcd", ["--vcd", "{w}/x.vcd", "--report", "{w}/x.vcd"]),
+            ("vcd-named-gtkw", ["--vcd", "{w}/x.gtkw"]),
+            ("uart-out-on-gtkw", ["--vcd", "{w}/x.vcd", "--uart-out", "{w}/x.gtkw"]),
+            ("uart-out-twice-hardlink", ["--vcd", "{w}/a.vcd", "--uart-out", "{w}/hard"]),
+            ("vcd-empty", ["--vcd", ""]),
+            ("report-empty", ["--report", ""]),
+            ("uart-out-dir", ["--uart-out", "{w}/d"]),
+            ("vcd-on-board", ["--vcd", "{w}/board.yaml"]),
+            ("uart-out-on-elf", ["--uart-out", "{w}/fw.elf"]),
+            ("vcd-on-uart-in", ["--uart-in", "{w}/in.txt", "--vcd", "{w}/in.txt"])):
+        def link(folder):
+            if os.path.exists(os.path.join(folder, "a.gtkw")):
+                return
+            open(os.path.join(folder, "a.gtkw"), "w").write("keep")
+            os.link(os.path.join(folder, "a.gtkw"), os.path.join(folder, "hard"))
+        out.append(Case(f"output-{label}", ["run", "{w}/fw.elf", "--board", "{w}/board.yaml", "--for", "1ms", "-q"] + extra,
+                        files={"board.yaml": UNO_BOARD, "fw.elf": open(echo, "rb").read(), "in.txt": "hello"},
+                        dirs=("d",), check_files=("board.yaml", "fw.elf", "in.txt", "a.gtkw", "hard"),
+                        setup=link if "hardlink" in label else None,
+                        says="an empty value" if "empty" in label else "folder" if "dir" in label else "is also"))
+    out.append(Case("output-pty-link-on-file", ["run", "{w}/fw.elf", "--board", "{w}/board.yaml", "--pty", "host",
+                                                 "--pty-link", "{w}/victim.txt", "--for", "1ms", "-q"],
+                    files={"board.yaml": UNO_BOARD, "fw.elf": open(echo, "rb").read(), "victim.txt": "keep"},
+                    check_files=("victim.txt",), says="not a link to a pseudo-terminal"))
+    dxf = open(os.path.join(ARGS.source, "tests/fixtures/dxf", sorted(os.listdir(os.path.join(ARGS.source, "tests/fixtures/dxf")))[0]), "rb").read()
+    out.append(Case("output-cam-own-input", ["cam", "{w}/plot.nc"], files={"plot.nc": dxf}, check_files=("plot.nc",), says="is also read"))
+    out.append(Case("output-cam-o-input", ["cam", "{w}/d.dxf", "-o", "{w}/d.dxf"], files={"d.dxf": dxf}, check_files=("d.dxf",),
+                    says="is also read"))
+    cnc = fw.get("cnc2axis")
+    if cnc:
+        out.append(Case("output-run-dxf-nc-on-drawing", ["run", cnc, "--board", "cnc2axis-seed002", "--dxf", "{w}/d.dxf",
+                                                         "--nc", "{w}/d.dxf", "-q"], files={"d.dxf": dxf}, check_files=("d.dxf",),
+                        says="is also read"))
+    # golden update writes goldens only, where goldens live.
+    for label, golden, expect in (("outside-txt", "../sentinel/victim.txt", 2), ("outside-timeline", "../sentinel/victim.timeline", 2),
+                                  ("inside-not-golden", "notes.timeline", 2), ("absolute", "/tmp/avrbench-hostile-victim.timeline", 2)):
+        out.append(Case(f"golden-update-{label}", ["golden", "update", "{w}/scen/s.yaml", "--firmware-dir", "{w}/scen"], expect=expect,
+                        files={"scen/board.yaml": UNO_BOARD, "scen/fw.elf": open(blink, "rb").read(),
+                               "scen/s.yaml": scenario_with(golden=golden), "scen/notes.timeline": "my notes\n",
+                               "sentinel/victim.txt": "keep", "sentinel/victim.timeline": "keep"},
+                        check_files=("sentinel/victim.txt", "sentinel/victim.timeline", "scen/notes.timeline"),
+                        says="not a golden timeline" if label == "inside-not-golden" else "golden update writes only"))
+    # The documented `board: <standard name>` from another folder.
+    out.append(Case("scenario-standard-board-elsewhere", ["check", "{w}/scen/s.yaml", "--firmware-dir", "{w}/scen"], expect=0,
+                    files={"scen/fw.elf": open(blink, "rb").read(), "scen/s.yaml": scenario_with(board="arduino-uno")},
+                    cwd="elsewhere", dirs=("elsewhere",)))
+
+    # Golden timelines that are malformed or that claim far more than a run.
+    head = ("avrbench-timeline 1\nbench 0.1.0\nend 16001 16000000\nsignal uno.PB5 wire 1 16000000\n"
+            "signal uno.PB1 wire 1 16000000\nsignal uno.uart0_tx bus 8 16000000\n\n@uno.PB5\n0 0\n")
+    for label, body, expect in (
+            ("two-changes-on-a-line", "+17 0 +15 1\n", 2), ("value-missing", "+17\n", 2), ("junk-after", "+17 1 junk\n", 2),
+            ("repeat-odd", "*3 +5 1 +5\n", 2), ("past-end", "+99999 1\n", 2),
+            ("repeat-bomb-past-end", "*24999990 +1 0 +1 1\n", 2),
+            ("signal-missing-clock", "", 2)):
+        text = head + body
+        if label == "signal-missing-clock":
+            text = text.replace("signal uno.PB1 wire 1 16000000", "signal uno.PB1 wire 1")
+        out.append(Case(f"golden-{label}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"], expect=expect,
+                        files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
+                               "s.yaml": scenario_with(golden="g.timeline"), "g.timeline": text}))
+    # A repeat inside the timeline's end but far past the run: read no further
+    # than the run went, so it fails (exit 1) at once.
+    big_end = head.replace("end 16001 16000000", "end 1000000000000 16000000")
+    out.append(Case("golden-repeat-bomb-past-run", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"], expect=1,
+                    files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
+                           "s.yaml": scenario_with(golden="g.timeline"), "g.timeline": big_end + "*24999990 +1 0 +1 1\n"}))
+
+    # Malformed or out-of-range .mmcu sections.
+    blink_bytes = open(blink, "rb").read()
+    for label, payload, expect in (
+            ("freq-0", NAME_TAG + freq_tag(0), 2), ("freq-64000001", NAME_TAG + freq_tag(64000001), 2),
+            ("freq-2^31", NAME_TAG + freq_tag(1 << 31), 2), ("freq-2^32-1", NAME_TAG + freq_tag((1 << 32) - 1), 2),
+            ("unknown-tag", NAME_TAG + freq_tag(16000000) + tag(18, b"\x0f"), 2),
+            ("command-0xffff", NAME_TAG + freq_tag(16000000) + tag(10, b"\xff\xff"), 2),
+            ("console-0xffff", NAME_TAG + freq_tag(16000000) + tag(11, b"\xff\xff"), 2),
+            ("vcd-trace-40", NAME_TAG + freq_tag(16000000) + tag(14, bytes(40)), 2),
+            ("tag-overruns", NAME_TAG + freq_tag(16000000) + bytes([2, 200, 0]), 2),
+            ("name-unterminated", tag(1, b"atmega328p") + freq_tag(16000000), 2),
+            ("fuse-tags-ignored", NAME_TAG + freq_tag(16000000) + tag(6, b"\xff") + tag(7, b"\xde"), 0),
+            ("vcd-trace-35-ignored", NAME_TAG + freq_tag(16000000) + tag(14, bytes(35)), 0)):
+        try:
+            elf = elf_with_mmcu(blink_bytes, payload)
+        except ValueError:
+            continue
+        out.append(Case(f"mmcu-{label}", ["run", "{w}/m.elf", "--for", "1ms", "-q"], expect=expect, files={"m.elf": elf},
+                        says=".mmcu section" if expect == 2 else ""))
+    # One trailing byte after the last tag: the section is one byte longer
+    # than its tags, which padding cannot express; cut it instead.
+    return out
+
+
+# --- running -----------------------------------------------------------------
+
+def digest(path):
+    try:
+        with open(path, "rb") as f:
+            return hashlib.sha256(f.read(1 << 20)).hexdigest() + str(os.path.getsize(path))
+    except OSError as e:
+        return "missing:" + type(e).__name__
+
+
+def prepare(case, folder):
+    if os.path.exists(folder):
+        shutil.rmtree(folder)
+    os.makedirs(folder)
+    for rel, content in case.files.items():
+        path = os.path.join(folder, rel)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "wb") as f:
+            f.write(content.encode() if isinstance(content, str) else content)
+    for rel in case.dirs:
+        os.makedirs(os.path.join(folder, rel), exist_ok=True)
+    for rel in case.fifos:
+        os.mkfifo(os.path.join(folder, rel))
+    for rel, (prefix, size) in case.sparse.items():
+        with open(os.path.join(folder, rel), "wb") as f:
+            f.write(prefix)
+            f.truncate(size)
+    if case.setup:
+        case.setup(folder)
+
+
+def run(case):
+    folder = os.path.join(ARGS.work, case.name)
+    prepare(case, folder)
+    watched = [os.path.join(folder, p) for p in case.check_files] + [os.path.join(folder, p) for p in case.files]
+    before = {p: digest(p) for p in watched if not any(p.endswith(f) for f in case.fifos)}
+    argv = [ARGS.cli] + [a.replace("{w}", folder) for a in case.args]
+    env = dict(os.environ, AVRBENCH_FIRMWARE_DIR=ARGS.firmware_dir)
+    cwd = os.path.join(folder, case.cwd) if case.cwd else folder
+    with open(os.path.join(folder, ".stdout"), "wb") as out, open(os.path.join(folder, ".stderr"), "wb") as err:
+        started = time.monotonic()
+        def limit():
+            if ARGS.address_space_mb:  # for an unsanitized CLI only: ASan reserves terabytes of address space
+                resource.setrlimit(resource.RLIMIT_AS, (ARGS.address_space_mb << 20, ARGS.address_space_mb << 20))
+        process = subprocess.Popen(argv, stdin=subprocess.PIPE if "-" in case.args else subprocess.DEVNULL, stdout=out,
+                                   stderr=err, cwd=cwd, env=env, start_new_session=True, preexec_fn=limit)
+        if process.stdin:
+            try:
+                process.stdin.write(b"G28\n")
+                process.stdin.close()
+            except BrokenPipeError:
+                pass  # the CLI ended without reading: its exit code tells
+        status = rusage = None
+        while True:
+            pid, status, rusage = os.wait4(process.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() - started > ARGS.wall_guard:
+                os.killpg(process.pid, signal.SIGKILL)
+                pid, status, rusage = os.wait4(process.pid, 0)
+                return case, [f"hang: still running after {ARGS.wall_guard:.0f} s of wall time"]
+            time.sleep(0.01)
+    code = os.waitstatus_to_exitcode(status)
+    stdout = open(os.path.join(folder, ".stdout"), "rb").read().decode("utf-8", "replace")
+    stderr = open(os.path.join(folder, ".stderr"), "rb").read().decode("utf-8", "replace")
+    problems = []
+    cpu = rusage.ru_utime + rusage.ru_stime
+    if cpu > CPU_LIMIT_S:
+        problems.append(f"{cpu:.1f} s of CPU time (limit {CPU_LIMIT_S:.0f} s)")
+    if rusage.ru_maxrss > RSS_LIMIT_KB:
+        problems.append(f"peak RSS {rusage.ru_maxrss // 1024} MB (limit {RSS_LIMIT_KB // 1024} MB)")
+    for marker in ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:", "internal error"):
+        if marker in stderr:
+            problems.append(f"'{marker}' on stderr")
+    if code < 0:
+        problems.append(f"killed by signal {-code}")
+    elif code != case.expect:
+        problems.append(f"exit {code}, expected {case.expect}")
+    if case.expect == 2 and code == 2:
+        lines = stderr.splitlines()
+        if len(lines) != 1 or not (lines[0].startswith("avrbench: error: ") or lines[0].startswith("avrbench: usage error: ")):
+            problems.append(f"stderr is not one 'avrbench: error:' line: {stderr[:300]!r}")
+        elif case.says and case.says not in lines[0]:
+            problems.append(f"the error does not say '{case.says}'")
+    if "\x1b" in stderr or "\x1b" in stdout:
+        problems.append("an escape sequence reached the terminal")
+    for p, d in before.items():
+        if digest(p) != d:
+            problems.append(f"{os.path.relpath(p, folder)} was modified")
+    if os.path.exists("/tmp/avrbench-hostile-victim.timeline"):
+        problems.append("/tmp/avrbench-hostile-victim.timeline was written")
+        os.remove("/tmp/avrbench-hostile-victim.timeline")
+    if problems:
+        problems.append(f"command: {' '.join(argv)!r}; stderr: {stderr[:400]!r}")
+    else:
+        shutil.rmtree(folder, ignore_errors=True)  # passed: no scratch left (sparse files are 2 GiB of nothing)
+    return case, problems
+
+
+def main():
+    global ARGS
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--cli", required=True)
+    parser.add_argument("--firmware-dir", required=True)
+    parser.add_argument("--source", required=True)
+    parser.add_argument("--work", required=True)
+    parser.add_argument("--sample", type=int, default=0, help="run this many cases, a seeded sample (0: all)")
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--list", action="store_true")
+    parser.add_argument("--only", default="", help="run the cases whose name contains this")
+    parser.add_argument("--wall-guard", type=float, default=WALL_GUARD_S, help="seconds before a case counts as a hang")
+    parser.add_argument("--address-space-mb", type=int, default=0,
+                        help="cap each run's address space (protects the machine when trying an old, unsanitized CLI)")
+    ARGS = parser.parse_args()
+    ARGS.work = os.path.abspath(ARGS.work)
+    ARGS.cli = os.path.abspath(ARGS.cli)
+    ARGS.firmware_dir = os.path.abspath(ARGS.firmware_dir)
+    ARGS.source = os.path.abspath(ARGS.source)
+    fw = {}
+    for name in ("blink_timer1", "uart_echo", "cnc2axis"):
+        path = os.path.join(ARGS.firmware_dir, name + ".elf")
+        if os.path.exists(path):
+            fw[name] = path
+    all_cases = cases(fw)
+    names = [c.name for c in all_cases]
+    assert len(names) == len(set(names)), "case names repeat"
+    chosen = [c for c in all_cases if ARGS.only in c.name]
+    if ARGS.sample and ARGS.sample < len(chosen):
+        chosen = random.Random(ARGS.seed).sample(chosen, ARGS.sample)
+    if ARGS.list:
+        for c in chosen:
+            print(c.name, c.expect)
+        return 0
+    os.makedirs(ARGS.work, exist_ok=True)
+    failed = 0
+    with concurrent.futures.ThreadPoolExecutor(max_workers=ARGS.jobs) as pool:
+        for case, problems in pool.map(run, chosen):
+            if problems:
+                failed += 1
+                print(f"FAIL {case.name}: " + "; ".join(problems))
+    print(f"hostile inputs: {len(chosen) - failed} of {len(chosen)} handled as documented "
+          f"(exit codes, one-line errors, no sanitizer report, <= {CPU_LIMIT_S:.0f} s CPU, <= {RSS_LIMIT_KB // 1024} MB, no file modified)")
+    return 1 if failed else 0
+
+
+ARGS = None
+if __name__ == "__main__":
+    sys.exit(main())
