@@ -275,7 +275,8 @@ Cycle Mcu::cycles_from_seconds(double seconds) const {
 bool Mcu::step() {
     if (halted_) return false;
     const std::uint32_t pc_before = avr_->pc;
-    const int state = options_.reference_run_loop ? avr_run(avr_) : SimavrStepper(avr_).step();
+    SimavrStepper stepper(avr_);
+    const int state = options_.reference_run_loop ? stepper.reference_step() : stepper.step();
     ++steps_;
     check_after_step(state, pc_before);
     return !halted_;
@@ -344,7 +345,7 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     while (avr->cycle < target_cycle) {
         if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
         const std::uint32_t pc_before = avr->pc;
-        const int state = __builtin_expect(reference, 0) ? avr_run(avr) : stepper.step();
+        const int state = __builtin_expect(reference, 0) ? stepper.reference_step() : stepper.step();
         ++steps_;
         check(state, pc_before);
         if constexpr (kCover) edges->hit(avr->pc);

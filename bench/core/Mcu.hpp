@@ -37,8 +37,9 @@ struct McuOptions {
     std::string name = "mcu";        // the MCU's name on the board, used in scopes and findings
     std::string mcu_type;            // overrides the ELF's .mmcu section, e.g. "atmega328p"
     std::uint32_t frequency_hz = 0;  // overrides the ELF's .mmcu section
-    // Step through simavr's own avr_run instead of core/SimavrStep (tests
-    // prove the two end in the same state).
+    // Step the way simavr's avr_callback_run_raw does, every cycle timer
+    // processed on every step, with none of Mcu::run_until's fast paths
+    // (SimavrStepper::reference_step; tests prove the two end in the same state).
     bool reference_run_loop = false;
     // Jump over the passes of an idle loop up to the next event
     // (core/IdleLoopSkip.hpp); exact, so on unless a test compares without.

@@ -1,6 +1,7 @@
 // One step of the core, as Debian's simavr 1.6 (1.6+dfsg-3) takes it in
-// avr_callback_run_raw (simavr/sim/sim_avr.c), with one change: the cycle
-// timers are processed only when the first is due. This is the one place in
+// avr_callback_run_raw (simavr/sim/sim_avr.c), with two changes: the cycle
+// timers are processed only when the first is due, and an interrupt is served
+// one instruction after SEI/RETI/OUT SREG, not two (see finish()). This is the one place in
 // the bench that mirrors simavr's run loop; it must follow that function
 // line by line (re-check it when the simavr version changes).
 //
@@ -47,6 +48,22 @@ public:
         return finish(new_pc);
     }
 
+    // The reference step (McuOptions::reference_run_loop): avr_callback_run_raw
+    // line by line - the cycle timers processed on every step - with the
+    // datasheet's interrupt timing of finish(); tests compare the fast loop
+    // with it.
+    int reference_step() {
+        avr_t* const avr = avr_;
+        if (!raw_) {
+            const int state = avr_run(avr);
+            recheck();
+            return state;
+        }
+        avr_flashaddr_t new_pc = avr->pc;
+        if (avr->state == cpu_Running) new_pc = avr_run_one(avr);
+        return finish(new_pc, true);
+    }
+
     // True when the next steps may take the fast path of Mcu::run_until:
     // simavr's raw loop, the core running, no interrupt on its way.
     bool fast_path_open() const {
@@ -55,11 +72,11 @@ public:
 
     // The rest of step() after avr_run_one returned `new_pc`: the cycle
     // timers (only when the first is due), the new PC, sleep, interrupts.
-    __attribute__((always_inline)) int finish(avr_flashaddr_t new_pc) {
+    __attribute__((always_inline)) int finish(avr_flashaddr_t new_pc, bool every_step = false) {
         avr_t* const avr = avr_;
         // avr_cycle_timer_process, or (nothing due) what it would return.
         const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
-        const bool due = first == nullptr || first->when <= avr->cycle;
+        const bool due = every_step || first == nullptr || first->when <= avr->cycle;
         avr_cycle_count_t sleep = 0;
         if (due) {
             sleep = avr_cycle_timer_process(avr);
@@ -79,7 +96,19 @@ public:
             avr->cycle += 1 + sleep;
         }
         if (state == cpu_Running || state == cpu_Sleeping) {
-            if (avr->interrupt_state) avr_service_interrupts(avr);
+            if (avr->interrupt_state) {
+                // The one departure from simavr's loop (a datasheet fix,
+                // fixes/InterruptTiming.cpp item 2): the step that set I (SEI,
+                // RETI, OUT SREG) leaves interrupt_state at -2, which serves
+                // a pending interrupt only after the second instruction
+                // that follows; the datasheet serves it after the first
+                // ("the instruction following SEI will be executed before any
+                // pending interrupts"). At -1 here, an interrupt raised while
+                // that one instruction runs is served right after it - before
+                // the CLI of `sei; nop; cli` (Klipper's irq_wait).
+                if (avr->interrupt_state == -2) avr->interrupt_state = -1;
+                avr_service_interrupts(avr);
+            }
         }
         return avr->state;
     }

@@ -12,7 +12,10 @@
 //     RETI is seen through the vector's "running" IRQ, OUT SREG through an I/O
 //     hook on SREG, SEI through a one-cycle cycle timer that runs only while an
 //     interrupt is pending with I = 0, and an interrupt raised in the very
-//     step that executed SEI through the "pending" IRQ;
+//     step that executed SEI through the "pending" IRQ; and, for an
+//     interrupt raised during the instruction after SEI with nothing pending
+//     at SEI (no hook sees that SEI), core/SimavrStep turns -2 into -1 at the
+//     end of the step that set I, before simavr's service routine;
 //  3. a sleep jump lands one cycle after the event that ends it;
 //  4. a wake-up costs nothing (the datasheet: 4/5 cycles more plus the
 //     start-up time of the sleep mode); SLEEP with a pending interrupt is a

@@ -9,8 +9,12 @@
  * soon as I is one and the current instruction (here the one after SEI) has
  * completed. The "irq_wait" idiom `sei; nop; cli` relies on it.
  *
- * Timer1 in CTC mode at clk/1 with OCR1A = 20 and OCIE1A set raises its
- * compare-match interrupt a fixed number of cycles after TCNT1 is cleared.
+ * Timer1 in Normal mode at clk/1 with OCR1A = 20 and OCIE1A set raises its
+ * compare-match interrupt a fixed number of cycles after TCNT1 is cleared,
+ * once: the next match is 65536 cycles later. (In CTC mode it would match
+ * again every 21 cycles, and the ISR takes 42 cycles from the match to the
+ * store that stops the timer: a second match would be pending when it
+ * returns, and rightly served in the next window.)
  * For each delay k = 0..23 cycles the firmware, with interrupts off, clears
  * TCNT1 and OCF1A, starts the timer, waits k cycles, then runs
  *
@@ -61,7 +65,7 @@ ISR(TIMER1_COMPA_vect)
         TCCR1B = 0;                                                       \
         TCNT1 = 0;                                                        \
         TIFR_T1 = _BV(OCF1A);                                             \
-        TCCR1B = _BV(WGM12) | _BV(CS10);                                  \
+        TCCR1B = _BV(CS10);                                               \
         __builtin_avr_delay_cycles((k) + 1);                              \
         in_window = 1;                                                    \
         __asm__ __volatile__("sei\n\tnop\n\tcli" ::: "memory");          \
