@@ -68,7 +68,7 @@ struct SerialDecl {
     std::string flow = "send_and_wait";  // or character_counting
     unsigned rx_buffer_bytes = 128;
     std::string family = "generic";  // grbl, marlin, teacup, generic (stimulus/UartHost.hpp)
-    double line_timeout_s = 2.0;     // no answer for this long (keep-alives restart it)
+    double line_timeout_s = 0;       // no answer for this long (keep-alives restart it); 0: the family's
     std::string location;
 };
 

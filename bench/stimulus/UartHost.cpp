@@ -170,6 +170,16 @@ const char* to_string(FirmwareFamily family) {
     return "?";
 }
 
+double default_line_timeout_s(FirmwareFamily family) {
+    switch (family) {
+        case FirmwareFamily::Marlin: return 5.0;
+        case FirmwareFamily::Teacup: return 2.5;
+        case FirmwareFamily::Grbl:
+        case FirmwareFamily::Generic: return 2.0;
+    }
+    return 2.0;
+}
+
 FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what) {
     for (FirmwareFamily f : {FirmwareFamily::Generic, FirmwareFamily::Grbl, FirmwareFamily::Marlin, FirmwareFamily::Teacup}) {
         if (text == to_string(f)) return f;
@@ -188,6 +198,21 @@ bool is_welcome(FirmwareFamily family, const std::string& text) {
         case FirmwareFamily::Generic: return false;
     }
     return false;
+}
+
+// A firmware that stopped for good: "!!" (Teacup, Repetier, Marlin 2's host
+// protocol), "fatal:" in any case, Marlin's kill() "Error:Printer halted.
+// kill() called!" (it answers nothing after it).
+bool is_fatal(const std::string& text) {
+    auto starts_ci = [&text](const char* p) {
+        const std::size_t n = std::strlen(p);
+        if (text.size() < n) return false;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (std::tolower(static_cast<unsigned char>(text[i])) != p[i]) return false;
+        }
+        return true;
+    };
+    return starts_ci("!!") || starts_ci("fatal:") || starts_ci("error:printer halted");
 }
 
 // Output that answers no line: reports, messages, keep-alives.
@@ -214,6 +239,7 @@ UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
     if (options_.flow == FlowControl::CharacterCounting && options_.rx_buffer_bytes == 0) {
         throw BadInput("UART host: rx_buffer_bytes must be at least 1 for character counting");
     }
+    if (options_.line_timeout_s == 0) options_.line_timeout_s = default_line_timeout_s(options_.family);
     if (!(options_.line_timeout_s > 0.0)) throw BadInput("UART host: line timeout must be positive");
     if (options_.family != FirmwareFamily::Generic && options_.startup == Startup::Immediately) {
         // A known family: start after its welcome and the boot chatter that follows.
@@ -358,7 +384,14 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     const TranscriptEntry entry{cycle, Direction::Received, text, 0};
     transcript_.push_back(entry);
 
-    // Any output is a sign of life: every timeout starts again.
+    // Any output is a sign of life: every timeout starts again. The longest
+    // pause between two outputs while a line waits is the firmware's
+    // keep-alive period: the line timeout stays 2.5 times above it.
+    if (!outstanding_.empty() && last_output_cycle_ != 0 && cycle > last_output_cycle_) {
+        const double pause_s = static_cast<double>(cycle - last_output_cycle_) / mcu_.frequency_hz();
+        keepalive_pause_s_ = std::max(keepalive_pause_s_, pause_s);
+    }
+    last_output_cycle_ = cycle;
     if (!failed_ && !outstanding_.empty()) arm_line_timeout();
 
     const FirmwareFamily family = options_.family;
@@ -389,6 +422,11 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     } else if (starts_with(text, "ok")) {
         ++oks_;
         acknowledge();
+    } else if (is_fatal(text)) {
+        ++fatals_;
+        HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
+        e.message = "firmware fatal error '" + text + "'" + after_line(e);
+        stop_or_record(options_.stop_on_fatal, std::move(e));
     } else if (starts_with(text, "error") || starts_with(text, "Error")) {
         ++errors_;
         HostEvent e = event_at_oldest_line(HostEventKind::Error, cycle, text);
@@ -401,11 +439,6 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         HostEvent e = event_at_oldest_line(HostEventKind::Alarm, cycle, text);
         e.message = "firmware alarm '" + text + "'" + after_line(e);
         stop_or_record(options_.stop_on_alarm, std::move(e));
-    } else if (starts_with(text, "!!")) {
-        ++fatals_;
-        HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
-        e.message = "firmware fatal error '" + text + "'" + after_line(e);
-        stop_or_record(options_.stop_on_fatal, std::move(e));
     }
     // Anything else (echo:, [MSG:...], banners, reports) is transcript only.
 
@@ -505,7 +538,12 @@ void UartHost::send_line(std::size_t index) {
     if (outstanding_bytes_ > max_outstanding_bytes_) max_outstanding_bytes_ = outstanding_bytes_;
     transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
     uart_.send(line.text + "\n");
-    if (was_idle) arm_line_timeout();  // after queueing: the timeout counts from the line's last byte
+    if (was_idle) {
+        // The pause a keep-alive ends is counted from the later of the last
+        // output and this line: the silence the line timeout measures.
+        last_output_cycle_ = mcu_.cycle();
+        arm_line_timeout();  // after queueing: the timeout counts from the line's last byte
+    }
     if (was_idle && options_.family == FirmwareFamily::Grbl && options_.grbl_status_poll_s > 0) {
         poll_status(++poll_generation_);
     }
@@ -559,10 +597,16 @@ void UartHost::resend(Cycle cycle, const std::string& text) {
     resend_on_next_ok_ = true;
 }
 
+double UartHost::line_timeout_s() const {
+    constexpr double kKeepaliveMargin = 2.5;  // as default_line_timeout_s
+    return std::max(options_.line_timeout_s, kKeepaliveMargin * keepalive_pause_s_);
+}
+
 // The timeout for the oldest unanswered line: longer for commands that take
 // long by design.
 double UartHost::timeout_for_oldest_s() const {
-    if (outstanding_.empty()) return options_.line_timeout_s;
+    const double line_timeout = line_timeout_s();
+    if (outstanding_.empty()) return line_timeout;
     const GcodeLine& line = lines_[outstanding_.front().index];
     std::string upper;
     for (char c : line.text) upper.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
@@ -586,12 +630,12 @@ double UartHost::timeout_for_oldest_s() const {
         if (p != std::string::npos) dwell_s = std::strtod(upper.c_str() + p + 1, nullptr) * p_unit_s;
         else if (sec != std::string::npos) dwell_s = std::strtod(upper.c_str() + sec + 1, nullptr);
         if (!std::isfinite(dwell_s) || dwell_s < 0) dwell_s = 0;
-        return std::max(options_.long_command_timeout_s, std::min(dwell_s, 1e6) + options_.line_timeout_s);
+        return std::max(options_.long_command_timeout_s, std::min(dwell_s, 1e6) + line_timeout);
     }
     for (const char* long_one : {"M109", "M190", "M116", "G28", "G29", "$H"}) {
-        if (has_word(long_one)) return std::max(options_.long_command_timeout_s, options_.line_timeout_s);
+        if (has_word(long_one)) return std::max(options_.long_command_timeout_s, line_timeout);
     }
-    return options_.line_timeout_s;
+    return line_timeout;
 }
 
 // While lines are unanswered, a '?' every grbl_status_poll_s: the report it

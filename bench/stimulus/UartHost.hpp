@@ -67,6 +67,15 @@ const char* to_string(FirmwareFamily family);
 // "generic", "grbl", "marlin", "teacup"; BadInput naming `what` otherwise.
 FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what);
 
+// A family's line timeout: 2.5 times the longest keep-alive period its
+// firmware documents, so a keep-alive arriving on time never races it.
+//   marlin  5 s: busy: every DEFAULT_KEEPALIVE_INTERVAL = 2 s
+//           (HOST_KEEPALIVE_FEATURE, Marlin's Configuration_adv.h)
+//   teacup  2.5 s: "Waiting for target temp" every second while M116 waits
+//   grbl    2 s: the host's own '?' every 250 ms brings a report (assumed)
+//   generic 2 s (assumed: no keep-alives known)
+double default_line_timeout_s(FirmwareFamily family);
+
 struct UartHostOptions {
     FlowControl flow = FlowControl::SendAndWait;
     FirmwareFamily family = FirmwareFamily::Generic;
@@ -87,9 +96,12 @@ struct UartHostOptions {
     // Character counting: the firmware's receive buffer. 128 = grbl 1.1's
     // RX_BUFFER_SIZE on the ATmega328P (grbl/serial.h).
     std::size_t rx_buffer_bytes = 128;
-    // No answer for this long (simulated) while a line is unanswered: stop
-    // and record a timeout. Assumed: 2 s, far longer than any short move.
-    double line_timeout_s = 2.0;
+    // No answer and no other output for this long (simulated) while a line
+    // is unanswered: stop and record a timeout. 0: the family's
+    // (default_line_timeout_s). It is never shorter than 2.5 times the
+    // longest pause between outputs seen while a line was unanswered: the
+    // firmware's keep-alive period, learned from the run.
+    double line_timeout_s = 0;
     Startup startup = Startup::Immediately;
     std::string banner_contains;     // WaitForBanner: empty = the first line, whatever it says
     double banner_timeout_s = 2.0;   // WaitForBanner: give up (failed) after this long
@@ -99,7 +111,10 @@ struct UartHostOptions {
     bool error_acknowledges = true;
     bool stop_on_error = false;  // stop streaming (failed) at the first error
     bool stop_on_alarm = true;   // grbl ALARM:N stops streaming (failed)
-    bool stop_on_fatal = true;   // Marlin/Teacup "!!" stops streaming (failed)
+    // A fatal message stops streaming (failed): "!!" (Teacup, Repetier,
+    // Marlin 2 with its host protocol), "fatal:", and Marlin's kill()
+    // "Error:Printer halted. kill() called!".
+    bool stop_on_fatal = true;
     // Binary protocols: no line parsing of the firmware's output; use
     // send_bytes() and received(). Lines cannot be queued in this mode.
     bool raw_bytes = false;
@@ -142,7 +157,7 @@ struct TranscriptEntry {
 enum class HostEventKind {
     Error,          // "error..." / "Error..." answer
     Alarm,          // "ALARM..." (grbl)
-    Fatal,          // "!!..." (Marlin, Teacup)
+    Fatal,          // "!!...", "fatal:...", "Error:Printer halted..."
     Timeout,        // a line got no answer within line_timeout_s
     BannerTimeout,  // WaitForBanner: no banner within banner_timeout_s
     LineTooLong,    // character counting: a line longer than the receive buffer can never be sent
@@ -241,6 +256,10 @@ public:
     // lockstep, run the lockstep and poll finished() instead.
     bool run_until_finished(double max_seconds);
 
+    // The line timeout in force: the configured (or the family's), raised to
+    // 2.5 times the keep-alive period seen so far.
+    double line_timeout_s() const;
+
 private:
     // An event about the oldest unanswered line (if any), with the firmware's answer.
     HostEvent event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const;
@@ -254,6 +273,8 @@ private:
     void arm_quiet_timer();
     void resend(Cycle cycle, const std::string& text);
     double timeout_for_oldest_s() const;
+    Cycle last_output_cycle_ = 0;     // the last line the firmware printed
+    double keepalive_pause_s_ = 0;    // the longest pause between outputs while a line waited
     std::uint64_t quiet_generation_ = 0;
     std::size_t resends_ = 0;
     bool resend_on_next_ok_ = false;

@@ -375,8 +375,10 @@ BoardRun prepare_board_run(const RunArgs& args) {
         UartHostOptions o = default_host_options(decl);
         if (!args.flow.empty()) o.flow = parse_flow_control(args.flow, "--flow");
         if (!args.family.empty()) o.family = parse_firmware_family(args.family, "--family");
-        if (!args.line_timeout.empty()) o.line_timeout_s = seconds_from_ps(parse_duration_ps(args.line_timeout, "--line-timeout"));
-        if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
+        if (!args.line_timeout.empty()) {
+            o.line_timeout_s = seconds_from_ps(parse_duration_ps(args.line_timeout, "--line-timeout"));
+            if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
+        }
         if (args.wait_banner) o.startup = Startup::WaitForBanner;
         run.host = &bench.host(decl.name, o);
         if (args.gcode_bytes) {
@@ -881,7 +883,7 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--family", run.family,
                         "grbl | marlin | teacup | generic: the firmware's protocol on the --host port (default: the board's)");
     run_cmd->add_option("--line-timeout", run.line_timeout,
-                        "a line unanswered this long with no output at all is a timeout (default: the board's, 2s)");
+                        "a line unanswered this long with no output at all is a timeout (default: the board's, else the family's: marlin 5s, teacup 2.5s, grbl and generic 2s; never under 2.5 times the keep-alive period seen)");
     run_cmd->add_option("--realtime", run.realtime,
                         "TIME=BYTES sent at that simulated time outside the line stream, e.g. 2s=! 4s=~ (grbl "
                         "feed hold/resume), 1s=^X, 3s=0x85 (repeatable; needs --gcode)");

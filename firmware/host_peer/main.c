@@ -19,6 +19,12 @@
  *   "echo:busy: processing" every second for 5 s, then "ok"; a line
  *   containing "*99" (a bad checksum) gets "Error:checksum mismatch, Last
  *   Line: 0", "Resend: 1", "ok" the first time and "ok" when sent again.
+ *   "G4 P<ms>" is answered "ok" when it is read (Marlin queues it) and then
+ *   dwells that long, printing "busy: processing" every 2000 ms
+ *   (HOST_KEEPALIVE_FEATURE, DEFAULT_KEEPALIVE_INTERVAL 2 in Marlin's
+ *   Configuration_adv.h): the next line waits unanswered in the meantime.
+ *   "KILL" prints "Error:Printer halted. kill() called!" and "FATAL" prints
+ *   "fatal:Homing failed!" - then either halts for good, answering nothing.
  * Teacup: "start" and a boot "ok"; each line "ok"; "M116" waits 5 s in
  *   silence, then "ok".
  */
@@ -146,6 +152,24 @@ int main(void)
             for (uint8_t s = 0; s < 5; ++s) {
                 _delay_ms(1000);
                 SAY("echo:busy: processing");
+            }
+        } else if (strncmp_P(line, PSTR("G4 P"), 4) == 0) {
+            SAY("ok");
+            long left_ms = atol(line + 4);
+            while (left_ms > 0) {
+                const long slice = left_ms < 2000 ? left_ms : 2000;
+                for (long ms = 0; ms < slice; ++ms) _delay_ms(1);
+                left_ms -= slice;
+                if (left_ms > 0) SAY("busy: processing");
+            }
+            continue;
+        } else if (strcmp_P(line, PSTR("KILL")) == 0 || strcmp_P(line, PSTR("FATAL")) == 0) {
+            if (line[0] == 'K') {
+                SAY("Error:Printer halted. kill() called!");
+            } else {
+                SAY("fatal:Homing failed!");
+            }
+            for (;;) {
             }
         } else if (strstr_P(line, PSTR("*99")) != 0 && !checksum_failed) {
             checksum_failed = 1;

@@ -81,6 +81,22 @@ TEST(CliRun, AHostGivesUpOnALineTheFirmwareRejectsEveryTime) {
     EXPECT_LE(resent, 6u) << r.out;  // the transcript tail shows at most the first send and 5 resends
 }
 
+// A firmware that halts with "fatal:" (a homing failure) ends the job with
+// exit 1 and one line naming the job's line, instead of "3 of 3
+// acknowledged" and exit 0 (firmware/host_peer, the Marlin family's peer).
+TEST(CliRun, AFatalMessageEndsTheJobWithExitCode1) {
+    const auto dir = test::scratch_dir("cli-fatal");
+    const auto job = dir / "job.gcode";
+    std::ofstream(job) << "G1 X1\nFATAL\nG1 X2\n";
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("host_peer_marlin")) +
+                                         " --board arduino-uno --family marlin --gcode " + quoted(job.string()) + " --for 20s",
+                                     dir);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("firmware fatal error 'fatal:Homing failed!' after line 2 'FATAL'"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("1 of 3 lines acknowledged"), std::string::npos) << r.out;
+}
+
 TEST(CliRun, UartInAndOut) {
     const auto dir = test::scratch_dir("cli-uart");
     const auto out = dir / "out.txt";

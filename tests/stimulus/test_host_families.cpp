@@ -164,6 +164,56 @@ TEST(HostFamilies, MarlinSlowBootKeepAlivesAndResend) {
     EXPECT_GT(p.first_sent(), p.received("start"));
 }
 
+// Marlin answers a G4 when it queues it and, while the dwell runs, says
+// "busy: processing" every 2000 ms (HOST_KEEPALIVE_FEATURE,
+// DEFAULT_KEEPALIVE_INTERVAL 2): the M105 behind it waits the whole dwell.
+// With a 2 s line timeout the first keep-alive would race it; the family's
+// default is 2.5 times the interval, 5 s.
+TEST(HostFamilies, MarlinKeepAlivesEveryTwoSecondsNeverRaceTheDefaultTimeout) {
+    Peer p("host_peer_marlin", FirmwareFamily::Marlin);
+    EXPECT_DOUBLE_EQ(p.host.line_timeout_s(), 5.0);
+    p.host.add_lines("G4 P60000\nM105\n");
+    ASSERT_TRUE(p.host.run_until_finished(80.0)) << p.host.failure_message() << p.host.tail(12);
+    EXPECT_EQ(p.host.lines_acknowledged(), 2u);
+    EXPECT_TRUE(p.host.events().empty());
+}
+
+// A timeout given shorter than that (3 s) still holds, and once a pause
+// between outputs has been seen it is never under 2.5 times that pause: 2 s
+// between keep-alives (plus the 17 bytes of "busy: processing\r\n" at
+// 115200 baud, U2X: 1.36 ms... at most a few ms) makes it 5 s and a bit.
+TEST(HostFamilies, TheLineTimeoutFollowsTheKeepAlivesSeen) {
+    UartHostOptions o = Peer::options(FirmwareFamily::Marlin, FlowControl::SendAndWait);
+    o.line_timeout_s = 3.0;
+    Mcu mcu(ElfImage::load(test::firmware("host_peer_marlin")));
+    UartHost host(mcu, 0, o);
+    EXPECT_DOUBLE_EQ(host.line_timeout_s(), 3.0);
+    host.add_lines("G4 P7000\nM105\n");
+    ASSERT_TRUE(host.run_until_finished(30.0)) << host.failure_message() << host.tail(12);
+    EXPECT_EQ(host.lines_acknowledged(), 2u);
+    EXPECT_GE(host.line_timeout_s(), 5.0);
+    EXPECT_LT(host.line_timeout_s(), 5.05);
+}
+
+// A firmware that halts with a fatal message ends the job at once, naming
+// the line: Marlin's kill() and the "fatal:" of a homing failure.
+TEST(HostFamilies, FatalMessagesEndTheJobNamingTheLine) {
+    for (const char* line : {"FATAL", "KILL"}) {
+        Peer p("host_peer_marlin", FirmwareFamily::Marlin);
+        p.host.add_lines(std::string("G1 X1\n") + line + "\nG1 X2\n");
+        p.host.run_until_finished(20.0);
+        ASSERT_TRUE(p.host.failed()) << line;
+        ASSERT_EQ(p.host.events().size(), 1u) << line;
+        const HostEvent& e = p.host.events().front();
+        EXPECT_EQ(e.kind, HostEventKind::Fatal) << line;
+        ASSERT_TRUE(e.line.has_value()) << line;
+        EXPECT_EQ(e.line->number, 2u) << line;
+        EXPECT_EQ(p.host.lines_acknowledged(), 1u) << line;
+        EXPECT_NE(p.host.failure_message().find(std::string("after line 2 '") + line + "'"), std::string::npos)
+            << p.host.failure_message();
+    }
+}
+
 TEST(HostFamilies, TeacupBootOkAndSilentM116) {
     // Teacup's boot "ok" answers nothing; M116 waits 5 s without output (a
     // long command: no timeout).
