@@ -14,8 +14,6 @@
 namespace avrbench {
 namespace {
 
-constexpr double kHz = 16e6;
-
 struct Change {
     Cycle cycle;
     double value;

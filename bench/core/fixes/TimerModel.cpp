@@ -1267,7 +1267,7 @@ private:
 class PrescalerResets {
 public:
     PrescalerResets(avr_t* avr, Family family, std::vector<TimerModel*> timers, Prescaler& sync, Prescaler& async)
-        : avr_(avr), family_(family), timers_(std::move(timers)), sync_(&sync), async_(&async) {
+        : family_(family), timers_(std::move(timers)), sync_(&sync), async_(&async) {
         const avr_io_addr_t reg = family == Family::Modern ? 0x43 : 0x50;  // GTCCR / SFIOR
         hook_ = std::make_unique<IoWriteHook>(avr, reg, &on_write, this);
     }
@@ -1297,7 +1297,6 @@ private:
         for (TimerModel* t : self->timers_) t->reschedule();
     }
 
-    avr_t* avr_;
     Family family_;
     std::vector<TimerModel*> timers_;
     Prescaler* sync_;
