@@ -62,7 +62,7 @@ struct ComparisonView {
     std::string summary;               // one paragraph, plain text
     struct ChannelRow {
         std::string signal;
-        std::string verdict;   // "ok", "timing", "missing", "extra", ...
+        std::string verdict;   // "ok", "timing", "missing", "new", ...
         std::string detail;
     };
     std::vector<ChannelRow> channels;

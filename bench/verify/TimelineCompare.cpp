@@ -387,9 +387,12 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
         ChannelResult r;
         r.signal = name;
         r.rule = rule.kind;
-        r.passed = false;
-        r.verdict = "extra";
-        r.detail = "recorded now but not in the golden timeline";
+        // A golden checks the channels it holds. One recorded now that it does
+        // not hold (a net added to the board, a signal a newer bench records)
+        // cannot contradict it: noted, not failed; `golden update` adds it.
+        r.passed = true;
+        r.verdict = "new";
+        r.detail = "recorded now, not in the golden timeline (avrbench golden update adds it)";
         const auto& a = actual_changes[id];
         r.actual_changes = a.size();
         r.clock_hz = actual.signals()[id].clock_hz;
@@ -408,9 +411,20 @@ std::string CompareResult::report() const {
     std::size_t failing = 0;
     for (const auto& c : channels) failing += c.passed ? 0 : 1;
     char buf[512];
+    std::vector<std::string> fresh;
+    for (const auto& c : channels) {
+        if (c.verdict == "new") fresh.push_back(c.signal);
+    }
+    std::string fresh_note;
+    if (!fresh.empty()) {
+        fresh_note = std::to_string(fresh.size()) + " channel" + (fresh.size() == 1 ? "" : "s") +
+                     " recorded now and not in the golden (not checked; avrbench golden update adds them):";
+        for (const auto& name : fresh) fresh_note += " " + name;
+        fresh_note += "\n";
+    }
     if (passed) {
-        std::snprintf(buf, sizeof buf, "PASS: all %zu channels match the golden timeline\n", channels.size());
-        return buf;
+        std::snprintf(buf, sizeof buf, "PASS: all %zu channels the golden holds match it\n", channels.size() - fresh.size());
+        return buf + fresh_note;
     }
     std::snprintf(buf, sizeof buf, "FAIL: %zu of %zu channels differ from the golden timeline\n", failing, channels.size());
     out += buf;
@@ -448,10 +462,11 @@ std::string CompareResult::report() const {
         out += buf;
         if (!c->expected.empty() || !c->actual.empty()) out += "    expected " + c->expected + "; actual " + c->actual + "\n";
     }
-    std::snprintf(buf, sizeof buf, "%zu other channel%s match%s\n", channels.size() - failing,
-                  channels.size() - failing == 1 ? "" : "s", channels.size() - failing == 1 ? "es" : "");
+    const std::size_t matching = channels.size() - failing - fresh.size();
+    std::snprintf(buf, sizeof buf, "%zu other channel%s match%s\n", matching, matching == 1 ? "" : "s",
+                  matching == 1 ? "es" : "");
     out += buf;
-    return out;
+    return out + fresh_note;
 }
 
 }  // namespace avrbench

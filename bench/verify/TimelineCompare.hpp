@@ -47,7 +47,7 @@ struct ChannelResult {
     std::string signal;
     RuleKind rule = RuleKind::Exact;
     bool passed = true;
-    std::string verdict;  // "ok", "differs", "missing", "extra"
+    std::string verdict;  // "ok", "differs", "missing", "new" (not in the golden: not checked)
     std::string detail;   // one line
     std::size_t golden_changes = 0;
     std::size_t actual_changes = 0;

@@ -126,7 +126,8 @@ void append_comparison(std::string& out, const Context& ctx) {
         out += "<table id=\"comparison-channels\"><thead><tr><th>signal</th><th>verdict</th><th>detail</th></tr></thead>"
                "<tbody>\n";
         for (const auto& row : cmp.channels) {
-            const bool ok = row.verdict == "ok";
+            // "new": recorded now, not in the golden, not checked.
+            const bool ok = row.verdict == "ok" || row.verdict == "new";
             out += std::string("<tr class=\"") + (ok ? "ok" : "diverged") + "\"><td class=\"mono\">" + esc(row.signal) +
                    "</td><td class=\"verdict\">" + esc(row.verdict) + "</td><td>";
             append_escaped(out, row.detail, 1000);
@@ -139,7 +140,7 @@ void append_comparison(std::string& out, const Context& ctx) {
     std::vector<std::string> names;
     if (!cmp.first_divergence_signal.empty()) names.push_back(cmp.first_divergence_signal);
     for (const auto& row : cmp.channels)
-        if (row.verdict != "ok" && std::find(names.begin(), names.end(), row.signal) == names.end())
+        if (row.verdict != "ok" && row.verdict != "new" && std::find(names.begin(), names.end(), row.signal) == names.end())
             names.push_back(row.signal);
     std::size_t drawn = 0;
     for (const std::string& name : names) {
