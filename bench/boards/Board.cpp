@@ -1,5 +1,7 @@
 #include "boards/Board.hpp"
 
+#include "core/McuPins.hpp"
+
 #include <cmath>
 #include <set>
 
@@ -398,6 +400,12 @@ McuPinTerminal& Board::add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net) {
     if (!watch) watch = std::make_unique<McuPortWatch>(mcu);
     watch->add(terminal);
     if (periodic_waves_) terminal.register_as_sink();
+    // A USART's RxDn on a net hears the frames the net carries.
+    for (int index = 0; const auto pins = usart_pins(mcu.mcu_type(), index); ++index) {
+        if (pin.name() == std::string("P") + pins->rx_port + static_cast<char>('0' + pins->rx_bit)) {
+            mcu.uart(index).listen_to_rx_line();
+        }
+    }
     return terminal;
 }
 

@@ -425,6 +425,17 @@ void Mcu::after_reset() {
     for (auto& fn : reset_listeners_) fn();
 }
 
+int Mcu::on_pin_direction_change(std::function<void()> fn) {
+    CompareOutputPins* overrides = CompareOutputPins::of(avr_);
+    return overrides != nullptr ? overrides->on_direction_change(std::move(fn)) : -1;
+}
+
+void Mcu::remove_pin_direction_listener(int id) {
+    if (CompareOutputPins* overrides = CompareOutputPins::of(avr_); overrides != nullptr && id >= 0) {
+        overrides->remove_direction_listener(id);
+    }
+}
+
 void Mcu::reset_external() {
     if (in_run_) throw std::logic_error("Mcu::reset_external during a run");
     if (halted_) {
@@ -577,7 +588,11 @@ Uart& Mcu::uart(int index) {
     auto& slot = uarts_[index];
     if (!slot) {
         try {
-            slot = std::make_unique<Uart>(avr_, *scheduler_, index);
+            Pin* rx_pin = nullptr;
+            if (const auto pins = usart_pins(mcu_type_, index)) {
+                rx_pin = &pin(std::string("P") + pins->rx_port + static_cast<char>('0' + pins->rx_bit));
+            }
+            slot = std::make_unique<Uart>(avr_, *scheduler_, index, rx_pin);
         } catch (...) {
             uarts_.erase(index);
             throw;

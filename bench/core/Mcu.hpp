@@ -185,6 +185,11 @@ public:
     // Called after each reset (watchdog, jump to the reset vector), once the
     // I/O registers hold their reset values.
     void on_reset(std::function<void()> fn) { reset_listeners_.push_back(std::move(fn)); }
+    // Called when a peripheral takes a pin as an output or lets it go without
+    // a DDRx write (a USART's TxDn follows TXEN): Pin::is_output changed.
+    // Returns an id for remove_pin_direction_listener (-1: nothing to hear).
+    int on_pin_direction_change(std::function<void()> fn);
+    void remove_pin_direction_listener(int id);
 
     // Value of a RAM variable by its ELF symbol (for tests and reports).
     std::uint8_t read_ram_u8(const std::string& symbol) const;

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <vector>
 
 namespace avrbench {
 namespace {
@@ -36,6 +37,26 @@ bool mcu_has_pin(const std::string& mcu_type, char port, int bit) {
     if (it == pinouts().end()) return true;
     auto p = it->second.find(port);
     return p != it->second.end() && (p->second & (1u << bit)) != 0;
+}
+
+std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index) {
+    static const std::map<std::string, std::vector<UsartPins>> table = [] {
+        const std::vector<UsartPins> mega48_328 = {{'D', 1, 'D', 0}};
+        const std::vector<UsartPins> mega2560 = {{'E', 1, 'E', 0}, {'D', 3, 'D', 2}, {'H', 1, 'H', 0}, {'J', 1, 'J', 0}};
+        const std::vector<UsartPins> mega16_32 = {{'D', 1, 'D', 0}};
+        const std::vector<UsartPins> mega164_1284 = {{'D', 1, 'D', 0}, {'D', 3, 'D', 2}};
+        return std::map<std::string, std::vector<UsartPins>>{
+            {"atmega48", mega48_328},    {"atmega88", mega48_328},  {"atmega168", mega48_328},
+            {"atmega168p", mega48_328},  {"atmega328", mega48_328}, {"atmega328p", mega48_328},
+            {"atmega1280", mega2560},    {"atmega2560", mega2560},
+            {"atmega16", mega16_32},     {"atmega32", mega16_32},
+            {"atmega164", mega164_1284}, {"atmega324", mega164_1284}, {"atmega644", mega164_1284},
+            {"atmega1284", mega164_1284},
+        };
+    }();
+    auto it = table.find(mcu_type);
+    if (it == table.end() || index < 0 || static_cast<std::size_t>(index) >= it->second.size()) return std::nullopt;
+    return it->second[static_cast<std::size_t>(index)];
 }
 
 }  // namespace avrbench

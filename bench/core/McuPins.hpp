@@ -2,6 +2,7 @@
 // without this table PD9 would be caught but PC7 on an ATmega328P would not.
 #pragma once
 
+#include <optional>
 #include <string>
 
 namespace avrbench {
@@ -12,5 +13,18 @@ bool mcu_has_pin(const std::string& mcu_type, char port, int bit);
 
 // True when the table knows the MCU type's pin-out.
 bool mcu_pinout_known(const std::string& mcu_type);
+
+// The pins of USART `index`: TxDn and RxDn (each port letter and bit).
+struct UsartPins {
+    char tx_port;
+    int tx_bit;
+    char rx_port;
+    int rx_bit;
+};
+// From the datasheets' alternate port functions (ATmega328P Table 14-9: PD1
+// TXD, PD0 RXD; ATmega2560 §13.3: USART0 PE1/PE0, USART1 PD3/PD2, USART2
+// PH1/PH0, USART3 PJ1/PJ0; ATmega32/644/1284: PD1/PD0, USART1 PD3/PD2).
+// std::nullopt for a USART or MCU type the table does not know.
+std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index);
 
 }  // namespace avrbench

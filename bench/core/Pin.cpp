@@ -12,7 +12,8 @@ extern "C" {
 namespace avrbench {
 
 Pin::Pin(avr_t* avr, std::string name, avr_irq_t* irq, avr_ioport_t* port, int bit)
-    : avr_(avr), name_(std::move(name)), irq_(irq), port_(port), mask_(static_cast<std::uint8_t>(1u << bit)) {
+    : avr_(avr), name_(std::move(name)), irq_(irq), port_(port), mask_(static_cast<std::uint8_t>(1u << bit)), bit_(bit),
+      overrides_(CompareOutputPins::of(avr)) {
     const PartFacts facts = part_facts(avr);
     pud_register_ = facts.pud_register;
     pud_mask_ = facts.pud_mask;
@@ -44,7 +45,9 @@ bool Pin::internal_pull_up() const {
     return !is_output() && (avr_->data[port_->r_port] & mask_) != 0 && !pull_ups_disabled;
 }
 
-bool Pin::is_output() const { return (avr_->data[port_->r_ddr] & mask_) != 0; }
+bool Pin::is_output() const {
+    return (avr_->data[port_->r_ddr] & mask_) != 0 || (overrides_ != nullptr && overrides_->forces_output(port_, bit_));
+}
 
 void Pin::on_change(Listener fn) {
     // A wave on this pin (core/PeriodicOutput.hpp) was accepted for the

@@ -14,6 +14,8 @@ struct avr_ioport_t;
 
 namespace avrbench {
 
+class CompareOutputPins;
+
 class Pin {
 public:
     using Listener = std::function<void(Cycle cycle, bool level)>;
@@ -39,7 +41,8 @@ public:
     // The firmware has the pin as an input with PORTxn = 1 and pull-ups
     // enabled (PUD = 0).
     bool internal_pull_up() const;
-    // The firmware has the pin as an output (DDxn = 1).
+    // The pin drives its level: the firmware has it as an output (DDxn = 1),
+    // or a peripheral forces it out (TxDn while TXEN is set).
     bool is_output() const;
     void on_change(Listener fn);
     std::size_t listener_count() const { return listeners_.size(); }
@@ -59,6 +62,8 @@ private:
     avr_irq_t* irq_;
     avr_ioport_t* port_;
     std::uint8_t mask_;
+    int bit_;
+    const CompareOutputPins* overrides_ = nullptr;  // who may force the pin out
     unsigned short pud_register_ = 0;  // 0: the part has no PUD bit the bench knows
     std::uint8_t pud_mask_ = 0;
     std::vector<Listener> listeners_;

@@ -7,7 +7,7 @@ namespace avrbench {
 SimavrFixes::SimavrFixes(avr_t* avr) {
     for (auto install : {&install_memory_guard, &install_virtual_sleep, &install_uart_framing,
                          // peripherals
-                         &install_interrupt_timing, &install_external_interrupts, &install_port_pins,
+                         &install_port_overrides, &install_interrupt_timing, &install_external_interrupts, &install_port_pins,
                          &install_watchdog, &install_adc_conversion, &install_uart_transmitter,
                          &install_uart_ursel, &install_eeprom_timing, &install_self_programming,
                          // timers
@@ -16,6 +16,10 @@ SimavrFixes::SimavrFixes(avr_t* avr) {
     }
 }
 
-SimavrFixes::~SimavrFixes() = default;
+SimavrFixes::~SimavrFixes() {
+    // Newest first: a fix may use one installed before it (the timers and the
+    // USARTs drive pins through install_port_overrides's CompareOutputPins).
+    while (!fixes_.empty()) fixes_.pop_back();
+}
 
 }  // namespace avrbench

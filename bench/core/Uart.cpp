@@ -1,19 +1,25 @@
 #include "core/Uart.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 extern "C" {
 #include <avr_uart.h>
 #include <sim_avr.h>
+#include <sim_cycle_timers.h>
 #include <sim_io.h>
 }
 
+#include "core/CycleAt.hpp"
 #include "core/Errors.hpp"
+#include "core/Pin.hpp"
 #include "core/Scheduler.hpp"
+#include "core/fixes/Fixes.hpp"
 
 namespace avrbench {
 
-Uart::Uart(avr_t* avr, Scheduler& scheduler, int index) : avr_(avr), scheduler_(scheduler), index_(index) {
+Uart::Uart(avr_t* avr, Scheduler& scheduler, int index, Pin* rx_pin)
+    : avr_(avr), scheduler_(scheduler), index_(index), rx_pin_(rx_pin) {
     const char name = static_cast<char>('0' + index);
     for (avr_io_t* io = avr->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "uart") == 0 &&
@@ -80,11 +86,140 @@ void Uart::pump() {
         if (!avr_regbit_get(avr_, uart_->rxen)) break;
         const std::uint8_t byte = to_send_.front();
         to_send_.pop_front();
-        ++delivered_;
-        avr_raise_irq(irqs_ + UART_IRQ_INPUT, byte);
+        draw_host_frame(byte);
+        deliver(byte);
     }
     pumping_ = false;
     if (!to_send_.empty()) schedule_retry();
+}
+
+void Uart::deliver(std::uint16_t value) {
+    ++delivered_;
+    avr_raise_irq(irqs_ + UART_IRQ_INPUT, value);
+}
+
+void Uart::draw_host_frame(std::uint16_t value) {
+    // simavr's FIFO sets RXC one frame after a byte enters it empty, then one
+    // frame apart while it holds more: the frames sit end to end on the line.
+    const UartFrame frame = uart_frame(avr_, uart_);
+    const Cycle start = std::max<Cycle>(avr_->cycle, rx_line_free_at_);
+    const Cycle frame_cycles = static_cast<Cycle>(frame.cycles_per_bit) * static_cast<Cycle>(frame.bits());
+    rx_line_free_at_ = start + frame_cycles;
+    if (rx_pin_ != nullptr && !rx_from_line_) {
+        const UartFrameLevels levels = uart_frame_levels(frame, value);
+        bool level = true;  // the host holds the line idle high
+        for (int i = 0; i < levels.count; ++i) {
+            if (levels.high[static_cast<std::size_t>(i)] == level) continue;
+            level = !level;
+            scheduler_.at(start + static_cast<Cycle>(i) * frame.cycles_per_bit, [this, level](Cycle at) {
+                CycleAt stamp(avr_, at);
+                rx_pin_->drive(level);
+            });
+        }
+    }
+    if (!rx_listeners_.empty()) {
+        scheduler_.at(rx_line_free_at_, [this, value](Cycle at) {
+            for (auto& fn : rx_listeners_) fn(at, static_cast<std::uint8_t>(value));
+        });
+    }
+}
+
+void Uart::listen_to_rx_line() {
+    if (rx_from_line_ || rx_pin_ == nullptr) return;
+    rx_from_line_ = true;
+    rx_pin_->on_change([this](Cycle cycle, bool high) { on_rx_edge(cycle, high); });
+}
+
+void Uart::on_rx_edge(Cycle cycle, bool high) {
+    if (line_frame_active_) {
+        line_edges_.emplace_back(cycle, high);
+        return;
+    }
+    // A falling edge on an idle line starts a frame (§20.8.1); the receiver
+    // sees none while it is off.
+    if (high || !avr_regbit_get(avr_, uart_->rxen)) return;
+    const UartFrame frame = uart_frame(avr_, uart_);
+    line_frame_active_ = true;
+    line_frame_start_ = cycle;
+    line_cycles_per_bit_ = frame.cycles_per_bit;
+    line_edges_.clear();
+    // The first stop bit's middle: bit index bits() - stop_bits, plus half a bit.
+    const double stop_middle_bits = frame.bits() - frame.stop_bits + 0.5;
+    scheduler_.at(cycle + static_cast<Cycle>(stop_middle_bits * frame.cycles_per_bit), [this](Cycle at) {
+        CycleAt stamp(avr_, at);
+        finish_line_frame();
+    });
+}
+
+void Uart::finish_line_frame() {
+    line_frame_active_ = false;
+    const UartFrame frame = uart_frame(avr_, uart_);
+    // The line's level in the middle of bit `index` (the start bit is index 0).
+    auto level_at_bit = [this](int index) {
+        const Cycle middle = line_frame_start_ + static_cast<Cycle>((index + 0.5) * line_cycles_per_bit_);
+        bool high = false;
+        for (const auto& [cycle, level] : line_edges_) {
+            if (cycle > middle) break;
+            high = level;
+        }
+        return high;
+    };
+    std::uint32_t data = 0;
+    for (int i = 0; i < frame.data_bits; ++i) {
+        if (level_at_bit(1 + i)) data |= 1u << i;
+    }
+    const UartFrameLevels expected = uart_frame_levels(frame, data);
+    int index = 1 + frame.data_bits;
+    if (frame.parity != 0) {
+        if (level_at_bit(index) != expected.high[static_cast<std::size_t>(index)]) ++line_parity_errors_;
+        ++index;
+    }
+    if (!level_at_bit(index)) ++line_framing_errors_;
+    // The rest of the frame's edges belong to no one: a falling edge after the
+    // stop bit's middle is the next start bit.
+    bool next_start = false;
+    Cycle next_start_cycle = 0;
+    const Cycle stop_middle = line_frame_start_ + static_cast<Cycle>((index + 0.5) * line_cycles_per_bit_);
+    for (const auto& [cycle, level] : line_edges_) {
+        if (cycle > stop_middle && !level) {
+            next_start = true;
+            next_start_cycle = cycle;
+        }
+    }
+
+    if (avr_regbit_get(avr_, uart_->rxen)) {
+        // simavr starts its receive-complete timer a whole frame after a byte
+        // enters an empty FIFO; the frame is over on the line already, so the
+        // timer is brought forward to now.
+        const bool fifo_was_idle = rxc_timer_ == nullptr || avr_cycle_timer_status(avr_, rxc_timer_, uart_) == 0;
+        std::vector<avr_cycle_timer_t> before;
+        if (rxc_timer_ == nullptr) {
+            for (avr_cycle_timer_slot_p t = avr_->cycle_timers.timer; t != nullptr; t = t->next) {
+                if (t->param == uart_) before.push_back(t->timer);
+            }
+        }
+        deliver(static_cast<std::uint16_t>(data));
+        if (rxc_timer_ == nullptr) {
+            for (avr_cycle_timer_slot_p t = avr_->cycle_timers.timer; t != nullptr; t = t->next) {
+                if (t->param == uart_ && std::find(before.begin(), before.end(), t->timer) == before.end()) {
+                    rxc_timer_ = t->timer;
+                }
+            }
+        }
+        if (fifo_was_idle && rxc_timer_ != nullptr && avr_cycle_timer_status(avr_, rxc_timer_, uart_) != 0) {
+            avr_cycle_timer_cancel(avr_, rxc_timer_, uart_);
+            avr_cycle_timer_register(avr_, 0, rxc_timer_, uart_);
+        }
+        for (auto& fn : rx_listeners_) fn(avr_->cycle, static_cast<std::uint8_t>(data));
+    }
+    if (next_start) {
+        std::vector<std::pair<Cycle, bool>> rest;
+        for (const auto& e : line_edges_) {
+            if (e.first > next_start_cycle) rest.push_back(e);
+        }
+        on_rx_edge(next_start_cycle, false);
+        for (const auto& [cycle, level] : rest) on_rx_edge(cycle, level);
+    }
 }
 
 void Uart::schedule_retry() {

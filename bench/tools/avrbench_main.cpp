@@ -622,7 +622,10 @@ int run_command(const RunArgs& args) {
     } catch (const BadInput&) {
         if (!args.uart_in.empty() || !args.uart_out.empty()) throw;
     }
-    if (uart0 != nullptr && tracing) recorder.trace_uart_tx(mcu, *uart0);
+    if (uart0 != nullptr && tracing) {
+        recorder.trace_uart_tx(mcu, *uart0);
+        recorder.trace_uart_rx(mcu, *uart0);
+    }
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
     const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);

@@ -64,6 +64,14 @@ SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
     return id;
 }
 
+SignalId Recorder::trace_uart_rx(Mcu& mcu, Uart& uart) {
+    const SignalId id = timeline_.add_signal(
+        {mcu.name(), "uart" + std::to_string(uart.index()) + "_rx", SignalKind::Bus, 8, mcu.frequency_hz(), true});
+    Timeline* timeline = &timeline_;
+    uart.on_receive([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
+    return id;
+}
+
 SignalId Recorder::trace_twi(Mcu& mcu, Twi& twi) {
     const SignalId id = timeline_.add_signal({mcu.name(), "twi", SignalKind::Bus, 8, mcu.frequency_hz(), true});
     Timeline* timeline = &timeline_;

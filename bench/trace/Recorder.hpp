@@ -23,8 +23,11 @@ public:
     // Adds "<mcu name>.<pin name>" as a wire, starting with its current level.
     SignalId trace_pin(Mcu& mcu, Pin& pin);
     // Adds "<mcu name>.uart<n>_tx" as an 8-bit bus: one event per byte, at the
-    // cycle of the UDR write.
+    // cycle of its start bit.
     SignalId trace_uart_tx(Mcu& mcu, Uart& uart);
+    // Adds "<mcu name>.uart<n>_rx": one event per byte the receiver takes, at
+    // the cycle its receive-complete flag is set.
+    SignalId trace_uart_rx(Mcu& mcu, Uart& uart);
     // Every address and data byte the MCU puts on its I2C bus as master, as
     // an 8-bit bus signal "twi" (one event per byte, at the end of its ACK bit).
     SignalId trace_twi(Mcu& mcu, Twi& twi);

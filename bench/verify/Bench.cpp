@@ -174,6 +174,7 @@ void Bench::trace_board() {
     for (const auto& s : board_->spec().serial) {
         Mcu& m = board_->mcu(s.mcu);
         recorder_.trace_uart_tx(m, m.uart(s.usart));
+        recorder_.trace_uart_rx(m, m.uart(s.usart));
     }
     for (Mcu* m : board_->mcus()) {
         // Only MCUs on a board's I2C bus: the others have nobody to talk to.

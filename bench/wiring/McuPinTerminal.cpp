@@ -83,9 +83,11 @@ McuPortWatch::McuPortWatch(Mcu& mcu) : mcu_(mcu) {
         write_hooks_.push_back(std::make_unique<IoWriteHook>(mcu.avr(), facts.pud_register, &on_pud_write, this));
     }
     mcu.on_reset([this] { refresh_all(); });
+    direction_listener_ = mcu.on_pin_direction_change([this] { refresh_all(); });
 }
 
 McuPortWatch::~McuPortWatch() {
+    mcu_.remove_pin_direction_listener(direction_listener_);
     // Hooks chain on simavr's I/O slots: undo them newest first.
     while (!read_hooks_.empty()) read_hooks_.pop_back();
     while (!write_hooks_.empty()) write_hooks_.pop_back();

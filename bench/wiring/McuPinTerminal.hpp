@@ -91,6 +91,7 @@ private:
     void refresh_all();
 
     Mcu& mcu_;
+    int direction_listener_ = -1;
     std::map<avr_ioport_t*, std::unique_ptr<PortWatch>> ports_;
     std::vector<std::unique_ptr<IoWriteHook>> write_hooks_;
     std::vector<std::unique_ptr<IoReadHook>> read_hooks_;

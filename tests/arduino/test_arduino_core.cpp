@@ -163,6 +163,37 @@ nets:
     EXPECT_TRUE(board.findings().empty()) << board.findings().front().describe();
 }
 
+// A whole serial line at pin level: the host talks to a Mega's Serial, the
+// Mega's Serial1 TX1 pin (PD3) drives a wire to the UNO's SoftwareSerial RX
+// (PB2), the UNO's TX (PB3) drives a wire to the Mega's RX1 (PD2). Nothing
+// between the two MCUs but two nets: the Mega's USART1 transmitter must toggle
+// its pin and its receiver must sample the line.
+TEST(ArduinoCore, HardwareSerialAndSoftwareSerialTalkOverTwoWires) {
+    const std::string board_text = R"(
+mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+  mega: {type: atmega2560, clock: 16MHz}
+nets:
+  mega_to_uno: [mega.PD3, uno.PB2]
+  uno_to_mega: [uno.PB3, mega.PD2]
+)";
+    Board board(parse_board_text(board_text, "serial-bridge.yaml"),
+                {{"uno", test::firmware("ard_software_serial")}, {"mega", test::firmware("ard_serial_bridge_mega")}});
+    Uart& host = board.mcu("mega").uart(0);
+    // One byte every 3 ms, for SoftwareSerial's half-duplex limit (see above).
+    const std::string hello = "hello";
+    for (std::size_t i = 0; i < hello.size(); ++i) {
+        board.run_for_seconds(i == 0 ? 0.020 : 0.003);
+        host.send(hello.substr(i, 1));
+    }
+    board.run_for_seconds(0.010);
+    // The bridge's banner, then the UNO's "ready\r\n" that came in on Serial1
+    // while the banner was still going out, then each byte echoed upper case.
+    EXPECT_EQ(host.transmitted_text(), "bridge\r\nready\r\nHELLO");
+    EXPECT_EQ(board.mcu("mega").uart(1).line_framing_errors(), 0u);
+    EXPECT_TRUE(board.findings().empty()) << board.findings().front().describe();
+}
+
 // The Wire library on two MCUs: an UNO master (A4 = PC4 SDA, A5 = PC5 SCL)
 // and a Mega slave at address 8 (D20 = PD1 SDA, D21 = PD0 SCL), with only
 // the internal pull-ups twi_init() switches on, as two boards joined by

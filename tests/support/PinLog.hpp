@@ -33,6 +33,15 @@ public:
         for (const auto& e : edges_) out.push_back(e.cycle);
         return out;
     }
+    // The level the pin had at `cycle` (an edge at `cycle` counts).
+    bool level_at(Cycle cycle) const {
+        bool level = initial_;
+        for (const auto& e : edges_) {
+            if (e.cycle > cycle) break;
+            level = e.level;
+        }
+        return level;
+    }
     const std::vector<Cycle>& rises() const { return rises_; }
     const std::vector<Cycle>& falls() const { return falls_; }
     // Cycles between consecutive edges (any direction).

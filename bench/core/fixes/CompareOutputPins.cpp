@@ -8,6 +8,7 @@ extern "C" {
 #include <sim_irq.h>
 }
 
+#include "core/fixes/Fixes.hpp"
 #include "core/fixes/Interrupts.hpp"
 #include "core/fixes/SimavrIrqHooks.hpp"
 
@@ -23,14 +24,17 @@ Registry<avr_t, CompareOutputPins>& instances() {
 struct CompareOutputPins::Port {
     CompareOutputPins* owner = nullptr;
     avr_ioport_t* io = nullptr;
-    std::uint8_t connected = 0;  // pins a connected OCnx drives
+    std::uint8_t connected = 0;  // pins a connected OCnx (or TxDn) drives
+    std::uint8_t forced = 0;     // of those, the ones driven as outputs whatever DDxn says
     std::uint8_t level = 0;      // their OCnx level
     std::uint8_t shared = 0;     // pins with more than one comparator (2560 PB7: OC0A, OC1C)
     std::uint8_t waving = 0;     // pins handed out as periodic waves
     std::unique_ptr<IoWriteHook> port_write, pin_write, ddr_write, pcmsk_write;
     std::unique_ptr<IoReadHook> pin_read;
 
-    std::uint8_t overridden(const avr_t* avr) const { return connected & avr->data[io->r_ddr]; }
+    std::uint8_t overridden(const avr_t* avr) const {
+        return static_cast<std::uint8_t>(connected & (avr->data[io->r_ddr] | forced));
+    }
     std::uint8_t effective(std::uint8_t port_value, std::uint8_t mask) const {
         return static_cast<std::uint8_t>((port_value & ~mask) | (level & mask));
     }
@@ -83,16 +87,59 @@ int CompareOutputPins::add(avr_regbit_t com_pin, avr_irq_t* compare_irq) {
     return static_cast<int>(drivers_.size() - 1);
 }
 
+int CompareOutputPins::add_forced_output(char port_letter, int bit) {
+    avr_ioport_t* io = nullptr;
+    for (avr_io_t* m = avr_->io_port; m != nullptr; m = m->next) {
+        if (m->kind == nullptr || std::string_view(m->kind) != "port") continue;
+        auto* p = reinterpret_cast<avr_ioport_t*>(m);
+        if (p->name == port_letter) io = p;
+    }
+    if (io == nullptr || bit < 0 || bit > 7) return -1;
+    Driver d;
+    d.port = port_for(io);
+    d.bit = static_cast<std::uint8_t>(bit);
+    d.pin_irq = io->io.irq + bit;
+    d.forces_output = true;
+    drivers_.push_back(d);
+    return static_cast<int>(drivers_.size() - 1);
+}
+
+bool CompareOutputPins::forces_output(const avr_ioport_t* io, int bit) const {
+    for (const auto& p : ports_) {
+        if (p->io == io) return ((p->forced & p->connected) >> bit & 1) != 0;
+    }
+    return false;
+}
+
+int CompareOutputPins::on_direction_change(std::function<void()> fn) {
+    direction_listeners_.emplace_back(next_listener_id_, std::move(fn));
+    return next_listener_id_++;
+}
+
+void CompareOutputPins::remove_direction_listener(int id) {
+    std::erase_if(direction_listeners_, [id](const auto& l) { return l.first == id; });
+}
+
+void CompareOutputPins::tell_direction_listeners() {
+    for (auto& [id, fn] : direction_listeners_) fn();
+}
+
 void CompareOutputPins::after_reset() {
+    bool forced_was_connected = false;
     for (Driver& d : drivers_) {
         if (d.waving) end_wave(static_cast<int>(&d - drivers_.data()), avr_->cycle);
+        forced_was_connected = forced_was_connected || (d.forces_output && d.connected);
         d.connected = false;
         d.level = false;
-        avr_unconnect_irq(d.compare_irq, d.pin_irq);
+        if (d.compare_irq != nullptr) avr_unconnect_irq(d.compare_irq, d.pin_irq);
     }
     for (auto& p : ports_) {
         p->connected = 0;
+        p->forced = 0;
         p->level = 0;
+    }
+    if (forced_was_connected) {
+        tell_direction_listeners();
     }
 }
 
@@ -101,11 +148,15 @@ void CompareOutputPins::set(int id, bool connected, bool level) {
     Driver& d = drivers_[static_cast<std::size_t>(id)];
     if (d.connected == connected && d.level == level) return;
     const bool level_changed = d.level != level;
+    const bool direction_changed = d.forces_output && d.connected != connected;
     d.connected = connected;
     d.level = level;
     // For anyone watching the comparator's own IRQ (it no longer reaches the pin).
-    if (level_changed) avr_raise_irq(d.compare_irq, level ? 1 : 0);
+    if (level_changed && d.compare_irq != nullptr) avr_raise_irq(d.compare_irq, level ? 1 : 0);
     update_pin(*d.port, d.bit);
+    if (direction_changed) {
+        tell_direction_listeners();
+    }
 }
 
 void CompareOutputPins::combine(Port& port, std::uint8_t bit, std::uint8_t port_value) {
@@ -121,6 +172,9 @@ void CompareOutputPins::combine(Port& port, std::uint8_t bit, std::uint8_t port_
     // ATmega2560 §19 "Output Compare Modulator (OCM1C0A)": with OC0A and OC1C
     // both connected to PB7, PORTB7 selects OR (1) or AND (0) of the two.
     const bool on = n == 1 ? any : ((port_value & mask) != 0 ? any : all);
+    bool forced = false;
+    for (const Driver& d : drivers_) forced = forced || (d.port == &port && d.bit == bit && d.connected && d.forces_output);
+    port.forced = static_cast<std::uint8_t>(forced ? (port.forced | mask) : (port.forced & ~mask));
     port.connected = static_cast<std::uint8_t>(n != 0 ? (port.connected | mask) : (port.connected & ~mask));
     port.level = static_cast<std::uint8_t>(n != 0 && on ? (port.level | mask) : (port.level & ~mask));
     // Installed once and kept (a hook cannot leave simavr's chain while
@@ -131,8 +185,18 @@ void CompareOutputPins::combine(Port& port, std::uint8_t bit, std::uint8_t port_
 void CompareOutputPins::update_pin(Port& port, std::uint8_t bit) {
     avr_t* avr = avr_;
     const std::uint8_t mask = static_cast<std::uint8_t>(1u << bit);
+    const bool was_forced = (port.forced & mask) != 0;
     combine(port, bit, avr->data[port.io->r_port]);
-    if ((avr->data[port.io->r_ddr] & mask) == 0) return;  // an input: OCnx is not visible (§15.6)
+    // An input: OCnx is not visible (§15.6) - unless the driver forces the pin out (TxDn).
+    if ((avr->data[port.io->r_ddr] & mask) == 0 && (port.forced & mask) == 0) {
+        // A forced output (TXEN cleared) just let go of an input pin: it reads
+        // its pull-up again, or whatever drives it from outside.
+        if (was_forced && (port.io->external.pull_mask & mask) == 0) {
+            const bool pull_up = (avr->data[port.io->r_port] & mask) != 0;
+            avr_raise_irq(port.io->io.irq + bit, pull_up ? 1 : 0);
+        }
+        return;
+    }
     const bool level = (port.connected & mask) != 0 ? (port.level & mask) != 0 : (avr->data[port.io->r_port] & mask) != 0;
     // The port module's pin IRQ: sets PINxn, raises pin change interrupts,
     // tells the pin's listeners (filtered: nothing happens when unchanged).
@@ -188,7 +252,7 @@ void CompareOutputPins::on_ddr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_
     }
     const avr_io_addr_t r_port = port->io->r_port;
     const std::uint8_t firmware_port = avr->data[r_port];
-    const std::uint8_t ovr = static_cast<std::uint8_t>(port->connected & value);
+    const std::uint8_t ovr = static_cast<std::uint8_t>(port->connected & (value | port->forced));
     avr->data[r_port] = port->effective(firmware_port, ovr);
     hook.write_original(avr, addr, value);
     avr->data[r_port] = firmware_port;
@@ -280,5 +344,19 @@ void CompareOutputPins::on_pcmsk_write(IoWriteHook& hook, avr_t* avr, avr_io_add
     if (port->waving != 0) port->owner->stop_waves(*port);
     hook.write_original(avr, addr, value);
 }
+
+namespace {
+
+class PortOverrides final : public Fix {
+public:
+    explicit PortOverrides(avr_t* avr) : pins_(avr) {}
+
+private:
+    CompareOutputPins pins_;
+};
+
+}  // namespace
+
+std::unique_ptr<Fix> install_port_overrides(avr_t* avr) { return std::make_unique<PortOverrides>(avr); }
 
 }  // namespace avrbench

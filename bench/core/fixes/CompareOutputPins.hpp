@@ -1,4 +1,11 @@
-// The OCnx pins of the timers, for the timer model (TimerModel.cpp).
+// The pins a peripheral drives in place of PORTxn: the OCnx pins of the
+// timers (TimerModel.cpp) and the USARTs' TxDn pins (UartTransmitter.cpp).
+//
+// TxDn (ATmega328P §20.6 and Table 14-9, DDOE = TXEN, DDOV = 1, PVOE = TXEN;
+// ATmega2560 §22.6; ATmega32 "USART"): while the transmitter is enabled the
+// USART drives the pin as an output whatever DDxn says - a "forced output"
+// driver here. Whoever decides what a pin drives (core/Pin::is_output, the
+// board's net terminals) asks forces_output() and hears when it changes.
 //
 // Datasheet (ATmega328P §15.6 / §16.8 "Compare Match Output Unit", ATmega2560
 // §16.6 / §17.8): while the COMnx bits connect the
@@ -16,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -37,6 +45,16 @@ public:
     // Adds the pin a timer comparator drives (its `com_pin` regbit); returns
     // the driver's id, or -1 when the core has no such pin.
     int add(avr_regbit_t com_pin, avr_irq_t* compare_irq);
+    // Adds pin `bit` of port `port_letter` as a forced output (a USART's
+    // TxDn); the driver's id, or -1 when the core has no such port.
+    int add_forced_output(char port_letter, int bit);
+    // Whether a connected forced-output driver holds pin `bit` of `io`.
+    bool forces_output(const avr_ioport_t* io, int bit) const;
+    // Called whenever a forced output connects or disconnects (its pin's
+    // direction changed without a DDRx write).
+    // Returns an id for remove_direction_listener.
+    int on_direction_change(std::function<void()> fn);
+    void remove_direction_listener(int id);
     // The comparator's state: whether COMnx connects OCnx to the pin, and the
     // level of the OCnx register. Raises the pin when what it shows changes.
     void set(int id, bool connected, bool level);
@@ -66,8 +84,9 @@ private:
     struct Driver {
         Port* port = nullptr;
         std::uint8_t bit = 0;
-        avr_irq_t* compare_irq = nullptr;
+        avr_irq_t* compare_irq = nullptr;  // nullptr for a forced output
         avr_irq_t* pin_irq = nullptr;
+        bool forces_output = false;
         bool connected = false;
         bool level = false;
         bool waving = false;
@@ -103,6 +122,9 @@ private:
     std::vector<std::unique_ptr<Port>> ports_;
     std::vector<Driver> drivers_;
     std::vector<Sink> sinks_;
+    std::vector<std::pair<int, std::function<void()>>> direction_listeners_;
+    int next_listener_id_ = 0;
+    void tell_direction_listeners();
 };
 
 }  // namespace avrbench

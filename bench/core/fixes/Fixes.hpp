@@ -3,9 +3,13 @@
 // with its datasheet section and test.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <memory>
 
 #include "core/fixes/Fix.hpp"
+
+struct avr_uart_t;
 
 namespace avrbench {
 
@@ -15,8 +19,33 @@ std::unique_ptr<Fix> install_memory_guard(avr_t* avr);
 std::unique_ptr<Fix> install_virtual_sleep(avr_t* avr);
 // USART: no usleep on UCSRnA polls, no stdout echo, datasheet frame length.
 std::unique_ptr<Fix> install_uart_framing(avr_t* avr);
+// A USART's frame format as its registers set it (ATmega328P §20.4).
+struct UartFrame {
+    std::uint32_t cycles_per_bit = 16;
+    int data_bits = 8;   // 5..9
+    int parity = 0;      // UPMn1:0: 0 none, 2 even, 3 odd
+    int stop_bits = 1;   // 1 or 2
+    int bits() const { return 1 + data_bits + (parity != 0 ? 1 : 0) + stop_bits; }
+};
+UartFrame uart_frame(avr_t* avr, const avr_uart_t* uart);
+// Where UCSRC shares its location with UBRRH (ATmega32: URSEL), the UCSRC the
+// firmware last wrote, kept by install_uart_ursel; uart_frame reads it from
+// here. nullptr unregisters.
+void set_uart_ucsrc_shadow(const avr_uart_t* uart, const std::uint8_t* ucsrc);
+// The line level during each bit time of a frame carrying `data` (§20.4,
+// Figure 20-4): start bit low, data bits LSB first (the ninth from bit 8),
+// the parity bit (even: the ones including it are even; odd: odd; the
+// reserved UPM = 01 as even), stop bits high.
+struct UartFrameLevels {
+    std::array<bool, 13> high{};  // 1 + 9 + 1 + 2 bits at most
+    int count = 0;
+};
+UartFrameLevels uart_frame_levels(const UartFrame& frame, std::uint32_t data);
 
 // --- peripherals: interrupts, ports, sleep, watchdog, ADC, USART, EEPROM
+// Pins a peripheral drives in place of PORTxn (timers' OCnx, USARTs' TxDn):
+// CompareOutputPins, installed before the fixes that add drivers to it.
+std::unique_ptr<Fix> install_port_overrides(avr_t* avr);
 // Interrupt response 4/5 cycles, one instruction after RETI/SEI, exact
 // wake-up from SLEEP (+ response + start-up time), SLEEP with SE = 0 is a NOP.
 std::unique_ptr<Fix> install_interrupt_timing(avr_t* avr);

@@ -76,6 +76,7 @@ extern "C" {
 #include <sim_regbit.h>
 }
 
+#include "core/CycleAt.hpp"
 #include "core/fixes/CompareOutputPins.hpp"
 #include "core/fixes/Fixes.hpp"
 
@@ -269,21 +270,6 @@ avr_irq_t* pin_irq(avr_t* avr, avr_regbit_t pin) {
     return nullptr;
 }
 
-// Listeners of what a timer clock does see the cycle of that clock, not the
-// end of the instruction in progress.
-class CycleAt {
-public:
-    CycleAt(avr_t* avr, Cycle at) : avr_(avr), saved_(avr->cycle) {
-        if (at < saved_) avr->cycle = at;
-    }
-    ~CycleAt() { avr_->cycle = saved_; }
-    CycleAt(const CycleAt&) = delete;
-    CycleAt& operator=(const CycleAt&) = delete;
-
-private:
-    avr_t* avr_;
-    Cycle saved_;
-};
 
 class TimerModel;
 
@@ -1306,7 +1292,7 @@ private:
 
 class TimerFix final : public Fix {
 public:
-    TimerFix(avr_t* avr, Family family) : pins_(avr) {
+    TimerFix(avr_t* avr, Family family) : pins_(*CompareOutputPins::of(avr)) {
         sync_.base = async_.base = avr->cycle;
         std::vector<TimerModel*> all;
         for (avr_io_t* io = avr->io_port; io != nullptr; io = io->next) {
@@ -1326,7 +1312,7 @@ public:
 
 private:
     Prescaler sync_, async_;
-    CompareOutputPins pins_;
+    CompareOutputPins& pins_;  // install_port_overrides's
     std::vector<std::unique_ptr<TimerModel>> timers_;
     std::unique_ptr<PrescalerResets> resets_;
 };

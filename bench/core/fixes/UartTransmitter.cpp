@@ -13,6 +13,15 @@
 // with nothing in the buffer. The byte is announced on UART_IRQ_OUTPUT when
 // its start bit goes out (the bench's Uart stamps it with that cycle).
 // The receiver is simavr's. TXEN is cleared at reset (simavr sets it).
+//
+// The TxDn pin (§20.6.1, Table 14-9: DDOE = PVOE = TXEN, DDOV = 1): while the
+// transmitter is enabled the USART drives it as an output, idle high, and
+// each frame goes out bit by bit - start bit low, 5 to 9 data bits LSB first
+// (the ninth from TXB8), the parity bit (even or odd over the data bits),
+// one or two stop bits high - each bit cycles_per_bit long from the start
+// bit's cycle, edges at exact cycles (the timer that raises them presents
+// its own cycle). TXEN cleared takes effect once the frames queued are out
+// (§20.6.5 "Disabling the Transmitter").
 #include <string_view>
 #include <vector>
 
@@ -23,6 +32,11 @@ extern "C" {
 #include <sim_irq.h>
 }
 
+#include <deque>
+
+#include "core/CycleAt.hpp"
+#include "core/McuPins.hpp"
+#include "core/fixes/CompareOutputPins.hpp"
 #include "core/fixes/Fixes.hpp"
 #include "core/fixes/Interrupts.hpp"
 
@@ -49,6 +63,11 @@ public:
         // simavr's reset sets TXEN ("allow printf without fiddling with enabling
         // the uart"); UCSRnB resets to 0 (328P §20.11.3).
         avr_regbit_clear(avr, uart->txen);
+        // The TxDn pin, where the bench knows the part's pin-out.
+        if (auto pins = usart_pins(avr->mmcu != nullptr ? avr->mmcu : "", uart->name - '0'); pins && CompareOutputPins::of(avr)) {
+            pins_ = CompareOutputPins::of(avr);
+            tx_driver_ = pins_->add_forced_output(pins->tx_port, pins->tx_bit);
+        }
     }
 
     ~UartTransmitter() override {
@@ -56,6 +75,7 @@ public:
         control_hook_.reset();
         avr_irq_unregister_notify(uart_->udrc.irq + AVR_INT_IRQ_PENDING, &on_udre_pending, this);
         avr_cycle_timer_cancel(avr_, &on_frame_end, this);
+        avr_cycle_timer_cancel(avr_, &on_line_edge, this);
         uart_->io.reset = original_reset_;
         tx_registry().remove(&uart_->io);
     }
@@ -78,12 +98,11 @@ private:
     void load(std::uint8_t byte, avr_cycle_count_t at) {
         shifting_ = true;
         shift_end_ = at + uart_->cycles_per_byte;
+        queue_frame(byte, at);
         // Observers stamp the byte with avr->cycle: present the start bit's
         // cycle (a timer runs after the instruction in progress, a few cycles late).
-        const avr_cycle_count_t now = avr_->cycle;
-        avr_->cycle = at;
+        CycleAt stamp(avr_, at);
         avr_raise_irq(uart_->io.irq + UART_IRQ_OUTPUT, byte);
-        avr_->cycle = now;
     }
 
     static void on_udr_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t, std::uint8_t value) {
@@ -135,6 +154,7 @@ private:
         self->set_udre(!self->buffered_ && avr_regbit_get(avr, self->uart_->txen));
         if (!avr_regbit_get(avr, self->uart_->txen)) avr_regbit_set(avr, self->uart_->udrc.raised);
         sync_enables(avr, addr);
+        self->drive_line();
     }
 
     static void on_reset(avr_io_t* io) {
@@ -143,6 +163,54 @@ private:
         avr_regbit_clear(self->avr_, self->uart_->txen);
         self->shifting_ = false;
         self->buffered_ = false;
+        self->edges_.clear();
+        avr_cycle_timer_cancel(self->avr_, &on_line_edge, self);
+        self->line_high_ = true;
+        self->drive_line();
+    }
+
+    // --- the TxDn pin -----------------------------------------------------
+
+    // The frame's level changes, from the start bit at `at`.
+    void queue_frame(std::uint8_t byte, avr_cycle_count_t at) {
+        if (tx_driver_ < 0) return;
+        const UartFrame f = uart_frame(avr_, uart_);
+        std::uint32_t data = byte;
+        if (f.data_bits == 9 && (avr_->data[uart_->r_ucsrb] & 0x01) != 0) data |= 0x100;  // TXB8n (§20.11.3)
+        const UartFrameLevels levels = uart_frame_levels(f, data);
+        bool level = edges_.empty() ? line_high_ : edges_.back().high;
+        for (int i = 0; i < levels.count; ++i) {
+            if (levels.high[static_cast<std::size_t>(i)] == level) continue;
+            level = !level;
+            edges_.push_back({at + static_cast<avr_cycle_count_t>(i) * f.cycles_per_bit, level});
+        }
+        if (!edges_.empty() && avr_cycle_timer_status(avr_, &on_line_edge, this) == 0) {
+            avr_cycle_timer_register(avr_, edges_.front().at > avr_->cycle ? edges_.front().at - avr_->cycle : 0,
+                                     &on_line_edge, this);
+        }
+    }
+
+    static avr_cycle_count_t on_line_edge(avr_t* avr, avr_cycle_count_t when, void* param) {
+        auto* self = static_cast<UartTransmitter*>(param);
+        while (!self->edges_.empty() && self->edges_.front().at <= when) {
+            const Edge e = self->edges_.front();
+            self->edges_.pop_front();
+            self->line_high_ = e.high;
+            CycleAt stamp(avr, e.at);  // listeners stamp the edge with the bit's own cycle
+            self->drive_line();
+        }
+        if (self->edges_.empty()) {
+            self->drive_line();  // TXEN cleared while frames were queued: let go now
+            return 0;
+        }
+        return self->edges_.front().at;
+    }
+
+    // The pin: driven while TXEN is set or a frame is still going out.
+    void drive_line() {
+        if (tx_driver_ < 0) return;
+        const bool connected = avr_regbit_get(avr_, uart_->txen) != 0 || !edges_.empty();
+        pins_->set(tx_driver_, connected, line_high_);
     }
 
     avr_t* avr_;
@@ -153,6 +221,15 @@ private:
     bool buffered_ = false;
     std::uint8_t buffer_ = 0;
     avr_cycle_count_t shift_end_ = 0;
+
+    struct Edge {
+        avr_cycle_count_t at;
+        bool high;
+    };
+    CompareOutputPins* pins_ = nullptr;
+    int tx_driver_ = -1;     // TxDn's driver, -1 when the pin-out is unknown
+    bool line_high_ = true;  // the line now: idle high
+    std::deque<Edge> edges_; // level changes of the frames going out, in order
 };
 
 class UartTransmitters final : public Fix {

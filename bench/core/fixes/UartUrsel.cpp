@@ -4,8 +4,8 @@
 // Registers"). simavr 1.6 stores both in one byte, so the UBRRH = 0 that
 // firmware writes after the frame format turns an 8N1 frame into 5 data bits
 // (7 bit times). Here the two are kept apart: the location holds UBRRH (what
-// a single read returns) and the frame length is computed from the UCSRC the
-// firmware wrote (§20.4 frame: start + data + parity if UPM != 0 + stop).
+// a single read returns) and the UCSRC the firmware wrote is kept apart for
+// uart_frame (frame length, the levels drawn on TxD/RxD).
 #include <vector>
 
 extern "C" {
@@ -32,8 +32,11 @@ public:
             done.push_back(r);
             hooks_.push_back(std::make_unique<IoWriteHook>(avr, r, &on_write, this));
         }
-        ucsrc_ = 0x86;  // reset value: 8N1 (URSEL reads one, UCSZ1:0 = 11)
+        set_uart_ucsrc_shadow(uart_, &ucsrc_);
     }
+    ~UartUrsel() override { set_uart_ucsrc_shadow(uart_, nullptr); }
+    UartUrsel(const UartUrsel&) = delete;
+    UartUrsel& operator=(const UartUrsel&) = delete;
 
 private:
     static void on_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
@@ -51,19 +54,12 @@ private:
         } else {
             hook.write_original(avr, addr, value);
         }
-        const std::uint32_t ubrr = avr->data[u->ubrrl.reg] | (static_cast<std::uint32_t>(self->ubrrh_) << 8);
-        std::uint32_t cycles_per_bit = (ubrr + 1) * 8;
-        if (!avr_regbit_get(avr, u->u2x)) cycles_per_bit *= 2;
-        static constexpr int kDataBits[8] = {5, 6, 7, 8, 8, 8, 8, 9};
-        const int ucsz = ((self->ucsrc_ >> 1) & 0x3) | (avr_regbit_get(avr, u->ucsz2) << 2);
-        const bool parity = ((self->ucsrc_ >> 4) & 0x3) != 0;
-        const int stop_bits = 1 + ((self->ucsrc_ >> 3) & 1);
-        const int bits = 1 + kDataBits[ucsz & 7] + (parity ? 1 : 0) + stop_bits;
-        u->cycles_per_byte = static_cast<avr_cycle_count_t>(cycles_per_bit) * static_cast<avr_cycle_count_t>(bits);
+        u->cycles_per_byte = static_cast<avr_cycle_count_t>(uart_frame(avr, u).cycles_per_bit) *
+                             static_cast<avr_cycle_count_t>(uart_frame(avr, u).bits());
     }
 
     avr_uart_t* uart_;
-    std::uint8_t ucsrc_ = 0x86;
+    std::uint8_t ucsrc_ = 0x86;  // reset value: 8N1 (URSEL reads one, UCSZ1:0 = 11)
     std::uint8_t ubrrh_ = 0;
     std::vector<std::unique_ptr<IoWriteHook>> hooks_;
 };
