@@ -52,6 +52,12 @@ std::string Uart::transmitted_text() const {
 Cycle Uart::cycles_per_frame() const { return uart_->cycles_per_byte; }
 
 void Uart::send(const std::string& bytes) {
+    // A host with something to say is connected: its TX idles high on RxD
+    // from now on, so a logic analyser sees each start bit as a falling edge.
+    if (!bytes.empty() && rx_pin_ != nullptr && !rx_from_line_ && !rx_line_held_) {
+        rx_line_held_ = true;
+        rx_pin_->drive(true);
+    }
     to_send_.insert(to_send_.end(), bytes.begin(), bytes.end());
     pump();
 }
@@ -127,6 +133,7 @@ void Uart::draw_host_frame(std::uint16_t value) {
 void Uart::listen_to_rx_line() {
     if (rx_from_line_ || rx_pin_ == nullptr) return;
     rx_from_line_ = true;
+    if (rx_line_held_) rx_pin_->release();  // the board's net drives RxD now
     rx_pin_->on_change([this](Cycle cycle, bool high) { on_rx_edge(cycle, high); });
 }
 

@@ -3,7 +3,8 @@
 // paced by simavr's receive FIFO (XON/XOFF IRQs) and held back until the
 // firmware has enabled its receiver, as a host would wait for the port.
 //
-// The RxDn pin (ATmega328P §20.7, Table 14-9). Bytes a host sends are drawn
+// The RxDn pin (ATmega328P §20.7, Table 14-9). From the first byte a host
+// queues, the pin idles high (the host's TX is connected); its bytes are drawn
 // on it as frames (start bit low, data LSB first, parity, stop bits high) at
 // the USART's bit time, one frame after the other from the moment each byte
 // enters simavr's receive FIFO, whose receive-complete flag follows one frame
@@ -104,6 +105,7 @@ private:
     Pin* rx_pin_;
     Cycle rx_line_free_at_ = 0;  // the end of the last host frame drawn on RxDn
     bool rx_from_line_ = false;
+    bool rx_line_held_ = false;  // RxD driven idle high since the first host byte was queued
     // The frame being read from the line: its start bit's cycle and the edges since.
     bool line_frame_active_ = false;
     Cycle line_frame_start_ = 0;

@@ -246,7 +246,7 @@ struct Workload {
     double simulated_s;
 };
 
-// Peak resident memory of `avrbench run <elf> --for <seconds>s --trace PB0
+// Peak resident memory of `avrbench run <elf> --for <seconds>s --trace-only PB0
 // --vcd <tmp>` in a child process (getrusage of the child), in MiB.
 double cli_peak_rss_mib(const std::string& elf, double seconds, const std::string& vcd_path) {
     const std::string for_arg = std::to_string(seconds) + "s";
@@ -254,7 +254,7 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
     if (pid == 0) {
         const int null_fd = open("/dev/null", O_WRONLY);
         dup2(null_fd, STDOUT_FILENO);
-        execl(AVRBENCH_CLI, AVRBENCH_CLI, "run", "-q", elf.c_str(), "--for", for_arg.c_str(), "--trace", "PB0", "--vcd",
+        execl(AVRBENCH_CLI, AVRBENCH_CLI, "run", "-q", elf.c_str(), "--for", for_arg.c_str(), "--trace-only", "PB0", "--vcd",
               vcd_path.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
@@ -359,7 +359,7 @@ int perf_main(int argc, char** argv) {
         return 0;
     }
     if (!rss_seconds.empty()) {
-        std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace PB0 --vcd", "sim s", "peak RSS MiB");
+        std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace-only PB0 --vcd", "sim s", "peak RSS MiB");
         for (const double seconds : rss_seconds) {
             const double mib = cli_peak_rss_mib(firmware_dir + "/toggle_1mhz.elf", seconds, vcd_path);
             std::printf("%-44s %9.0f %14.1f\n", "", seconds, mib);

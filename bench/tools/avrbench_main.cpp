@@ -61,8 +61,10 @@ struct RunArgs {
     bool strict = false;
     std::string mcu;
     std::string freq;
-    std::string trace;
+    std::string trace;       // pins added to what a run records by default
+    std::string trace_only;  // pins recorded instead of the defaults
     std::string vcd;
+    std::string vcd_buses = "bits";
     std::string duration = "1s";
     bool duration_given = false;
     bool until_sleep = false;
@@ -186,12 +188,12 @@ public:
     // 100 baud. The dump is written up to this far behind the simulation.
     static constexpr Picoseconds kSettleLagPs = 100 * kPsPerMs;
 
-    Waveforms(Timeline& timeline, std::string vcd_path, bool stream)
-        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()) {}
+    Waveforms(Timeline& timeline, std::string vcd_path, bool stream, VcdBuses buses)
+        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()), buses_(buses) {}
 
     // Once every signal is registered.
     void start() {
-        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_);
+        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_, buses_);
     }
     void drain(Picoseconds now_ps) {
         if (stream_) stream_->drain(timeline_, now_ps > kSettleLagPs ? now_ps - kSettleLagPs : 0);
@@ -200,11 +202,13 @@ public:
     std::string finish(const Mcu& clock) {
         if (path_.empty()) return "";
         VcdOptions vcd_options;
+        vcd_options.buses = buses_;
         vcd_options.end_cycle = clock.cycle();
         vcd_options.end_clock_hz = clock.frequency_hz();
         const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, path_, vcd_options);
         const std::string gtkw_path = with_extension(path_, ".gtkw");
         GtkwOptions gtkw_options;
+        gtkw_options.buses = buses_;
         gtkw_options.fit_end_time = vcd.end_time;
         gtkw_options.fit_timescale = vcd.timescale;
         // The save file names the dump relative to its own folder, which gtkwave
@@ -221,8 +225,11 @@ private:
     Timeline& timeline_;
     std::string path_;
     bool stream_wanted_;
+    VcdBuses buses_;
     std::unique_ptr<VcdStream> stream_;
 };
+
+VcdBuses vcd_buses(const RunArgs& args) { return args.vcd_buses == "vector" ? VcdBuses::Vector : VcdBuses::Bits; }
 
 void print_findings(const std::vector<Finding>& findings) {
     std::printf("  findings   %zu\n", findings.size());
@@ -270,11 +277,36 @@ void print_text_tail(const std::string& text, std::size_t max_lines) {
 // A crash of the firmware (the MCU's own oracles); part, net and host findings
 // fail a run only with --strict.
 // --trace: the recorder's error, named after the option that gave the list.
-void trace_pins_for_cli(Recorder& recorder, Mcu& mcu, const std::string& spec) {
+void trace_pins_for_cli(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option = "--trace") {
     try {
         recorder.trace_pins(mcu, spec);
     } catch (const BadInput& e) {
-        throw BadInput(std::string("--trace: ") + e.what());
+        throw BadInput(std::string(option) + ": " + e.what());
+    }
+}
+
+// On a board: PB5, PORTB or all name pins of every MCU; MCU.PB5, MCU.PORTB
+// or MCU.all those of one MCU.
+void trace_board_pins_for_cli(Recorder& recorder, Board& board, const std::string& spec, const char* option) {
+    if (spec.empty()) return;
+    std::string every_mcu;
+    std::map<std::string, std::string> per_mcu;
+    std::stringstream items(spec);
+    std::string item;
+    while (std::getline(items, item, ',')) {
+        const auto dot = item.find('.');
+        if (dot == std::string::npos) {
+            every_mcu += item + ",";
+            continue;
+        }
+        const std::string mcu = item.substr(0, dot);
+        if (board.spec().find_mcu(mcu) == nullptr)
+            throw BadInput(std::string(option) + ": '" + item + "': the board has no MCU '" + mcu + "'");
+        per_mcu[mcu] += item.substr(dot + 1) + ",";
+    }
+    for (Mcu* m : board.mcus()) {
+        if (!every_mcu.empty()) trace_pins_for_cli(recorder, *m, every_mcu, option);
+        if (const auto it = per_mcu.find(m->name()); it != per_mcu.end()) trace_pins_for_cli(recorder, *m, it->second, option);
     }
 }
 
@@ -428,11 +460,9 @@ BoardRun prepare_board_run(const RunArgs& args) {
         std::fflush(stdout);
     }
     if (!args.vcd.empty() || !args.report.empty()) {
-        if (!args.trace.empty()) {
-            for (Mcu* m : board.mcus()) trace_pins_for_cli(bench.recorder(), *m, args.trace);
-        } else {
-            bench.trace_board();
-        }
+        if (args.trace_only.empty()) bench.trace_board();
+        trace_board_pins_for_cli(bench.recorder(), board, args.trace_only.empty() ? args.trace : args.trace_only,
+                                 args.trace_only.empty() ? "--trace" : "--trace-only");
     }
     return run;
 }
@@ -538,7 +568,7 @@ int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome
 int run_board_command(const RunArgs& args) {
     BoardRun run = prepare_board_run(args);
     Bench& bench = *run.bench;
-    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty());
+    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_buses(args));
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -613,8 +643,10 @@ int run_command(const RunArgs& args) {
     Mcu mcu(elf, options);
     Timeline timeline;
     Recorder recorder(timeline);
-    const bool tracing = !args.vcd.empty() || !args.trace.empty();
-    if (tracing) trace_pins_for_cli(recorder, mcu, args.trace.empty() ? "all" : args.trace);
+    const bool tracing = !args.vcd.empty() || !args.trace.empty() || !args.trace_only.empty();
+    // The default on one MCU is every pin; --trace only checks its names then.
+    if (tracing && !args.trace.empty()) trace_pins_for_cli(recorder, mcu, args.trace);
+    if (tracing) trace_pins_for_cli(recorder, mcu, args.trace_only.empty() ? "all" : args.trace_only, "--trace-only");
 
     Uart* uart0 = nullptr;
     try {
@@ -622,14 +654,14 @@ int run_command(const RunArgs& args) {
     } catch (const BadInput&) {
         if (!args.uart_in.empty() || !args.uart_out.empty()) throw;
     }
-    if (uart0 != nullptr && tracing) {
+    if (uart0 != nullptr && tracing && args.trace_only.empty()) {
         recorder.trace_uart_tx(mcu, *uart0);
         recorder.trace_uart_rx(mcu, *uart0);
     }
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
     const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
-    Waveforms waveforms(timeline, args.vcd, true);
+    Waveforms waveforms(timeline, args.vcd, true, vcd_buses(args));
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -861,8 +893,17 @@ int main(int argc, char** argv) {
     run_cmd->add_flag("--strict", run.strict, "part findings (driver timing, axis crashes) also give exit code 1");
     run_cmd->add_option("--mcu", run.mcu, "MCU type, e.g. atmega328p (default: from the ELF's .mmcu section)");
     run_cmd->add_option("--freq", run.freq, "clock, e.g. 16MHz (default: from the ELF's .mmcu section)");
-    run_cmd->add_option("--trace", run.trace, "pins to record: PB5,PD2 | PORTB | all (default with --vcd: all)");
+    auto* trace_option = run_cmd->add_option(
+        "--trace", run.trace,
+        "pins to record besides the defaults: PB5,PD2 | PORTB | all; on a board MCU.PB5 for one MCU (defaults with "
+        "--vcd: every pin and USART on one MCU; a board's nets, labels, serial ports, I2C and parts)");
+    run_cmd->add_option("--trace-only", run.trace_only, "record only these pins, none of the defaults (same syntax as --trace)")
+        ->excludes(trace_option);
     run_cmd->add_option("--vcd", run.vcd, "write the recorded signals as VCD (+ a .gtkw save file beside it)");
+    run_cmd->add_option("--vcd-buses", run.vcd_buses,
+                        "bits (default: one 1-bit signal per bit, which sigrok/PulseView read; the .gtkw joins them) | "
+                        "vector (one VCD vector per bus)")
+        ->check(CLI::IsMember({"bits", "vector"}));
     run_cmd->add_option("--for", run.duration, "simulated time to run, e.g. 2s, 250ms (default 1s; with --gcode the limit for the job, default 60s)")
         ->each([&run](const std::string&) { run.duration_given = true; });
     run_cmd->add_option("--gcode", run.gcode, "stream this G-code file to the board's serial port (needs --board)");

@@ -25,11 +25,17 @@ namespace avrbench {
 namespace {
 
 // gtkwave's names for VCD variables: "scope.name", plus "[msb:0]" for vectors
-// declared without a range, which is how VcdWriter declares buses.
-std::string gtkwave_name(const SignalInfo& info) {
-    std::string name = info.scope + "." + info.name;
-    if (info.kind == SignalKind::Bus && info.width > 1) name += "[" + std::to_string(info.width - 1) + ":0]";
-    return name;
+// declared without a range, which is how VcdWriter declares buses. A bus
+// written as bits is one trace made of its bits: "#{scope.name[msb:0]}"
+// followed by "scope.name[msb]" ... "scope.name[0]", gtkwave's concatenation.
+std::string gtkwave_name(const SignalInfo& info, VcdBuses buses) {
+    const std::string name = info.scope + "." + info.name;
+    if (info.kind != SignalKind::Bus || info.width <= 1) return name;
+    const std::string range = "[" + std::to_string(info.width - 1) + ":0]";
+    if (buses == VcdBuses::Vector) return name + range;
+    std::string joined = "#{" + name + range + "}";
+    for (unsigned bit = info.width; bit-- > 0;) joined += " " + name + "[" + std::to_string(bit) + "]";
+    return joined;
 }
 
 // gtkwave's trace flags (its TR_* bits): 0x20 right-justify, 0x02 hex,
@@ -81,7 +87,7 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
         for (const SignalId id : group.signals) {
             const SignalInfo& info = infos[id];
             text += trace_flags(info);
-            text += gtkwave_name(info) + "\n";
+            text += gtkwave_name(info, options.buses) + "\n";
             if (info.kind == SignalKind::Real)
                 for (unsigned row = 0; row < options.analog_extra_rows; ++row) text += "@20000\n-\n";
         }
@@ -100,7 +106,7 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
             SignalInfo shown = infos[a.target];
             shown.scope = a.scope;
             shown.name = a.name;
-            text += trace_flags(shown) + gtkwave_name(shown) + "\n";
+            text += trace_flags(shown) + gtkwave_name(shown, options.buses) + "\n";
         }
         text += "@1000200\n-" + scope + "\n";
     }

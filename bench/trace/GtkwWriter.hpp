@@ -17,10 +17,14 @@
 #include <string>
 
 #include "trace/Timeline.hpp"
+#include "trace/VcdWriter.hpp"
 
 namespace avrbench {
 
 struct GtkwOptions {
+    // How the dump holds buses (VcdOptions::buses): written as bits, each bus
+    // is joined back into one trace ("#{scope.name[7:0]} scope.name[7] ...").
+    VcdBuses buses = VcdBuses::Bits;
     unsigned analog_extra_rows = 3;  // height of each real's plot beyond its own row
     bool groups_closed = false;      // start with groups collapsed (@c00200)
     // When non-zero: open zoomed so the dump's 0..fit_end_time (in units of

@@ -74,6 +74,7 @@ private:
 // value staged for the timestamp being assembled.
 struct SignalState {
     std::string code;  // VCD identifier
+    std::vector<std::string> bit_codes;  // VcdBuses::Bits: one per bit, bit 0 first (code unused)
     SignalKind kind = SignalKind::Wire;
     unsigned width = 1;
     std::uint64_t mask = 1;
@@ -91,12 +92,17 @@ public:
         : timeline_(timeline), options_(options), out_(out), timescale_(choose_timescale(timeline, options)) {
         const auto& infos = timeline.signals();
         signals_.resize(infos.size());
+        std::uint32_t next_code = 0;
         for (std::size_t id = 0; id < infos.size(); ++id) {
             SignalState& s = signals_[id];
             const SignalInfo& info = infos[id];
-            s.code = vcd_identifier(static_cast<std::uint32_t>(id));
             s.kind = info.kind;
             s.width = info.kind == SignalKind::Bus ? info.width : 1;
+            if (options.buses == VcdBuses::Bits && s.kind == SignalKind::Bus && s.width > 1) {
+                for (unsigned bit = 0; bit < s.width; ++bit) s.bit_codes.push_back(vcd_identifier(next_code++));
+            } else {
+                s.code = vcd_identifier(next_code++);
+            }
             s.mask = s.width >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.width) - 1;
             s.clock_hz = info.clock_hz;
             s.units_per_cycle = timescale_.units_per_cycle(info.clock_hz);
@@ -240,6 +246,20 @@ private:
         const auto& infos = timeline_.signals();
         auto declare = [&](SignalId id, const std::string& name) {
             const SignalState& s = signals_[id];
+            if (!s.bit_codes.empty()) {
+                // MSB first, as a vector's bits read; "name[i]" with no space, so
+                // every bit is a signal of its own name in every reader.
+                for (unsigned bit = s.width; bit-- > 0;) {
+                    out_.text("$var wire 1 ");
+                    out_.text(s.bit_codes[bit]);
+                    out_.character(' ');
+                    out_.text(name);
+                    out_.character('[');
+                    out_.number(bit);
+                    out_.text("] $end\n");
+                }
+                return;
+            }
             out_.text(s.kind == SignalKind::Real ? "$var real 64 " : "$var wire ");
             if (s.kind != SignalKind::Real) {
                 out_.number(s.width);
@@ -271,7 +291,19 @@ private:
         out_.text("$enddefinitions $end\n");
     }
 
-    void write_value(const SignalState& s, std::uint64_t value) {
+    // `previous` and `known`: what was written before, so a bus written as
+    // bits writes only the bits that changed.
+    void write_value(const SignalState& s, std::uint64_t value, std::uint64_t previous = 0, bool known = false) {
+        if (!s.bit_codes.empty()) {
+            const std::uint64_t changed = known ? (value ^ previous) & s.mask : s.mask;
+            for (unsigned bit = s.width; bit-- > 0;) {
+                if (((changed >> bit) & 1U) == 0) continue;
+                out_.character(((value >> bit) & 1U) != 0 ? '1' : '0');
+                out_.text(s.bit_codes[bit]);
+                out_.character('\n');
+            }
+            return;
+        }
         if (s.kind == SignalKind::Real) {
             out_.character('r');
             out_.real(std::bit_cast<double>(value));
@@ -288,10 +320,20 @@ private:
     }
 
     void write_unknown(const SignalState& s) {
+        if (!s.bit_codes.empty()) {
+            for (unsigned bit = s.width; bit-- > 0;) {
+                out_.character('z');
+                out_.text(s.bit_codes[bit]);
+                out_.character('\n');
+            }
+            return;
+        }
         if (s.kind == SignalKind::Real)
             out_.text("r0 ");
+        else if (s.kind == SignalKind::Bus)
+            out_.text(s.width == 1 ? "z" : "bz ");
         else
-            out_.text(s.width == 1 ? "x" : "bx ");
+            out_.text("x");
         out_.text(s.code);
         out_.character('\n');
     }
@@ -318,7 +360,7 @@ private:
                 stamped = true;
                 result_.end_time = time;
             }
-            write_value(s, s.staged);
+            write_value(s, s.staged, s.written, s.known);
             s.written = s.staged;
             s.known = true;
             ++result_.value_changes;
@@ -392,8 +434,8 @@ struct VcdStream::Impl {
         std::uint64_t sequence;
         TimelineEvent event;
     };
-    Impl(const Timeline& timeline, const std::string& path)
-        : file(path, "VCD"), path_copy(path), out(buffer, file.stream(), path_copy), emitter(timeline, no_options, out) {
+    Impl(const Timeline& timeline, const std::string& path, VcdBuses buses)
+        : no_options{buses, std::nullopt, 16000000}, file(path, "VCD"), path_copy(path), out(buffer, file.stream(), path_copy), emitter(timeline, no_options, out) {
         buffer.reserve(kFlushBytes + 4096);
         emitter.begin();
     }
@@ -434,8 +476,8 @@ struct VcdStream::Impl {
     std::uint64_t sequence = 0;
 };
 
-VcdStream::VcdStream(const Timeline& timeline, const std::string& path)
-    : impl_(std::make_unique<Impl>(timeline, path)) {}
+VcdStream::VcdStream(const Timeline& timeline, const std::string& path, VcdBuses buses)
+    : impl_(std::make_unique<Impl>(timeline, path, buses)) {}
 
 VcdStream::~VcdStream() = default;
 

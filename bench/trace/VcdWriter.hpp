@@ -12,11 +12,14 @@
 //   and an event that leaves a signal's value unchanged is dropped, so recorders
 //   may record blindly.
 // - $dumpvars at #0 gives each signal's value at time 0: its last event at
-//   time 0, else x for wires and buses and r0 for reals (VCD has no unknown
-//   real; record a value at cycle 0 when 0 would mislead).
-// - Wires and 1-bit buses are written as scalars (`1!`), wider buses as full-width
-//   binary (`b00100000 "`), reals in the shortest form that reads back to the
-//   same double (`r25.5 #`, std::to_chars; also `rinf`, `rnan`).
+//   time 0, else x for wires, z for buses (nothing on the bus yet: a byte
+//   stream before its first byte; viewers draw it as a neutral line, not as
+//   an error) and r0 for reals (VCD has no unknown real; record a value at
+//   cycle 0 when 0 would mislead).
+// - Wires and 1-bit buses are written as scalars (`1!`), wider buses as one
+//   scalar per bit (VcdBuses::Bits, the default) or full-width binary
+//   (`b00100000 "`), reals in the shortest form that reads back to the same
+//   double (`r25.5 #`, std::to_chars; also `rinf`, `rnan`).
 // - Signals are listed one $scope module per distinct SignalInfo::scope, scopes
 //   in order of first appearance, signals in registration order.
 #pragma once
@@ -30,7 +33,19 @@
 
 namespace avrbench {
 
+// How buses wider than one bit are written.
+enum class VcdBuses {
+    // One 1-bit wire per bit, `name[msb]` .. `name[0]`: every tool reads it
+    // (sigrok/PulseView's VCD input, libsigrok 0.5, takes 1-bit signals only
+    // and stops at the first vector value); the .gtkw file joins the bits
+    // back into one trace (GtkwOptions::buses).
+    Bits,
+    // One vector variable per bus (`b00100000 "`): gtkwave, surfer, Python's vcdvcd.
+    Vector,
+};
+
 struct VcdOptions {
+    VcdBuses buses = VcdBuses::Bits;
     // When set, the dump ends with #<time of end_cycle> so viewers show the whole
     // run, not just up to the last change. Ignored when earlier than the last change.
     std::optional<Cycle> end_cycle;
@@ -60,8 +75,9 @@ std::string format_vcd(const Timeline& timeline, const VcdOptions& options = {},
 // registered before the first drain (the header lists them).
 class VcdStream {
 public:
-    // Checks `path` and opens its temporary file (core/OutputFile).
-    VcdStream(const Timeline& timeline, const std::string& path);
+    // Checks `path` and opens its temporary file (core/OutputFile). `buses`
+    // as VcdOptions::buses (finish's options give only the end).
+    VcdStream(const Timeline& timeline, const std::string& path, VcdBuses buses = VcdBuses::Bits);
     ~VcdStream();
     VcdStream(const VcdStream&) = delete;
     VcdStream& operator=(const VcdStream&) = delete;
@@ -80,7 +96,8 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-// The VCD identifier code of the signal with id `index`: bijective base 94 over
+// The VCD identifier code number `index` (codes are handed out in signal
+// order, one per bit of a bus written as bits): bijective base 94 over
 // the printable characters '!'..'~', least significant digit first, so ids
 // 0..93 get one character and the next 94^2 = 8836 get two.
 std::string vcd_identifier(std::uint32_t index);

@@ -23,7 +23,7 @@ TEST(CliRun, BlinkWritesAVcdThatReadsBackWithTheTimerPeriod) {
     const auto dir = test::scratch_dir("cli-blink");
     const auto vcd = (dir / "blink.vcd").string();
     const auto r = test::run_command(kCli + " run " + quoted(test::firmware("blink_timer1")) +
-                                         " --for 10ms --trace PB5,PB1 --vcd " + quoted(vcd), dir);
+                                         " --for 10ms --trace-only PB5,PB1 --vcd " + quoted(vcd), dir);
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     // 10 ms at 16 MHz = 160000 cycles; the run stops at the first
     // instruction boundary at or after it (instructions take up to 5 cycles).

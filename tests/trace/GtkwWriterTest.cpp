@@ -33,6 +33,7 @@ std::size_t count(const std::string& text, const std::string& what) {
 TEST(GtkwWriter, OneGroupPerScopeWithFormatsPerKind) {
     GtkwOptions options;
     options.analog_extra_rows = 1;
+    options.buses = VcdBuses::Vector;
     const std::string text = format_gtkw(three_scopes(), "run.vcd", "run.gtkw", options);
     // Flags (gtkwave TR_* bits): 28 = bin|rjustify, 22 = hex|rjustify,
     // 8028 = analog step|bin|rjustify, 20000 = analog height row,
@@ -60,6 +61,17 @@ TEST(GtkwWriter, OneGroupPerScopeWithFormatsPerKind) {
     EXPECT_EQ(text, expected);
     EXPECT_EQ(count(text, "@800200\n"), 3u);   // one group per scope
     EXPECT_EQ(count(text, "@1000200\n"), 3u);
+}
+
+// A dump whose buses are bits (the default): each bus is one trace again,
+// gtkwave's concatenation "#{name[msb:0]} name[msb] ... name[0]".
+TEST(GtkwWriter, BusesWrittenAsBitsAreJoinedIntoOneTrace) {
+    const std::string text = format_gtkw(three_scopes(), "run.vcd", "run.gtkw");
+    EXPECT_NE(text.find("@22\n#{mcu.portb[7:0]} mcu.portb[7] mcu.portb[6] mcu.portb[5] mcu.portb[4] mcu.portb[3] "
+                        "mcu.portb[2] mcu.portb[1] mcu.portb[0]\n"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("@28\nmcu.flag\n"), std::string::npos) << text;  // a 1-bit bus stays one wire
 }
 
 TEST(GtkwWriter, ClosedGroupsAndDefaults) {

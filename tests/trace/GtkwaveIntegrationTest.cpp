@@ -175,7 +175,7 @@ TEST(GtkwaveAcceptsOurFiles, ViewerLoadsDumpThroughSaveFile) {
     auto values = run_gtkwave(dir, dir.file("demo.gtkw"), tcl);
     if (values.empty()) return;
 
-    EXPECT_EQ(values["FACS"], "4");
+    EXPECT_EQ(values["FACS"], "11");  // PB5, portb as 8 one-bit wires (joined again by the .gtkw), temp_degC, step
     EXPECT_EQ(values["DIM"], "p");
     EXPECT_EQ(values["MAXTIME"], "3000000000");  // end_cycle: 3 ms
     // 4 signals + a begin and an end marker per scope (3) + 3 analog height rows.

@@ -26,6 +26,14 @@ using trace_test::ScratchDir;
 constexpr std::uint32_t k16MHz = 16000000;
 constexpr std::uint32_t k20MHz = 20000000;
 
+// Buses as one VCD vector each (the format tests below); the default, one
+// wire per bit, has tests of its own (BusesAsBits*).
+VcdOptions vector_buses() {
+    VcdOptions options;
+    options.buses = VcdBuses::Vector;
+    return options;
+}
+
 // The part of a dump after its header.
 std::string body_of(const std::string& vcd) {
     const std::string marker = "$enddefinitions $end\n";
@@ -48,7 +56,7 @@ TEST(VcdWriter, SmallDumpMatchesHandWrittenText) {
     timeline.record(pb5, 32000, 0);
 
     VcdResult result;
-    const std::string vcd = format_vcd(timeline, {}, &result);
+    const std::string vcd = format_vcd(timeline, vector_buses(), &result);
     // Identifiers by registration order: PB5 '!', portb '"', temp_degC '#', PB4 '$'.
     // 16 MHz and 20 MHz -> 100ps; 16000 cycles at 16 MHz = 1 ms = 10^7 units;
     // 32000 at 16 MHz and 40000 at 20 MHz are both 2 ms = 2 * 10^7 units, written
@@ -70,7 +78,7 @@ TEST(VcdWriter, SmallDumpMatchesHandWrittenText) {
         "#0\n"
         "$dumpvars\n"
         "0!\n"
-        "bx \"\n"
+        "bz \"\n"  // a bus with nothing on it yet
         "r21.5 #\n"
         "x$\n"
         "$end\n"
@@ -85,6 +93,42 @@ TEST(VcdWriter, SmallDumpMatchesHandWrittenText) {
     EXPECT_TRUE(result.exact);
     EXPECT_EQ(result.value_changes, 4u);  // 1!, b00100000, r25.25, 0!
     EXPECT_EQ(result.end_time, 20000000u);
+}
+
+// The default: a bus is one 1-bit wire per bit, "name[i]", MSB declared
+// first, so readers that take only scalars (libsigrok 0.5's VCD input, and
+// with it PulseView and sigrok-cli) read the whole dump; only bits that
+// change are written. Aliases (net names) get the same bits under their name.
+TEST(VcdWriter, BusesAsBitsAreOneWirePerBitWithOnlyChangedBitsWritten) {
+    Timeline timeline;
+    const SignalId pin = timeline.add_signal({"mcu", "PD1", SignalKind::Wire, 1, k16MHz});
+    const SignalId tx = timeline.add_signal({"mcu", "tx", SignalKind::Bus, 3, k16MHz});
+    timeline.add_alias(tx, "nets", "link");
+    timeline.record(pin, 0, 1);
+    timeline.record(tx, 1, 0b101);
+    timeline.record(tx, 2, 0b100);  // only bit 0 changes
+    const std::string vcd = format_vcd(timeline);
+    // Codes: PD1 '!', tx bits 0, 1, 2 '"', '#', '$'.
+    const std::string expected_header_vars =
+        "$scope module mcu $end\n"
+        "$var wire 1 ! PD1 $end\n"
+        "$var wire 1 $ tx[2] $end\n"
+        "$var wire 1 # tx[1] $end\n"
+        "$var wire 1 \" tx[0] $end\n"
+        "$upscope $end\n"
+        "$scope module nets $end\n"
+        "$var wire 1 $ link[2] $end\n"
+        "$var wire 1 # link[1] $end\n"
+        "$var wire 1 \" link[0] $end\n"
+        "$upscope $end\n";
+    EXPECT_NE(vcd.find(expected_header_vars), std::string::npos) << vcd;
+    EXPECT_EQ(body_of(vcd),
+              "#0\n$dumpvars\n1!\nz$\nz#\nz\"\n$end\n"
+              "#625\n1$\n0#\n1\"\n"
+              "#1250\n0\"\n");
+    const VcdDump dump = parse_vcd(vcd);
+    EXPECT_EQ(dump.at("mcu.tx[2]").width, 1u);
+    EXPECT_EQ(dump.at("nets.link[0]").id, dump.at("mcu.tx[0]").id);
 }
 
 TEST(VcdWriter, TimestampsAreExactCycleTimesAt16And20MHz) {
@@ -150,16 +194,16 @@ TEST(VcdWriter, BusAndRealFormatting) {
     const double reals[] = {0.1, 1e-7, -0.0, 1.0 / 3.0, 1e300, 100.0, std::numeric_limits<double>::infinity()};
     Cycle cycle = 3;
     for (const double value : reals) timeline.record_real(real, cycle++, value);
-    const std::string body = body_of(format_vcd(timeline));
+    const std::string body = body_of(format_vcd(timeline, vector_buses()));
     const std::string ones64(64, '1');
     EXPECT_EQ(body,
-              "#0\n$dumpvars\nbx !\nbx \"\nx#\nr0 $\n$end\n"
+              "#0\n$dumpvars\nbz !\nbz \"\nz#\nr0 $\n$end\n"
               "#625\nb11111111 !\nb" + ones64 + " \"\n1#\n"
               "#1250\nb00000101 !\n"
               // shortest round-trip text (std::to_chars): -0 differs from 0 in its bits, so it is written
               "#1875\nr0.1 $\n#2500\nr1e-07 $\n#3125\nr-0 $\n#3750\nr0.3333333333333333 $\n"
               "#4375\nr1e+300 $\n#5000\nr100 $\n#5625\nrinf $\n");
-    const VcdDump dump = parse_vcd(format_vcd(timeline));
+    const VcdDump dump = parse_vcd(format_vcd(timeline, vector_buses()));
     const auto& changes = dump.at("m.real").changes;
     ASSERT_EQ(changes.size(), 8u);  // r0 + 7 values
     EXPECT_EQ(std::stod(changes[4].value), 1.0 / 3.0);  // reads back bit-exact
@@ -176,7 +220,7 @@ TEST(VcdWriter, InitialValuesComeFromTimeZeroEventsElseUnknown) {
     timeline.record_real(real, 5, 0.0);  // r0 already shown: nothing to write
     timeline.record(bus, 1, 0xA);        // unchanged
     VcdResult result;
-    EXPECT_EQ(body_of(format_vcd(timeline, {}, &result)), "#0\n$dumpvars\n0!\nb1010 \"\nr0 #\n$end\n");
+    EXPECT_EQ(body_of(format_vcd(timeline, vector_buses(), &result)), "#0\n$dumpvars\n0!\nb1010 \"\nr0 #\n$end\n");
     EXPECT_EQ(result.value_changes, 0u);
     EXPECT_EQ(result.end_time, 0u);
 }
@@ -229,7 +273,7 @@ TEST(VcdWriter, RoundTripsThroughTheReader) {
         timeline.record(port, cycle, cycle / 100);
         timeline.record_real(temp, cycle, 20.0 + static_cast<double>(cycle) / 1000.0);
     }
-    const VcdDump dump = parse_vcd(format_vcd(timeline));
+    const VcdDump dump = parse_vcd(format_vcd(timeline, vector_buses()));
     EXPECT_EQ(dump.version, "avrbench " AVRBENCH_VERSION);
     EXPECT_EQ(dump.timescale, "100ps");
     EXPECT_EQ(dump.timescale_fs, 100000u);
@@ -247,8 +291,8 @@ TEST(VcdWriter, RoundTripsThroughTheReader) {
 
     const VcdVariable& v_port = dump.at("mcu.portb");
     EXPECT_EQ(v_port.width, 8u);
-    ASSERT_EQ(v_port.changes.size(), 11u);  // bx, then 1..10
-    EXPECT_EQ(v_port.changes[0].value, "x");
+    ASSERT_EQ(v_port.changes.size(), 11u);  // bz, then 1..10
+    EXPECT_EQ(v_port.changes[0].value, "z");
     EXPECT_EQ(v_port.changes[10].time, 625000u);
     EXPECT_EQ(v_port.changes[10].value, "00001010");
 

@@ -1,0 +1,101 @@
+// sigrok (sigrok-cli, the command-line face of PulseView's libsigrok and
+// libsigrokdecode) must read the VCDs `avrbench run` writes: to their end,
+// every signal, and its protocol decoders must find in them what the bench
+// itself reports. Debian's sigrok-cli 0.7 / libsigrok 0.5 reads 1-bit signals
+// only and stops at the first vector value, which is why buses are written
+// as one wire per bit by default (VcdBuses::Bits).
+//
+// sigrok-cli comes from ci/setup; a missing tool fails the test.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/Paths.hpp"
+#include "trace/TraceTestSupport.hpp"
+
+namespace avrbench {
+namespace {
+
+using trace_test::quoted;
+using trace_test::read_text;
+using trace_test::ScratchDir;
+
+std::string sigrok_cli() {
+    const std::string path = trace_test::find_program("sigrok-cli");
+    if (path.empty()) ADD_FAILURE() << "sigrok-cli not found on PATH: run ci/setup (it installs Debian's sigrok-cli)";
+    return path;
+}
+
+// Runs sigrok-cli on `vcd` with `arguments`; its standard output. The VCD's
+// unit is 100 ps: downsample=625 gives one sample per 16 MHz cycle.
+std::string sigrok(const ScratchDir& dir, const std::string& vcd, const std::string& arguments) {
+    const std::string out = dir.file("sigrok.out");
+    const int status = trace_test::run_command(
+        "timeout 120 " + quoted(sigrok_cli()) + " -I vcd:downsample=625 -i " + quoted(vcd) + " " + arguments, out);
+    EXPECT_EQ(status, 0) << read_text(out);
+    return read_text(out);
+}
+
+// The bytes of the UART decoder's "uart-1: 61" lines.
+std::string decoded_bytes(const std::string& sigrok_output) {
+    std::string bytes;
+    std::istringstream lines(sigrok_output);
+    std::string line;
+    while (std::getline(lines, line)) {
+        const auto colon = line.find(": ");
+        if (line.rfind("uart-", 0) != 0 || colon == std::string::npos) continue;
+        bytes.push_back(static_cast<char>(std::stoi(line.substr(colon + 2), nullptr, 16)));
+    }
+    return bytes;
+}
+
+// uart_echo at 115200 baud with U2X (UBRR = 16: 16 MHz / (8 x 17) = 117 647
+// baud, §20.3.1 Table 20-1; the decoder is given that rate): sigrok's UART
+// decoder on TXD (PD1) reads exactly what --uart-out wrote, and on RXD (PD0)
+// exactly what --uart-in sent.
+TEST(SigrokReadsOurVcd, UartDecoderOnTxdAndRxdMatchesTheBytes) {
+    ScratchDir dir;
+    const std::string input = "hello, sigrok\n";
+    trace_test::write_text(dir.file("in.txt"), input);
+    const int status = trace_test::run_command(
+        quoted(AVRBENCH_CLI) + " run -q " + quoted(test::firmware("uart_echo")) + " --for 5ms --uart-in " +
+            quoted(dir.file("in.txt")) + " --uart-out " + quoted(dir.file("out.txt")) + " --vcd " + quoted(dir.file("u.vcd")),
+        dir.file("run.log"));
+    ASSERT_EQ(status, 0) << read_text(dir.file("run.log"));
+    const std::string sent_by_firmware = read_text(dir.file("out.txt"));
+    ASSERT_GT(sent_by_firmware.size(), input.size());  // banner + echo
+    // 5 ms at 16 MHz: 80 000 samples; libsigrok read the whole file.
+    EXPECT_NE(sigrok(dir, dir.file("u.vcd"), "--show").find("Logic sample count: 80000\n"), std::string::npos);
+    EXPECT_EQ(decoded_bytes(sigrok(dir, dir.file("u.vcd"), "-P uart:rx=PD1:baudrate=117647 -A uart=rx-data")),
+              sent_by_firmware);
+    EXPECT_EQ(decoded_bytes(sigrok(dir, dir.file("u.vcd"), "-P uart:rx=PD0:baudrate=117647 -A uart=rx-data")), input);
+}
+
+// A two-MCU board (Wire master on an UNO, slave on a Mega): sigrok reads the
+// dump to its end and lists each board net under its board-file name.
+TEST(SigrokReadsOurVcd, BoardDumpIsReadToItsEndWithNetNames) {
+    ScratchDir dir;
+    trace_test::write_text(dir.file("wire.yaml"),
+                           "mcus:\n"
+                           "  uno: {type: atmega328p, clock: 16MHz}\n"
+                           "  mega: {type: atmega2560, clock: 16MHz}\n"
+                           "nets:\n"
+                           "  sda: [uno.PC4, mega.PD1]\n"
+                           "  scl: [uno.PC5, mega.PD0]\n");
+    const int status = trace_test::run_command(
+        quoted(AVRBENCH_CLI) + " run -q --board " + quoted(dir.file("wire.yaml")) + " " +
+            quoted(test::firmware("ard_wire_master")) + " --firmware mega=" + quoted(test::firmware("ard_wire_slave_mega")) +
+            " --for 30ms --vcd " + quoted(dir.file("w.vcd")),
+        dir.file("run.log"));
+    ASSERT_EQ(status, 0) << read_text(dir.file("run.log"));
+    const std::string shown = sigrok(dir, dir.file("w.vcd"), "--show");
+    EXPECT_NE(shown.find("Logic sample count: 480000\n"), std::string::npos) << shown;  // 30 ms x 16 MHz
+    EXPECT_NE(shown.find("- sda: logic\n"), std::string::npos) << shown;
+    EXPECT_NE(shown.find("- scl: logic\n"), std::string::npos) << shown;
+    EXPECT_NE(shown.find("- twi[7]: logic\n"), std::string::npos) << shown;  // a bus, as bits
+}
+
+}  // namespace
+}  // namespace avrbench
