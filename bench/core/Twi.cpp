@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/CycleAt.hpp"
 #include "core/Scheduler.hpp"
+#include "core/fixes/CompareOutputPins.hpp"
 #include "core/fixes/Fix.hpp"
 
 extern "C" {
@@ -84,7 +86,8 @@ std::unique_ptr<Twi> Twi::install(avr_t* avr, const std::string& mcu_type, Sched
         auto* module = reinterpret_cast<avr_twi_t*>(io);
         const Registers r{module->r_twbr, module->r_twsr, module->r_twar,
                           module->r_twdr, module->r_twcr, module->r_twamr};
-        return std::unique_ptr<Twi>(new Twi(avr, r, &module->twi, false, scheduler, std::move(owner_name)));
+        return std::unique_ptr<Twi>(
+            new Twi(avr, r, &module->twi, false, scheduler, std::move(owner_name), twi_pins(mcu_type)));
     }
     if (mcu_type == "atmega32") {
         // Registers from the ATmega32 datasheet's register summary (I/O
@@ -96,20 +99,21 @@ std::unique_ptr<Twi> Twi::install(avr_t* avr, const std::string& mcu_type, Sched
         vector->raised = AVR_IO_REGBIT(0x56, 7);  // TWINT
         vector->raise_sticky = 1;                 // the ISR does not clear TWINT (§22.9.2)
         avr_register_vector(avr, vector);
-        return std::unique_ptr<Twi>(new Twi(avr, r, vector, true, scheduler, std::move(owner_name)));
+        return std::unique_ptr<Twi>(new Twi(avr, r, vector, true, scheduler, std::move(owner_name), twi_pins(mcu_type)));
     }
     return nullptr;
 }
 
 Twi::Twi(avr_t* avr, Registers registers, avr_int_vector_t* vector, bool own_vector, Scheduler& scheduler,
-         std::string owner_name)
+         std::string owner_name, TwiPins pins)
     : avr_(avr),
       registers_(registers),
       vector_(vector),
       own_vector_(own_vector),
       scheduler_(scheduler),
       owner_name_(std::move(owner_name)),
-      own_bus_(std::make_unique<TwiBus>()) {
+      own_bus_(std::make_unique<TwiBus>()),
+      pins_(std::move(pins)) {
     control_hook_ = std::make_unique<IoWriteHook>(avr, registers_.twcr, &Twi::on_control_write, this);
     data_hook_ = std::make_unique<IoWriteHook>(avr, registers_.twdr, &Twi::on_data_write, this);
     status_hook_ = std::make_unique<IoWriteHook>(avr, registers_.twsr, &Twi::on_status_write, this);
@@ -145,6 +149,7 @@ void Twi::attach(TwiBus& bus) {
 
 void Twi::reset() {
     if (bus_ != nullptr) bus_->drop(*this);
+    release_lines();
     addressed_ = transmitting_ = general_call_ = last_byte_ = start_pending_ = false;
     last_status_ = status::kNoState;
     avr_clear_interrupt(avr_, vector_);
@@ -248,9 +253,37 @@ void Twi::disable() {
     // §22.9.2 TWEN: "writing it to zero switches the TWI off, and all TWI
     // transmissions are terminated, regardless of any ongoing operation".
     bus_->drop(*this);
+    release_lines();
     addressed_ = transmitting_ = general_call_ = last_byte_ = start_pending_ = false;
     clear_interrupt_flag();
     last_status_ = status::kNoState;
+}
+
+void Twi::draw(Line line, bool low, Cycle at) {
+    if (line_low_[line] == low) return;
+    line_low_[line] = low;
+    if (line_driver_[line] == -2) {
+        CompareOutputPins* outputs = CompareOutputPins::of(avr_);
+        const std::string& name = line == kSda ? pins_.sda : pins_.scl;
+        line_driver_[line] = outputs != nullptr && name.size() == 3 ? outputs->add_forced_output(name[1], name[2] - '0') : -1;
+    }
+    const int driver = line_driver_[line];
+    if (driver < 0) return;
+    scheduler_.at(at, [this, driver, low](Cycle cycle) {
+        CompareOutputPins* outputs = CompareOutputPins::of(avr_);
+        if (outputs == nullptr) return;
+        const CycleAt stamp(avr_, cycle);
+        outputs->set(driver, low, false);  // pulled low, or let go to the pull-ups
+    });
+}
+
+void Twi::release_lines() {
+    // At once: a reset or TWEN = 0 lets both lines go (§22.9.2).
+    for (const Line line : {kSda, kScl}) {
+        line_low_[line] = false;
+        if (line_driver_[line] < 0) continue;
+        if (CompareOutputPins* outputs = CompareOutputPins::of(avr_)) outputs->set(line_driver_[line], false, false);
+    }
 }
 
 void Twi::act() {
@@ -370,8 +403,60 @@ void TwiBus::request(Twi& master, Op op, bool then_start) {
     begin(op, then_start);
 }
 
+void TwiBus::draw(Op op) {
+    Twi& m = *master_;
+    const Cycle t0 = m.avr_->cycle;
+    const Cycle period = m.scl_period_cycles();
+    const Cycle quarter = period / 4;
+    switch (op) {
+    case Op::Start:
+        // From idle both lines are up already; a repeated START first lets
+        // SDA and then SCL go (Figure 22-6, "REPEATED START").
+        m.draw(Twi::kSda, false, t0);
+        m.draw(Twi::kScl, false, t0 + quarter);
+        m.draw(Twi::kSda, true, t0 + 2 * quarter);
+        m.draw(Twi::kScl, true, t0 + period);
+        return;
+    case Op::Address:
+    case Op::Write:
+    case Op::Read: {
+        // Eight bits MSB first, then the receiver's ACK (low) or NACK; each
+        // bit changes SDA while SCL is low, SCL is high for the middle half.
+        std::uint8_t byte = 0xFF;
+        bool acked = false;
+        if (op == Op::Read) {
+            if (slave_ != nullptr && slave_->addressed_ && slave_->transmitting_) byte = slave_->data();
+            acked = m.control_bit(kTwea);
+        } else if (op == Op::Address) {
+            byte = m.data();
+            bool general_call = false;
+            acked = find_slave(byte, general_call) != nullptr;
+        } else {
+            byte = m.data();
+            acked = slave_ != nullptr && slave_->addressed_ && !slave_->transmitting_ && slave_->control_bit(kTwea);
+        }
+        for (int bit = 0; bit < 9; ++bit) {
+            const bool high = bit < 8 ? ((byte >> (7 - bit)) & 1) != 0 : !acked;
+            const Cycle begins = t0 + static_cast<Cycle>(bit) * period;
+            m.draw(Twi::kSda, !high, begins + quarter);
+            m.draw(Twi::kScl, false, begins + 2 * quarter);
+            m.draw(Twi::kScl, true, begins + period);
+        }
+        return;
+    }
+    case Op::Stop:
+        m.draw(Twi::kSda, true, t0 + quarter);
+        m.draw(Twi::kScl, false, t0 + 2 * quarter);
+        m.draw(Twi::kSda, false, t0 + 3 * quarter);
+        return;
+    case Op::None:
+        return;
+    }
+}
+
 void TwiBus::begin(Op op, bool then_start) {
     const bool byte = op == Op::Address || op == Op::Write || op == Op::Read;
+    draw(op);
     const Cycle duration = (byte ? 9 : 1) * master_->scl_period_cycles();
     const std::uint64_t generation = ++generation_;
     in_flight_ = true;

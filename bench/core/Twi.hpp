@@ -17,8 +17,17 @@
 // 4^TWPS)): a byte with its ACK takes 9 SCL periods; START, repeated START and
 // STOP take one (the datasheet gives no figure for the status latency of
 // these; one period covers the setup and hold times of §28.7).
+// SDA and SCL on the pins (§22.3, Figures 22-3..22-6): the master of each
+// operation draws it on its own SDA and SCL as an open-drain output (pulled
+// low, or let go to the pull-ups), in quarters of an SCL period: START pulls
+// SDA low while SCL is high, every bit sets SDA while SCL is low and raises
+// SCL in the middle of the period, the ninth bit carries the receiver's ACK
+// (low) or NACK, STOP lets SDA go while SCL is high. The slave's bits (its
+// ACKs, the bytes it transmits) are drawn by the master too, which is what a
+// logic analyser on the nets sees; on the MCUs' own pins the board's nets
+// carry it to the others.
 // Not modelled: arbitration between two masters (a second START waits for
-// the bus to be free), the pins' electrical levels while TWEN is set, PRTWI.
+// the bus to be free), PRTWI.
 #pragma once
 
 #include <cstdint>
@@ -89,7 +98,7 @@ private:
         std::uint16_t twbr, twsr, twar, twdr, twcr, twamr;
     };
     Twi(avr_t* avr, Registers registers, avr_int_vector_t* vector, bool own_vector, Scheduler& scheduler,
-        std::string owner_name);
+        std::string owner_name, TwiPins pins);
 
     static void on_control_write(IoWriteHook& hook, avr_t* avr, std::uint16_t addr, std::uint8_t value);
     static void on_data_write(IoWriteHook& hook, avr_t* avr, std::uint16_t addr, std::uint8_t value);
@@ -113,6 +122,12 @@ private:
     // The firmware cleared TWINT (or started from idle): act on TWSTA/TWSTO/TWDR.
     void act();
     void disable();
+
+    // The master's drawing of SDA and SCL: pull `line` low or let it go at
+    // cycle `at` (open drain; nothing when the pins are unknown).
+    enum Line : std::uint8_t { kSda = 0, kScl = 1 };
+    void draw(Line line, bool low, Cycle at);
+    void release_lines();
 
     avr_t* avr_;
     Registers registers_;
@@ -138,6 +153,10 @@ private:
     bool start_pending_ = false;  // TWSTA while the bus belongs to another master
     std::function<void()> sync_;
     std::uint8_t last_status_ = 0xF8;  // TWSR's status as the firmware last saw it with TWINT
+
+    TwiPins pins_;
+    int line_driver_[2] = {-2, -2};       // forced-output drivers of SDA, SCL; -2 not asked yet, -1 none
+    bool line_low_[2] = {false, false};   // as last drawn (scheduled)
 };
 
 // The wires SDA and SCL between TWI modules: who owns the bus, who is
@@ -160,6 +179,8 @@ private:
     // A master operation; begins now or once the addressed slave releases SCL.
     void request(Twi& master, Op op, bool then_start = false);
     void begin(Op op, bool then_start);
+    // Draws the operation on the master's SDA and SCL pins as it begins.
+    void draw(Op op);
     void complete(Op op, bool then_start);
     // The addressed slave cleared TWINT: SCL is free again.
     void slave_released(Twi& slave);

@@ -64,7 +64,7 @@ struct RunArgs {
     std::string trace;       // pins added to what a run records by default
     std::string trace_only;  // pins recorded instead of the defaults
     std::string vcd;
-    std::string vcd_buses = "bits";
+    std::string vcd_format = "portable";
     std::string duration = "1s";
     bool duration_given = false;
     bool until_sleep = false;
@@ -188,12 +188,12 @@ public:
     // 100 baud. The dump is written up to this far behind the simulation.
     static constexpr Picoseconds kSettleLagPs = 100 * kPsPerMs;
 
-    Waveforms(Timeline& timeline, std::string vcd_path, bool stream, VcdBuses buses)
-        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()), buses_(buses) {}
+    Waveforms(Timeline& timeline, std::string vcd_path, bool stream, const VcdOptions& layout)
+        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()), layout_(layout) {}
 
     // Once every signal is registered.
     void start() {
-        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_, buses_);
+        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_, layout_);
     }
     void drain(Picoseconds now_ps) {
         if (stream_) stream_->drain(timeline_, now_ps > kSettleLagPs ? now_ps - kSettleLagPs : 0);
@@ -201,14 +201,13 @@ public:
     // Writes the rest (or all) and the save file; returns the save file's path.
     std::string finish(const Mcu& clock) {
         if (path_.empty()) return "";
-        VcdOptions vcd_options;
-        vcd_options.buses = buses_;
+        VcdOptions vcd_options = layout_;
         vcd_options.end_cycle = clock.cycle();
         vcd_options.end_clock_hz = clock.frequency_hz();
         const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, path_, vcd_options);
         const std::string gtkw_path = with_extension(path_, ".gtkw");
         GtkwOptions gtkw_options;
-        gtkw_options.buses = buses_;
+        gtkw_options.buses = layout_.buses;
         gtkw_options.fit_end_time = vcd.end_time;
         gtkw_options.fit_timescale = vcd.timescale;
         // The save file names the dump relative to its own folder, which gtkwave
@@ -225,11 +224,19 @@ private:
     Timeline& timeline_;
     std::string path_;
     bool stream_wanted_;
-    VcdBuses buses_;
+    VcdOptions layout_;
     std::unique_ptr<VcdStream> stream_;
 };
 
-VcdBuses vcd_buses(const RunArgs& args) { return args.vcd_buses == "vector" ? VcdBuses::Vector : VcdBuses::Bits; }
+// --vcd-format: portable (every reader, sigrok included) or compact (gtkwave's vectors and shared codes).
+VcdOptions vcd_layout(const RunArgs& args) {
+    VcdOptions layout;
+    if (args.vcd_format == "compact") {
+        layout.buses = VcdBuses::Vector;
+        layout.alias_codes = false;
+    }
+    return layout;
+}
 
 void print_findings(const std::vector<Finding>& findings) {
     std::printf("  findings   %zu\n", findings.size());
@@ -568,7 +575,7 @@ int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome
 int run_board_command(const RunArgs& args) {
     BoardRun run = prepare_board_run(args);
     Bench& bench = *run.bench;
-    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_buses(args));
+    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_layout(args));
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -661,7 +668,7 @@ int run_command(const RunArgs& args) {
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
     const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
-    Waveforms waveforms(timeline, args.vcd, true, vcd_buses(args));
+    Waveforms waveforms(timeline, args.vcd, true, vcd_layout(args));
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -900,10 +907,10 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--trace-only", run.trace_only, "record only these pins, none of the defaults (same syntax as --trace)")
         ->excludes(trace_option);
     run_cmd->add_option("--vcd", run.vcd, "write the recorded signals as VCD (+ a .gtkw save file beside it)");
-    run_cmd->add_option("--vcd-buses", run.vcd_buses,
-                        "bits (default: one 1-bit signal per bit, which sigrok/PulseView read; the .gtkw joins them) | "
-                        "vector (one VCD vector per bus)")
-        ->check(CLI::IsMember({"bits", "vector"}));
+    run_cmd->add_option("--vcd-format", run.vcd_format,
+                        "portable (default: 1-bit signals only, nets under their own codes: sigrok/PulseView read it; "
+                        "the .gtkw joins bus bits again) | compact (vectors for buses, nets sharing their pin's code: smaller)")
+        ->check(CLI::IsMember({"portable", "compact"}));
     run_cmd->add_option("--for", run.duration, "simulated time to run, e.g. 2s, 250ms (default 1s; with --gcode the limit for the job, default 60s)")
         ->each([&run](const std::string&) { run.duration_given = true; });
     run_cmd->add_option("--gcode", run.gcode, "stream this G-code file to the board's serial port (needs --board)");

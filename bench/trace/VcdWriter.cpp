@@ -73,8 +73,13 @@ private:
 // Per-signal writer state: how to format it, what was last written, and the
 // value staged for the timestamp being assembled.
 struct SignalState {
-    std::string code;  // VCD identifier
-    std::vector<std::string> bit_codes;  // VcdBuses::Bits: one per bit, bit 0 first (code unused)
+    // VCD identifiers: one per bit when the bus is written as bits (bit 0
+    // first), else one; then the same again for every alias that has codes
+    // of its own (VcdOptions::alias_codes), in alias order.
+    std::vector<std::string> codes;
+    bool as_bits = false;
+    unsigned codes_per_copy() const { return as_bits ? width : 1; }
+    std::size_t copies() const { return codes.size() / codes_per_copy(); }
     SignalKind kind = SignalKind::Wire;
     unsigned width = 1;
     std::uint64_t mask = 1;
@@ -98,14 +103,21 @@ public:
             const SignalInfo& info = infos[id];
             s.kind = info.kind;
             s.width = info.kind == SignalKind::Bus ? info.width : 1;
-            if (options.buses == VcdBuses::Bits && s.kind == SignalKind::Bus && s.width > 1) {
-                for (unsigned bit = 0; bit < s.width; ++bit) s.bit_codes.push_back(vcd_identifier(next_code++));
-            } else {
-                s.code = vcd_identifier(next_code++);
-            }
+            s.as_bits = options.buses == VcdBuses::Bits && s.kind == SignalKind::Bus && s.width > 1;
+            for (unsigned i = 0; i < s.codes_per_copy(); ++i) s.codes.push_back(vcd_identifier(next_code++));
             s.mask = s.width >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.width) - 1;
             s.clock_hz = info.clock_hz;
             s.units_per_cycle = timescale_.units_per_cycle(info.clock_hz);
+        }
+        // Aliases: the target's codes, or codes of their own after every signal's.
+        for (const auto& alias : timeline.aliases()) {
+            SignalState& s = signals_.at(alias.target);
+            if (!options.alias_codes) {
+                alias_copy_.push_back(0);
+                continue;
+            }
+            alias_copy_.push_back(s.copies());
+            for (unsigned i = 0; i < s.codes_per_copy(); ++i) s.codes.push_back(vcd_identifier(next_code++));
         }
     }
 
@@ -244,14 +256,15 @@ private:
         out_.text(" $end\n");
 
         const auto& infos = timeline_.signals();
-        auto declare = [&](SignalId id, const std::string& name) {
+        auto declare = [&](SignalId id, const std::string& name, std::size_t copy) {
             const SignalState& s = signals_[id];
-            if (!s.bit_codes.empty()) {
+            const std::string* codes = &s.codes[copy * s.codes_per_copy()];
+            if (s.as_bits) {
                 // MSB first, as a vector's bits read; "name[i]" with no space, so
                 // every bit is a signal of its own name in every reader.
                 for (unsigned bit = s.width; bit-- > 0;) {
                     out_.text("$var wire 1 ");
-                    out_.text(s.bit_codes[bit]);
+                    out_.text(codes[bit]);
                     out_.character(' ');
                     out_.text(name);
                     out_.character('[');
@@ -265,7 +278,7 @@ private:
                 out_.number(s.width);
                 out_.character(' ');
             }
-            out_.text(s.code);
+            out_.text(codes[0]);
             out_.character(' ');
             out_.text(name);
             out_.text(" $end\n");
@@ -282,9 +295,10 @@ private:
             out_.text("$scope module ");
             out_.text(group.scope);
             out_.text(" $end\n");
-            for (const SignalId id : group.signals) declare(id, infos[id].name);
-            for (const auto& alias : timeline_.aliases()) {
-                if (alias.scope == group.scope) declare(alias.target, alias.name);
+            for (const SignalId id : group.signals) declare(id, infos[id].name, 0);
+            const auto& aliases = timeline_.aliases();
+            for (std::size_t a = 0; a < aliases.size(); ++a) {
+                if (aliases[a].scope == group.scope) declare(aliases[a].target, aliases[a].name, alias_copy_[a]);
             }
             out_.text("$upscope $end\n");
         }
@@ -292,50 +306,54 @@ private:
     }
 
     // `previous` and `known`: what was written before, so a bus written as
-    // bits writes only the bits that changed.
+    // bits writes only the bits that changed. Every copy (aliases with codes
+    // of their own) gets the same change.
     void write_value(const SignalState& s, std::uint64_t value, std::uint64_t previous = 0, bool known = false) {
-        if (!s.bit_codes.empty()) {
-            const std::uint64_t changed = known ? (value ^ previous) & s.mask : s.mask;
-            for (unsigned bit = s.width; bit-- > 0;) {
-                if (((changed >> bit) & 1U) == 0) continue;
-                out_.character(((value >> bit) & 1U) != 0 ? '1' : '0');
-                out_.text(s.bit_codes[bit]);
-                out_.character('\n');
+        const unsigned per_copy = s.codes_per_copy();
+        for (std::size_t copy = 0; copy < s.copies(); ++copy) {
+            const std::string* codes = &s.codes[copy * per_copy];
+            if (s.as_bits) {
+                const std::uint64_t changed = known ? (value ^ previous) & s.mask : s.mask;
+                for (unsigned bit = s.width; bit-- > 0;) {
+                    if (((changed >> bit) & 1U) == 0) continue;
+                    out_.character(((value >> bit) & 1U) != 0 ? '1' : '0');
+                    out_.text(codes[bit]);
+                    out_.character('\n');
+                }
+                continue;
             }
-            return;
+            if (s.kind == SignalKind::Real) {
+                out_.character('r');
+                out_.real(std::bit_cast<double>(value));
+                out_.character(' ');
+            } else if (s.width == 1) {
+                out_.character(value != 0 ? '1' : '0');
+            } else {
+                out_.character('b');
+                out_.binary(value, s.width);
+                out_.character(' ');
+            }
+            out_.text(codes[0]);
+            out_.character('\n');
         }
-        if (s.kind == SignalKind::Real) {
-            out_.character('r');
-            out_.real(std::bit_cast<double>(value));
-            out_.character(' ');
-        } else if (s.width == 1) {
-            out_.character(value != 0 ? '1' : '0');
-        } else {
-            out_.character('b');
-            out_.binary(value, s.width);
-            out_.character(' ');
-        }
-        out_.text(s.code);
-        out_.character('\n');
     }
 
     void write_unknown(const SignalState& s) {
-        if (!s.bit_codes.empty()) {
-            for (unsigned bit = s.width; bit-- > 0;) {
+        const unsigned per_copy = s.codes_per_copy();
+        for (std::size_t i = 0; i < s.codes.size(); ++i) {
+            // MSB first within each copy, as write_value writes bits.
+            const std::string& code = s.codes[(i / per_copy) * per_copy + (per_copy - 1 - i % per_copy)];
+            if (s.as_bits || (s.kind == SignalKind::Bus && s.width == 1))
                 out_.character('z');
-                out_.text(s.bit_codes[bit]);
-                out_.character('\n');
-            }
-            return;
+            else if (s.kind == SignalKind::Real)
+                out_.text("r0 ");
+            else if (s.kind == SignalKind::Bus)
+                out_.text("bz ");
+            else
+                out_.character('x');
+            out_.text(code);
+            out_.character('\n');
         }
-        if (s.kind == SignalKind::Real)
-            out_.text("r0 ");
-        else if (s.kind == SignalKind::Bus)
-            out_.text(s.width == 1 ? "z" : "bz ");
-        else
-            out_.text("x");
-        out_.text(s.code);
-        out_.character('\n');
     }
 
     void stage(const TimelineEvent& e) {
@@ -393,6 +411,7 @@ private:
     Output& out_;
     VcdTimescale timescale_;
     std::vector<SignalState> signals_;
+    std::vector<std::size_t> alias_copy_;  // per alias: which copy of its target's codes it declares
     std::vector<SignalId> touched_;
     std::uint64_t group_ = 0;  // counts timestamps; marks which signals are staged
     std::optional<VcdOptions> end_options_;  // a stream learns its end only at the end
@@ -434,8 +453,8 @@ struct VcdStream::Impl {
         std::uint64_t sequence;
         TimelineEvent event;
     };
-    Impl(const Timeline& timeline, const std::string& path, VcdBuses buses)
-        : no_options{buses, std::nullopt, 16000000}, file(path, "VCD"), path_copy(path), out(buffer, file.stream(), path_copy), emitter(timeline, no_options, out) {
+    Impl(const Timeline& timeline, const std::string& path, const VcdOptions& layout)
+        : no_options{layout.buses, layout.alias_codes, std::nullopt, 16000000}, file(path, "VCD"), path_copy(path), out(buffer, file.stream(), path_copy), emitter(timeline, no_options, out) {
         buffer.reserve(kFlushBytes + 4096);
         emitter.begin();
     }
@@ -476,8 +495,8 @@ struct VcdStream::Impl {
     std::uint64_t sequence = 0;
 };
 
-VcdStream::VcdStream(const Timeline& timeline, const std::string& path, VcdBuses buses)
-    : impl_(std::make_unique<Impl>(timeline, path, buses)) {}
+VcdStream::VcdStream(const Timeline& timeline, const std::string& path, const VcdOptions& layout)
+    : impl_(std::make_unique<Impl>(timeline, path, layout)) {}
 
 VcdStream::~VcdStream() = default;
 

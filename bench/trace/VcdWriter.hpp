@@ -46,6 +46,11 @@ enum class VcdBuses {
 
 struct VcdOptions {
     VcdBuses buses = VcdBuses::Bits;
+    // Aliases (a net's or label's name for a pin) get identifier codes of
+    // their own and repeat the target's changes: readers that keep one
+    // signal per code (libsigrok 0.5 leaves every later one empty) show them.
+    // false: they share the target's code (smaller; gtkwave reads both).
+    bool alias_codes = true;
     // When set, the dump ends with #<time of end_cycle> so viewers show the whole
     // run, not just up to the last change. Ignored when earlier than the last change.
     std::optional<Cycle> end_cycle;
@@ -75,9 +80,9 @@ std::string format_vcd(const Timeline& timeline, const VcdOptions& options = {},
 // registered before the first drain (the header lists them).
 class VcdStream {
 public:
-    // Checks `path` and opens its temporary file (core/OutputFile). `buses`
-    // as VcdOptions::buses (finish's options give only the end).
-    VcdStream(const Timeline& timeline, const std::string& path, VcdBuses buses = VcdBuses::Bits);
+    // Checks `path` and opens its temporary file (core/OutputFile). `layout`
+    // gives buses and alias_codes (finish's options give only the end).
+    VcdStream(const Timeline& timeline, const std::string& path, const VcdOptions& layout = {});
     ~VcdStream();
     VcdStream(const VcdStream&) = delete;
     VcdStream& operator=(const VcdStream&) = delete;

@@ -219,7 +219,7 @@ def cases(fw):
         out.append(Case(f"cli-trace-{label}", ["run", blink, "--trace", value, "--for", "1ms", "-q"]))
         out.append(Case(f"cli-trace-only-{label}", ["run", blink, "--trace-only", value, "--for", "1ms", "-q"]))
     out.append(Case("cli-trace-and-trace-only", ["run", blink, "--trace", "PB5", "--trace-only", "PB1", "--for", "1ms", "-q"]))
-    out.append(Case("cli-vcd-buses-unknown", ["run", blink, "--vcd-buses", "wide", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"]))
+    out.append(Case("cli-vcd-format-unknown", ["run", blink, "--vcd-format", "wide", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"]))
     out.append(Case("cli-trace-duplicate", ["run", blink, "--trace", "PB5,PB5,pb5", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"],
                     expect=0))
     # Clocks outside 1 Hz .. 64 MHz, in boards.

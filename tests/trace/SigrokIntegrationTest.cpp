@@ -8,6 +8,7 @@
 // sigrok-cli comes from ci/setup; a missing tool fails the test.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -73,9 +74,14 @@ TEST(SigrokReadsOurVcd, UartDecoderOnTxdAndRxdMatchesTheBytes) {
     EXPECT_EQ(decoded_bytes(sigrok(dir, dir.file("u.vcd"), "-P uart:rx=PD0:baudrate=117647 -A uart=rx-data")), input);
 }
 
-// A two-MCU board (Wire master on an UNO, slave on a Mega): sigrok reads the
-// dump to its end and lists each board net under its board-file name.
-TEST(SigrokReadsOurVcd, BoardDumpIsReadToItsEndWithNetNames) {
+// A two-MCU board, Wire master on an UNO and slave on a Mega (the sketches
+// of ArduinoCore.WireMasterAndSlaveOnTwoMcus): sigrok reads the dump to its
+// end, lists each board net under its board-file name, and its I2C decoder on
+// the nets `sda` and `scl` finds the sketches' transactions. Expected from
+// wire_master.cpp / wire_slave.cpp: every 20 ms a write of "n=<round>" to
+// address 8, then a read of 6 bytes "ok#<writes seen>..", the master NACKing
+// the last (I2C: a master receiver ends a read with NACK; §22.7.2).
+TEST(SigrokReadsOurVcd, I2cDecoderOnTheBoardNetsFindsTheSketchesTransactions) {
     ScratchDir dir;
     trace_test::write_text(dir.file("wire.yaml"),
                            "mcus:\n"
@@ -87,14 +93,41 @@ TEST(SigrokReadsOurVcd, BoardDumpIsReadToItsEndWithNetNames) {
     const int status = trace_test::run_command(
         quoted(AVRBENCH_CLI) + " run -q --board " + quoted(dir.file("wire.yaml")) + " " +
             quoted(test::firmware("ard_wire_master")) + " --firmware mega=" + quoted(test::firmware("ard_wire_slave_mega")) +
-            " --for 30ms --vcd " + quoted(dir.file("w.vcd")),
+            " --for 70ms --vcd " + quoted(dir.file("w.vcd")),
         dir.file("run.log"));
     ASSERT_EQ(status, 0) << read_text(dir.file("run.log"));
     const std::string shown = sigrok(dir, dir.file("w.vcd"), "--show");
-    EXPECT_NE(shown.find("Logic sample count: 480000\n"), std::string::npos) << shown;  // 30 ms x 16 MHz
+    EXPECT_NE(shown.find("Logic sample count: 1120000\n"), std::string::npos) << shown;  // 70 ms x 16 MHz
     EXPECT_NE(shown.find("- sda: logic\n"), std::string::npos) << shown;
     EXPECT_NE(shown.find("- scl: logic\n"), std::string::npos) << shown;
     EXPECT_NE(shown.find("- twi[7]: logic\n"), std::string::npos) << shown;  // a bus, as bits
+
+    std::string expected;
+    auto hex = [](char c) {
+        char text[3];
+        std::snprintf(text, sizeof text, "%02X", static_cast<unsigned char>(c));
+        return std::string(text);
+    };
+    // Rounds at about 20, 40 and 60 ms: three in 70 ms.
+    for (int round = 0; round < 3; ++round) {
+        expected += "Start|Write|Address write: 08|ACK|";  // the R/W bit is its own annotation
+        for (char c : "n=" + std::to_string(round)) expected += "Data write: " + hex(c) + "|ACK|";
+        expected += "Stop|Start|Read|Address read: 08|ACK|";
+        const std::string reply = "ok#" + std::to_string(round + 1) + "..";
+        for (std::size_t i = 0; i < reply.size(); ++i)
+            expected += "Data read: " + hex(reply[i]) + (i + 1 < reply.size() ? "|ACK|" : "|NACK|");
+        expected += "Stop|";
+    }
+    const std::string decoded =
+        sigrok(dir, dir.file("w.vcd"),
+               "-P i2c:scl=scl:sda=sda -A i2c=start:repeat-start:stop:ack:nack:address-read:address-write:data-read:data-write");
+    std::string joined;
+    std::istringstream lines(decoded);
+    std::string line;
+    while (std::getline(lines, line)) {
+        if (line.rfind("i2c-1: ", 0) == 0) joined += line.substr(7) + "|";
+    }
+    EXPECT_EQ(joined, expected);
 }
 
 }  // namespace

@@ -98,7 +98,9 @@ TEST(VcdWriter, SmallDumpMatchesHandWrittenText) {
 // The default: a bus is one 1-bit wire per bit, "name[i]", MSB declared
 // first, so readers that take only scalars (libsigrok 0.5's VCD input, and
 // with it PulseView and sigrok-cli) read the whole dump; only bits that
-// change are written. Aliases (net names) get the same bits under their name.
+// change are written. An alias (a net's name) has codes of its own that
+// repeat the target's changes: libsigrok keeps one signal per code and would
+// leave a second name of the same code empty.
 TEST(VcdWriter, BusesAsBitsAreOneWirePerBitWithOnlyChangedBitsWritten) {
     Timeline timeline;
     const SignalId pin = timeline.add_signal({"mcu", "PD1", SignalKind::Wire, 1, k16MHz});
@@ -108,7 +110,7 @@ TEST(VcdWriter, BusesAsBitsAreOneWirePerBitWithOnlyChangedBitsWritten) {
     timeline.record(tx, 1, 0b101);
     timeline.record(tx, 2, 0b100);  // only bit 0 changes
     const std::string vcd = format_vcd(timeline);
-    // Codes: PD1 '!', tx bits 0, 1, 2 '"', '#', '$'.
+    // Codes: PD1 '!', tx bits 0, 1, 2 '"', '#', '$'; link's bits 0, 1, 2 '%', '&', '\''.
     const std::string expected_header_vars =
         "$scope module mcu $end\n"
         "$var wire 1 ! PD1 $end\n"
@@ -117,18 +119,24 @@ TEST(VcdWriter, BusesAsBitsAreOneWirePerBitWithOnlyChangedBitsWritten) {
         "$var wire 1 \" tx[0] $end\n"
         "$upscope $end\n"
         "$scope module nets $end\n"
-        "$var wire 1 $ link[2] $end\n"
-        "$var wire 1 # link[1] $end\n"
-        "$var wire 1 \" link[0] $end\n"
+        "$var wire 1 ' link[2] $end\n"
+        "$var wire 1 & link[1] $end\n"
+        "$var wire 1 % link[0] $end\n"
         "$upscope $end\n";
     EXPECT_NE(vcd.find(expected_header_vars), std::string::npos) << vcd;
     EXPECT_EQ(body_of(vcd),
-              "#0\n$dumpvars\n1!\nz$\nz#\nz\"\n$end\n"
-              "#625\n1$\n0#\n1\"\n"
-              "#1250\n0\"\n");
+              "#0\n$dumpvars\n1!\nz$\nz#\nz\"\nz'\nz&\nz%\n$end\n"
+              "#625\n1$\n0#\n1\"\n1'\n0&\n1%\n"
+              "#1250\n0\"\n0%\n");
     const VcdDump dump = parse_vcd(vcd);
     EXPECT_EQ(dump.at("mcu.tx[2]").width, 1u);
-    EXPECT_EQ(dump.at("nets.link[0]").id, dump.at("mcu.tx[0]").id);
+    EXPECT_EQ(dump.at("nets.link[0]").changes.size(), dump.at("mcu.tx[0]").changes.size());
+
+    // Shared codes on request: the alias declares the target's.
+    VcdOptions shared;
+    shared.alias_codes = false;
+    const VcdDump compact = parse_vcd(format_vcd(timeline, shared));
+    EXPECT_EQ(compact.at("nets.link[0]").id, compact.at("mcu.tx[0]").id);
 }
 
 TEST(VcdWriter, TimestampsAreExactCycleTimesAt16And20MHz) {
