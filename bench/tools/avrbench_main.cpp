@@ -210,6 +210,12 @@ public:
         gtkw_options.buses = layout_.buses;
         gtkw_options.fit_end_time = vcd.end_time;
         gtkw_options.fit_timescale = vcd.timescale;
+        // A window a laptop screen holds; the run fills the wave pane (about
+        // 1400 - 330 pixels of signal names and margins).
+        gtkw_options.window_width = 1400;
+        gtkw_options.window_height = 900;
+        gtkw_options.fit_width_pixels = 1000;
+        gtkw_options.background_scopes = background_scopes_;
         // The save file names the dump relative to its own folder, which gtkwave
         // resolves from wherever it is started.
         std::error_code ec;
@@ -225,6 +231,13 @@ private:
     std::string path_;
     bool stream_wanted_;
     VcdOptions layout_;
+    std::vector<std::string> background_scopes_;
+
+public:
+    // On a board: the MCUs' scopes go last in the save file, collapsed.
+    void set_background_scopes(std::vector<std::string> scopes) { background_scopes_ = std::move(scopes); }
+
+private:
     std::unique_ptr<VcdStream> stream_;
 };
 
@@ -576,6 +589,11 @@ int run_board_command(const RunArgs& args) {
     BoardRun run = prepare_board_run(args);
     Bench& bench = *run.bench;
     Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_layout(args));
+    {
+        std::vector<std::string> mcu_scopes;
+        for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
+        waveforms.set_background_scopes(std::move(mcu_scopes));
+    }
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();

@@ -64,6 +64,8 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
     text += "[dumpfile] \"" + dump_path + "\"\n";
     if (!save_file_name.empty()) text += "[savefile] \"" + save_file_name + "\"\n";
     text += "[timestart] 0\n";
+    if (options.window_width > 0 && options.window_height > 0)
+        text += "[size] " + std::to_string(options.window_width) + " " + std::to_string(options.window_height) + "\n";
     if (options.fit_end_time > 0 && options.fit_width_pixels > 0) {
         // "100ps" -> 100: gtkwave counts time in the unit (ps), not in steps of 100 ps.
         const double multiplier = std::max(1.0, std::atof(options.fit_timescale.c_str()));
@@ -81,26 +83,38 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
     // Opens the scopes in gtkwave's signal tree too, so their signals are one click away.
     for (const ScopeGroup& group : groups) text += "[treeopen] " + group.scope + ".\n";
 
-    const char* const group_begin = options.groups_closed ? "@c00200\n-" : "@800200\n-";
-    for (const ScopeGroup& group : groups) {
-        text += group_begin + group.scope + "\n";
+    const char* const open_group = options.groups_closed ? "@c00200\n-" : "@800200\n-";
+    const char* const closed_group = "@c00200\n-";
+    auto is_background = [&options](const std::string& scope) {
+        return std::find(options.background_scopes.begin(), options.background_scopes.end(), scope) !=
+               options.background_scopes.end();
+    };
+    // `which`: 0 every signal, 1 only the non-pins (buses, reals), 2 only the pins (1-bit wires).
+    auto write_group = [&](const ScopeGroup& group, const char* begin, int which, const std::string& title) {
+        bool any = false;
+        for (const SignalId id : group.signals) any = any || which == 0 || (infos[id].kind == SignalKind::Wire) == (which == 2);
+        if (!any) return;
+        text += begin + title + "\n";
         for (const SignalId id : group.signals) {
             const SignalInfo& info = infos[id];
+            if (which != 0 && (info.kind == SignalKind::Wire) != (which == 2)) continue;
             text += trace_flags(info);
             text += gtkwave_name(info, options.buses) + "\n";
             if (info.kind == SignalKind::Real)
                 for (unsigned row = 0; row < options.analog_extra_rows; ++row) text += "@20000\n-\n";
         }
-        text += "@1000200\n-" + group.scope + "\n";
-    }
-    // Aliases (net and label names) as groups of their own, shown like their targets.
+        text += "@1000200\n-" + title + "\n";
+    };
+    // Aliases (net and label names: what the board file calls the wires)
+    // first, as groups of their own shown like their targets; then the
+    // parts; the MCUs' raw pins last, collapsed.
     std::vector<std::string> alias_scopes;
     for (const auto& a : timeline.aliases()) {
         if (std::find(alias_scopes.begin(), alias_scopes.end(), a.scope) == alias_scopes.end()) alias_scopes.push_back(a.scope);
     }
     for (const auto& scope : alias_scopes) {
         if (std::any_of(groups.begin(), groups.end(), [&](const ScopeGroup& g) { return g.scope == scope; })) continue;
-        text += group_begin + scope + "\n";
+        text += open_group + scope + "\n";
         for (const auto& a : timeline.aliases()) {
             if (a.scope != scope) continue;
             SignalInfo shown = infos[a.target];
@@ -110,6 +124,17 @@ std::string format_gtkw(const Timeline& timeline, const std::string& dump_path, 
         }
         text += "@1000200\n-" + scope + "\n";
     }
+    // A background scope's bytes (its USARTs' and TWI's) stay in view; only
+    // its pins go to the collapsed group at the end.
+    for (const ScopeGroup& group : groups) {
+        if (!is_background(group.scope)) {
+            write_group(group, open_group, 0, group.scope);
+        } else {
+            write_group(group, open_group, 1, group.scope);
+        }
+    }
+    for (const ScopeGroup& group : groups)
+        if (is_background(group.scope)) write_group(group, closed_group, 2, group.scope + " pins");
     return text;
 }
 

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "trace/Timeline.hpp"
 #include "trace/VcdWriter.hpp"
@@ -36,6 +37,13 @@ struct GtkwOptions {
     std::uint64_t fit_end_time = 0;
     std::string fit_timescale = "1ps";
     unsigned fit_width_pixels = 550;
+    // The window gtkwave opens ("[size]"; 0: gtkwave's default, 870 x 560).
+    unsigned window_width = 0;
+    unsigned window_height = 0;
+    // Scopes whose pins (1-bit wires) are shown last, collapsed, as "<scope>
+    // pins" (a board's MCUs), after the net and label names and the parts;
+    // their other signals (USART and TWI bytes) stay in an open group.
+    std::vector<std::string> background_scopes;
 };
 
 // `dump_path` is written as given into [dumpfile]. gtkwave opens it relative to

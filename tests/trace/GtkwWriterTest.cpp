@@ -74,6 +74,33 @@ TEST(GtkwWriter, BusesWrittenAsBitsAreJoinedIntoOneTrace) {
     EXPECT_NE(text.find("@28\nmcu.flag\n"), std::string::npos) << text;  // a 1-bit bus stays one wire
 }
 
+// A board's save file opens on what the board file names: nets and labels
+// first, then the parts, then each MCU's bytes; its raw pins come last in a
+// collapsed group (@c00200), one click away. The window is sized.
+TEST(GtkwWriter, BoardNamesComeFirstAndRawPinsLastCollapsed) {
+    Timeline timeline;
+    const SignalId pd2 = timeline.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    timeline.add_signal({"uno", "uart0_tx", SignalKind::Bus, 8, 16000000, true});
+    timeline.add_signal({"x", "position_mm", SignalKind::Real, 64, 16000000});
+    timeline.add_alias(pd2, "nets", "x_step");
+    GtkwOptions options;
+    options.buses = VcdBuses::Vector;
+    options.analog_extra_rows = 0;
+    options.background_scopes = {"uno"};
+    options.window_width = 1400;
+    options.window_height = 900;
+    const std::string text = format_gtkw(timeline, "run.vcd", "");
+    const std::string sized = format_gtkw(timeline, "run.vcd", "", options);
+    EXPECT_NE(sized.find("[size] 1400 900\n"), std::string::npos) << sized;
+    const std::string groups = sized.substr(sized.find("@800200"));
+    EXPECT_EQ(groups,
+              "@800200\n-nets\n@28\nnets.x_step\n@1000200\n-nets\n"
+              "@800200\n-uno\n@820\nuno.uart0_tx[7:0]\n@1000200\n-uno\n"
+              "@800200\n-x\n@8028\nx.position_mm\n@1000200\n-x\n"
+              "@c00200\n-uno pins\n@28\nuno.PD2\n@1000200\n-uno pins\n");
+    EXPECT_EQ(text.find("[size]"), std::string::npos);  // no size asked: gtkwave's default
+}
+
 TEST(GtkwWriter, ClosedGroupsAndDefaults) {
     GtkwOptions options;
     options.groups_closed = true;
