@@ -79,6 +79,9 @@ td.num { white-space: nowrap; font-variant-numeric: tabular-nums; }
 .badge.info { background: #3b4457; color: #fff; }
 p.none { color: #2c7a3a; font-weight: bold; }
 p.note { color: #5d6573; font-style: italic; }
+pre#comparison-summary { font-size: 12px; background: #fafbfc; border: 1px solid #e1e4e8; padding: 8px 10px; white-space: pre-wrap; overflow-wrap: anywhere; max-height: 640px; overflow: auto; }
+table.byte-comparison td.bytes { overflow-wrap: anywhere; }
+table.byte-comparison mark { background: #ffd54f; font-weight: bold; }
 pre#transcript { font-size: 12px; line-height: 1.4; background: #fafbfc; border: 1px solid #e1e4e8; padding: 8px 10px; max-height: 640px; overflow: auto; white-space: pre-wrap; margin: 4px 0 0; }
 .from-host { color: #1f5fa8; }
 .from-firmware { color: #18753a; }

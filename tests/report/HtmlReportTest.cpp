@@ -294,6 +294,39 @@ TEST(HtmlReport, PassedComparisonShowsTheTableWithoutPlots) {
     EXPECT_EQ(html.find("id=\"comparison-mcu"), std::string::npos);
 }
 
+// A UART that sent different bytes is shown as text, golden above actual,
+// the first differing byte marked, not plotted as a number.
+TEST(HtmlReport, DifferingUartBytesAreShownAsTextWithTheFirstDifferenceMarked) {
+    DemoRun run = square_run();
+    Timeline& t = *run.timeline;
+    const SignalId tx = t.add_signal({"mcu", "uart0_tx", SignalKind::Bus, 8, kClock, true});
+    Timeline golden;
+    const SignalId gtx = golden.add_signal({"mcu", "uart0_tx", SignalKind::Bus, 8, kClock, true});
+    const std::string expected = "ok\r\nok\r\n", actual = "ok\r\nerror:1\r\n";
+    for (std::size_t i = 0; i < expected.size(); ++i) golden.record(gtx, 1000 + i * 1360, static_cast<std::uint8_t>(expected[i]));
+    for (std::size_t i = 0; i < actual.size(); ++i) t.record(tx, 1000 + i * 1360, static_cast<std::uint8_t>(actual[i]));
+    ComparisonView cmp;
+    cmp.passed = false;
+    cmp.golden = std::move(golden);
+    cmp.first_divergence_signal = "mcu.uart0_tx";
+    cmp.first_divergence_cycle = 1000 + 4 * 1360;
+    cmp.summary = "FAIL: 1 of 1 channels differ from the golden timeline\n";
+    cmp.channels = {{"mcu.uart0_tx", "differs", "byte 5"}};
+    run.report.comparison = std::move(cmp);
+    run.report.timeline = run.timeline.get();
+    const std::string html = format_html_report(run.report);
+    const std::string table = element(html, "table", "comparison-mcu-uart0_tx");
+    ASSERT_NE(table, "") << html;
+    // Byte 5 (index 4) is the first that differs: 'o' in the golden, 'e' now.
+    EXPECT_NE(table.find("byte 5 at"), std::string::npos) << table;
+    EXPECT_NE(table.find("ok\\r\\n<mark>o</mark>k\\r\\n"), std::string::npos) << table;
+    EXPECT_NE(table.find("ok\\r\\n<mark>e</mark>rror:1\\r\\n"), std::string::npos) << table;
+    EXPECT_EQ(element(html, "svg", "comparison-mcu-uart0_tx"), "");  // no numeric plot
+    // The summary wraps inside its card.
+    EXPECT_NE(html.find("pre#comparison-summary {"), std::string::npos);
+    EXPECT_NE(html.find("white-space: pre-wrap; overflow-wrap: anywhere;"), std::string::npos);
+}
+
 TEST(HtmlReport, EscapesEveryPieceOfText) {
     DemoRun run = square_run();
     run.report.title = "a & b <i>";

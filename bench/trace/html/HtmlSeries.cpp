@@ -165,51 +165,35 @@ DataPoints mean_points(const Series& s, double t0, double t1, int columns) {
     return out;
 }
 
-Series step_velocity(const Series& position) {
+Series windowed_velocity(const Series& position, double t0, double t1, int columns, double min_window_s) {
     Series out;
-    if (position.size() < 2) return out;
-    out.push_back({0, 0});
-    for (std::size_t i = 1; i < position.size(); ++i) {
-        const double dt = position[i].t - position[i - 1].t;
-        if (dt <= 0) continue;
-        const double next_dt = i + 1 < position.size() ? position[i + 1].t - position[i].t : dt;
-        const bool pause = dt > 4 * next_dt;
-        out.push_back({position[i - 1].t, pause ? 0.0 : (position[i].v - position[i - 1].v) / dt});
+    if (position.size() < 2 || t1 <= t0 || columns <= 0) return out;
+    const double column_s = (t1 - t0) / columns;
+    const double window_s = std::max(4 * column_s, min_window_s);
+    auto first_at_or_after = [&position](double t) {
+        return std::lower_bound(position.begin(), position.end(), t,
+                                [](const Sample& s, double at) { return s.t < at; });
+    };
+    for (int c = 0; c < columns; ++c) {
+        const double centre = t0 + (c + 0.5) * column_s;
+        // The first sample is where the axis starts, not a change.
+        const auto begin = std::max(first_at_or_after(centre - window_s / 2), position.begin() + 1);
+        const auto end = first_at_or_after(centre + window_s / 2);
+        // Edge to edge: the position changes inside the window and the time
+        // between the first and the last of them. A steady step rate gives
+        // exactly its velocity, however the window falls on the steps; the
+        // quiet before a move's first step or after its last does not dilute it.
+        double v = 0;
+        if (end > begin && end - begin >= 2) {
+            const Sample& first = *begin;
+            const Sample& last = *(end - 1);
+            if (last.t > first.t) v = (last.v - first.v) / (last.t - first.t);
+        }
+        out.push_back({t0 + c * column_s, v});
     }
-    out.push_back({position.back().t, 0});
+    out.push_back({t1, out.back().v});
     normalize(out);
     return out;
-}
-
-[[maybe_unused]] std::vector<double> column_velocity(const Series& s, double t0, double t1, int columns) {
-    std::vector<double> moved(static_cast<std::size_t>(columns), 0.0);
-    if (s.size() < 2 || t1 <= t0) return moved;
-    const double w = (t1 - t0) / columns;
-    const double max_spread = 2 * w;
-    auto column_of = [&](double t) {
-        const double c = std::floor((t - t0) / w);
-        return static_cast<long>(std::clamp(c, 0.0, static_cast<double>(columns - 1)));
-    };
-    for (std::size_t i = 1; i < s.size(); ++i) {
-        const double delta = s[i].v - s[i - 1].v;
-        const double dt = s[i].t - s[i - 1].t;
-        const double next_dt = i + 1 < s.size() ? s[i + 1].t - s[i].t : dt;
-        const double spread = std::min({dt, next_dt, max_spread});
-        const double end = s[i].t;
-        const double begin = end - spread;
-        if (end <= t0 || begin >= t1) continue;
-        if (spread <= 0) {
-            moved[static_cast<std::size_t>(column_of(end))] += delta;
-            continue;
-        }
-        for (long c = column_of(begin); c <= column_of(end); ++c) {
-            const double c0 = t0 + static_cast<double>(c) * w, c1 = c0 + w;
-            const double overlap = std::min(end, c1) - std::max(begin, c0);
-            if (overlap > 0) moved[static_cast<std::size_t>(c)] += delta * overlap / spread;
-        }
-    }
-    for (double& m : moved) m /= w;
-    return moved;
 }
 
 }  // namespace avrbench::html_report

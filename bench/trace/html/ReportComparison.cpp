@@ -103,6 +103,50 @@ Range value_range(const std::vector<const Series*>& all, double t0, double t1, b
     return nice_range(lo, hi, include_zero);
 }
 
+// Every byte of a character bus (a UART), repeats included, with its time.
+std::vector<std::pair<double, std::uint8_t>> byte_events(const Timeline& timeline, SignalId id) {
+    std::vector<std::pair<double, std::uint8_t>> out;
+    const SignalInfo& info = timeline.signals()[id];
+    for (const TimelineEvent& e : timeline.events())
+        if (e.signal == id) out.emplace_back(to_seconds(e.cycle, info.clock_hz), static_cast<std::uint8_t>(e.value.bits));
+    return out;
+}
+
+// The bytes of a UART around the first one that differs, as text (C-style
+// escapes for control bytes), golden above actual, the differing byte marked:
+// a byte stream read as a number would be a meaningless line from 0 to 140.
+std::string byte_comparison(const std::string& id, const std::vector<std::pair<double, std::uint8_t>>& golden,
+                            const std::vector<std::pair<double, std::uint8_t>>& actual) {
+    std::size_t k = 0;
+    while (k < golden.size() && k < actual.size() && golden[k] == actual[k]) ++k;
+    constexpr std::size_t kContext = 40;
+    const std::size_t from = k > kContext ? k - kContext : 0;
+    auto row = [&](const char* label, const std::vector<std::pair<double, std::uint8_t>>& bytes) {
+        std::string cells = std::string("<tr><td>") + label + "</td><td class=\"num\">";
+        cells += k < bytes.size() ? seconds_text(bytes[k].first) : std::string("(ended)");
+        cells += "</td><td class=\"mono bytes\">";
+        if (from > 0) cells += "\u2026";
+        for (std::size_t i = from; i < bytes.size() && i < k + kContext; ++i) {
+            const std::uint8_t b = bytes[i].second;
+            char text[8];
+            if (b == '\n') std::snprintf(text, sizeof text, "\\n");
+            else if (b == '\r') std::snprintf(text, sizeof text, "\\r");
+            else if (b < 0x20 || b >= 0x7f) std::snprintf(text, sizeof text, "\\x%02x", b);
+            else std::snprintf(text, sizeof text, "%c", static_cast<char>(b));
+            if (i == k) cells += "<mark>";
+            cells += esc(text);
+            if (i == k) cells += "</mark>";
+        }
+        if (from + 2 * kContext < bytes.size() && k + kContext < bytes.size()) cells += "\u2026";
+        return cells + "</td></tr>\n";
+    };
+    std::string out = "<table class=\"byte-comparison\" id=\"" + id + "\"><thead><tr><th></th><th>byte " +
+                      std::to_string(k + 1) + " at</th><th>bytes around it (the first that differs marked)</th></tr></thead><tbody>\n";
+    out += row("golden", golden);
+    out += row("actual", actual);
+    return out + "</tbody></table>\n";
+}
+
 void append_comparison(std::string& out, const Context& ctx) {
     const ComparisonView& cmp = *ctx.report.comparison;
     out += "<section id=\"comparison-section\"><h2>Comparison with the golden timeline</h2>\n";
@@ -155,6 +199,15 @@ void append_comparison(std::string& out, const Context& ctx) {
             continue;
         }
         ++drawn;
+        const SignalInfo& any_info = g >= 0 ? cmp.golden.signals()[static_cast<std::size_t>(g)]
+                                            : ctx.report.timeline->signals()[static_cast<std::size_t>(a)];
+        if (any_info.kind == SignalKind::Bus && any_info.characters) {
+            out += plot_block(name + ": bytes, golden and actual", byte_comparison("comparison-" + id_fragment(name),
+                                   g >= 0 ? byte_events(cmp.golden, static_cast<SignalId>(g)) : decltype(byte_events(cmp.golden, 0)){},
+                                   a >= 0 ? byte_events(*ctx.report.timeline, static_cast<SignalId>(a))
+                                          : decltype(byte_events(cmp.golden, 0)){}));
+            continue;
+        }
         Series golden, actual;
         const SignalInfo* info = nullptr;
         if (g >= 0) {

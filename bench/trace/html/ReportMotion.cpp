@@ -42,7 +42,10 @@ void append_motion(std::string& out, const Context& ctx) {
     out += "<section id=\"velocity-section\"><h2>Axis velocity</h2>\n";
     for (std::size_t i = 0; i < report.axes.size(); ++i) {
         const AxisSeries& axis = report.axes[i];
-        const Series velocity = step_velocity(series[i]);
+        // Averaged over at least 10 ms: a derivative of quantised position
+        // would swing by a whole step per interval.
+        constexpr double kMinVelocityWindowS = 0.010;
+        const Series velocity = windowed_velocity(series[i], 0, ctx.end_s, kTimePlotWidth, kMinVelocityWindowS);
         TimePlot plot;
         plot.id = "velocity-" + id_fragment(axis.name);
         plot.title = "velocity of axis " + axis.name;
@@ -62,7 +65,9 @@ void append_motion(std::string& out, const Context& ctx) {
         plot.events = ctx.fault_markers;
         plot.series.push_back({axis.name + " velocity [" + unit + "]", palette(i),
                                velocity.empty() ? DataPoints{} : step_points(velocity, 0, ctx.end_s, kTimePlotWidth), 1.6, 1, ""});
-        out += plot_block("axis " + axis.name + ": " + std::to_string(series[i].size()) + " position changes",
+        out += plot_block("axis " + axis.name + ": " + std::to_string(series[i].size()) +
+                              " position changes; velocity from first to last change in each window of " +
+                              std::to_string(static_cast<int>(std::lround(1000 * std::max(kMinVelocityWindowS, 4 * ctx.end_s / kTimePlotWidth)))) + " ms",
                           render_time_plot(plot));
     }
     out += "</section>\n";

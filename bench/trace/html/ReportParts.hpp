@@ -177,18 +177,11 @@ DataPoints step_points(const Series& s, double t0, double t1, int columns);
 // once per column (a PWM duty), else exactly as step_points draws it.
 DataPoints mean_points(const Series& s, double t0, double t1, int columns);
 
-// Velocity as a step function of time, from the intervals between position
-// changes: over (t[i-1], t[i]] the axis moved v[i] - v[i-1] in t[i] - t[i-1].
-// A constant step rate gives a constant velocity whatever the plot's
-// resolution (no aliasing against pixel columns). An interval over 4x longer
-// than the next one is rest (a pause between moves, or the time from the
-// start of the trace to a move's first step; an AVR446 ramp shortens its
-// intervals by less than 2x per step). After the last change the axis
-// stands still.
-Series step_velocity(const Series& position);
-
-// Average velocity per column of [t0, t1] (units per second); see the header.
-[[maybe_unused]] std::vector<double> column_velocity(const Series& s, double t0, double t1, int columns);
+// An axis's velocity per plot column: the mean of the position changes
+// inside a window centred on the column (4 columns or `min_window_s`,
+// whichever is longer), from the first change to the last, so a steady step
+// rate reads as exactly its velocity and quantised positions do not spike.
+Series windowed_velocity(const Series& position, double t0, double t1, int columns, double min_window_s);
 
 double nice_step(double range, double target);
 
