@@ -100,6 +100,9 @@ std::vector<ParamSpec> HybridStepper::param_specs(bool unipolar) {
          .source = "assumed", .help = "a winding switched off alone counts as released (not chopped) after this long"},
         {.name = "stall_quiet", .type = PT::Quantity, .dimension = D::Time, .default_value = "100ms",
          .source = "assumed", .help = "a stall event ends after this long without another pole slip"},
+        {.name = "hold_trace_period", .type = PT::Quantity, .dimension = D::Time, .default_value = "1ms",
+         .source = "assumed: a 1 kHz view of a holding motor",
+         .help = "once the command has stood still for stall_quiet, the signals are traced this often, not every tick"},
     };
     if (unipolar) {
         for (const char* c : {"a", "b", "c", "d"}) {
@@ -178,6 +181,7 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
     sample_cycles_ = cycles("sample_period");
     release_cycles_ = cycles("release_delay");
     stall_quiet_cycles_ = cycles("stall_quiet");
+    hold_trace_cycles_ = cycles("hold_trace_period");
     if (unipolar_) {
         supply_v_ = params.quantity("supply");
         sense_ohm_ = params.quantity("sense_resistor");
@@ -462,6 +466,21 @@ void HybridStepper::update_shaft() {
 
 void HybridStepper::publish_all() {
     update_shaft();
+    // A motor holding its position under a chopping driver never settles: its
+    // currents ripple and the rotor trembles by hundredths of a degree. While
+    // the command stands still its signals are traced every
+    // `hold_trace_period`, not every tick (a minute of holding would
+    // otherwise be tens of millions of trace events); a new command, a stall
+    // or a stall's end is traced at once.
+    const Cycle now = clock().cycle();
+    const double command = commanded_deg();
+    if (command != last_traced_command_ || in_stall_ != last_traced_stall_) last_traced_change_ = now;
+    const bool holding = now - last_traced_change_ > stall_quiet_cycles_;
+    if (holding && traced_once_ && now - last_trace_ < hold_trace_cycles_) return;
+    traced_once_ = true;
+    last_trace_ = now;
+    last_traced_command_ = command;
+    last_traced_stall_ = in_stall_;
     publish(sig_angle_, angle_deg());
     publish(sig_command_, commanded_deg());
     publish(sig_error_, following_error_deg());

@@ -104,7 +104,11 @@ private:
     bool unipolar_;
     HybridStepperModel model_;
     double seconds_per_cycle_;
-    Cycle sample_cycles_, release_cycles_, stall_quiet_cycles_;
+    Cycle sample_cycles_, release_cycles_, stall_quiet_cycles_, hold_trace_cycles_;
+    // Tracing while holding (publish_all).
+    Cycle last_traced_change_ = 0, last_trace_ = 0;
+    double last_traced_command_ = 0;
+    bool last_traced_stall_ = false, traced_once_ = false;
     Cycle last_cycle_ = 0;
 
     // What drives the windings, and one drive per winding.
