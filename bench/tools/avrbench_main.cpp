@@ -28,6 +28,7 @@
 #include "tools/FuzzCommand.hpp"
 #include "core/Mcu.hpp"
 #include "core/Units.hpp"
+#include "core/Twi.hpp"
 #include "core/UserStop.hpp"
 #include "parts/Axis.hpp"
 #include "parts/StepDirDriver.hpp"
@@ -375,6 +376,11 @@ struct BoardRun {
     unsigned resets_on_open = 0;
     std::vector<PortFile> uart_out;
     Picoseconds duration_ps = 0, settle_ps = 0;
+    // I2C traffic per master MCU, for the summary.
+    struct I2cCount {
+        std::uint64_t transfers = 0, bytes = 0, nacks = 0;
+    };
+    std::map<std::string, std::shared_ptr<I2cCount>> i2c;
 };
 
 BoardRun prepare_board_run(const RunArgs& args) {
@@ -479,6 +485,28 @@ BoardRun prepare_board_run(const RunArgs& args) {
                     args.pty_link.empty() ? "" : " = ", args.pty_link.c_str());
         std::fflush(stdout);
     }
+    for (Mcu* m : board.mcus()) {
+        Twi* twi = m->twi();
+        if (twi == nullptr) continue;
+        for (const auto& bus : board.twi_buses()) {
+            if (&twi->bus() != bus.get() || bus->members().size() < 2) continue;
+            auto count = std::make_shared<BoardRun::I2cCount>();
+            run.i2c[m->name()] = count;
+            // NACKs of the slaves (address, written bytes); a master receiver
+            // NACKs the last byte it reads by design.
+            auto reading = std::make_shared<bool>(false);
+            twi->on_event([count, reading](const TwiEvent& e) {
+                if (e.kind == TwiEvent::Kind::Address) {
+                    ++count->transfers;
+                    *reading = (e.byte & 1) != 0;
+                    if (!e.acked) ++count->nacks;
+                } else if (e.kind == TwiEvent::Kind::Data) {
+                    ++count->bytes;
+                    if (!*reading && !e.acked) ++count->nacks;
+                }
+            });
+        }
+    }
     if (!args.vcd.empty() || !args.report.empty()) {
         if (args.trace_only.empty()) bench.trace_board();
         trace_board_pins_for_cli(bench.recorder(), board, args.trace_only.empty() ? args.trace : args.trace_only,
@@ -523,6 +551,12 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
         std::printf("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s\n", args.gcode.c_str(),
                     run.host->lines_acknowledged(), run.host->lines().size(), run.host->oks(), run.host->errors(),
                     to_string(outcome));
+    }
+    for (const auto& [mcu, count] : run.i2c) {
+        if (count->transfers == 0) continue;  // a master that never spoke is no master
+        std::printf("  i2c        %s as master: %llu transfers, %llu data bytes, %llu NACKed by a slave\n", mcu.c_str(),
+                    static_cast<unsigned long long>(count->transfers), static_cast<unsigned long long>(count->bytes),
+                    static_cast<unsigned long long>(count->nacks));
     }
     for (Part* part : board.parts()) {
         if (const std::string line = part->summary(); !line.empty()) std::printf("  %s\n", line.c_str());

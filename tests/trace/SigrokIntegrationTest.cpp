@@ -13,7 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "core/Twi.hpp"
+#include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
+#include "trace/VcdWriter.hpp"
+#include "support/PinLog.hpp"
 #include "trace/TraceTestSupport.hpp"
 
 namespace avrbench {
@@ -96,6 +100,12 @@ TEST(SigrokReadsOurVcd, I2cDecoderOnTheBoardNetsFindsTheSketchesTransactions) {
             " --for 70ms --vcd " + quoted(dir.file("w.vcd")),
         dir.file("run.log"));
     ASSERT_EQ(status, 0) << read_text(dir.file("run.log"));
+    // The summary counts the same traffic: 3 rounds of a write ("n=<r>", 3
+    // bytes) and a read (6 bytes); the master's NACK of its last read byte is
+    // no slave's NACK.
+    EXPECT_NE(read_text(dir.file("run.log")).find("i2c        uno as master: 6 transfers, 27 data bytes, 0 NACKed by a slave\n"),
+              std::string::npos)
+        << read_text(dir.file("run.log"));
     const std::string shown = sigrok(dir, dir.file("w.vcd"), "--show");
     EXPECT_NE(shown.find("Logic sample count: 1120000\n"), std::string::npos) << shown;  // 70 ms x 16 MHz
     EXPECT_NE(shown.find("- sda: logic\n"), std::string::npos) << shown;
@@ -128,6 +138,62 @@ TEST(SigrokReadsOurVcd, I2cDecoderOnTheBoardNetsFindsTheSketchesTransactions) {
         if (line.rfind("i2c-1: ", 0) == 0) joined += line.substr(7) + "|";
     }
     EXPECT_EQ(joined, expected);
+}
+
+// Seed 001's five-MCU printer: the interpolator sets the hot end's target
+// and reads its status over I2C and steps X. sigrok's I2C decoder on the
+// board's `sda`/`scl` nets reads the same bytes the bench's TWI model
+// exchanged (TwiEvent: SLA+R/W and data, in order), and its edge counter on
+// the `x_step` net counts the rising edges the interpolator's STEP pin made.
+TEST(SigrokReadsOurVcd, FiveMcuPrinterI2cBytesAndStepEdgesAgreeWithTheBench) {
+    ScratchDir dir;
+    auto bench = test::printer_bench();
+    bench->trace_board();
+    std::string bench_bytes;
+    bench->mcu("interp").twi()->on_event([&bench_bytes](const TwiEvent& e) {
+        char text[16];
+        if (e.kind == TwiEvent::Kind::Address) {
+            std::snprintf(text, sizeof text, "A%02X%c|", e.byte >> 1, (e.byte & 1) ? 'r' : 'w');
+            bench_bytes += text;
+        } else if (e.kind == TwiEvent::Kind::Data) {
+            std::snprintf(text, sizeof text, "D%02X|", e.byte);
+            bench_bytes += text;
+        }
+    });
+    test::PinLog x_step(bench->mcu("interp"), "PA0");
+    bench->host().add_lines("M104 S60\nG1 X1 F600\nM400\nM105\n");  // M400: the move ends before the status
+    ASSERT_EQ(bench->run_until_idle(10.0), IdleResult::Idle) << bench->host().received_text();
+    VcdOptions options;
+    options.end_cycle = bench->mcu("interp").cycle();
+    options.end_clock_hz = bench->mcu("interp").frequency_hz();
+    write_vcd(bench->timeline(), dir.file("p.vcd"), options);
+    ASSERT_GT(bench_bytes.size(), 20u);   // a set point and status reads at least
+    ASSERT_GE(x_step.rises().size(), 90u);  // 1 mm at 100 steps/mm (the board's lead screws)
+
+    // 16 MHz / 62.5 ns per sample (downsample 625): the 100 kHz I2C bus and
+    // the STEP pulses are many samples wide.
+    const std::string decoded =
+        sigrok(dir, dir.file("p.vcd"), "-P i2c:scl=scl:sda=sda -A i2c=address-read:address-write:data-read:data-write");
+    std::string sigrok_bytes;
+    std::istringstream lines(decoded);
+    std::string line;
+    while (std::getline(lines, line)) {
+        const auto colon = line.rfind(": ");
+        // "i2c-1: Write" / "i2c-1: Read" (the R/W bit alone) carry no value.
+        if (line.rfind("i2c-1: ", 0) != 0 || colon == std::string::npos || colon < 7) continue;
+        const std::string value = line.substr(colon + 2);
+        if (line.find("Address write") != std::string::npos) sigrok_bytes += "A" + value + "w|";
+        else if (line.find("Address read") != std::string::npos) sigrok_bytes += "A" + value + "r|";
+        else sigrok_bytes += "D" + value + "|";
+    }
+    EXPECT_EQ(sigrok_bytes, bench_bytes);
+
+    const std::string counted =
+        sigrok(dir, dir.file("p.vcd"), "-P counter:data=x_step:data_edge=rising -A counter=edge_count");
+    // The counter annotates its running count at every edge; the last is the total.
+    const auto last = counted.rfind("counter-1: ");
+    ASSERT_NE(last, std::string::npos) << counted;
+    EXPECT_EQ(std::stoul(counted.substr(last + 11)), x_step.rises().size()) << counted.substr(last);
 }
 
 }  // namespace
