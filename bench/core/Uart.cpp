@@ -51,13 +51,15 @@ std::string Uart::transmitted_text() const {
 
 Cycle Uart::cycles_per_frame() const { return uart_->cycles_per_byte; }
 
+void Uart::connect_host() {
+    if (rx_pin_ == nullptr || rx_from_line_ || rx_line_held_) return;
+    rx_line_held_ = true;
+    rx_pin_->drive(true);
+}
+
 void Uart::send(const std::string& bytes) {
-    // A host with something to say is connected: its TX idles high on RxD
-    // from now on, so a logic analyser sees each start bit as a falling edge.
-    if (!bytes.empty() && rx_pin_ != nullptr && !rx_from_line_ && !rx_line_held_) {
-        rx_line_held_ = true;
-        rx_pin_->drive(true);
-    }
+    // A host with something to say is connected (if it did not say so before).
+    if (!bytes.empty()) connect_host();
     to_send_.insert(to_send_.end(), bytes.begin(), bytes.end());
     pump();
 }

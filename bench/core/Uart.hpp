@@ -57,6 +57,10 @@ public:
     std::string transmitted_text() const;
     void on_transmit(TxListener fn) { tx_listeners_.push_back(std::move(fn)); }
 
+    // A host is connected to RxD from now on: its TX idles high, so a logic
+    // analyser sees each start bit as a falling edge (send() does this too).
+    // Nothing when a board's net drives RxD.
+    void connect_host();
     // Queues bytes for the firmware's receiver.
     void send(const std::string& bytes);
     // Bytes the receiver took (from a host or from the RxDn line), each with

@@ -239,6 +239,7 @@ UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
     if (options_.flow == FlowControl::CharacterCounting && options_.rx_buffer_bytes == 0) {
         throw BadInput("UART host: rx_buffer_bytes must be at least 1 for character counting");
     }
+    uart_.connect_host();
     if (options_.line_timeout_s == 0) options_.line_timeout_s = default_line_timeout_s(options_.family);
     if (!(options_.line_timeout_s > 0.0)) throw BadInput("UART host: line timeout must be positive");
     if (options_.family != FirmwareFamily::Generic && options_.startup == Startup::Immediately) {

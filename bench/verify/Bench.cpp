@@ -1,5 +1,7 @@
 #include "verify/Bench.hpp"
 
+#include "core/McuPins.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -175,6 +177,14 @@ void Bench::trace_board() {
         Mcu& m = board_->mcu(s.mcu);
         recorder_.trace_uart_tx(m, m.uart(s.usart));
         recorder_.trace_uart_rx(m, m.uart(s.usart));
+        // The port's lines too, under the port's name, where a logic
+        // analyser (sigrok's UART decoder) reads them: serial.<port>_txd/_rxd.
+        if (const auto pins = usart_pins(m.mcu_type(), s.usart)) {
+            const std::string txd = std::string("P") + pins->tx_port + static_cast<char>('0' + pins->tx_bit);
+            const std::string rxd = std::string("P") + pins->rx_port + static_cast<char>('0' + pins->rx_bit);
+            timeline_.add_alias(recorder_.trace_pin(m, m.pin(txd)), "serial", s.name + "_txd");
+            timeline_.add_alias(recorder_.trace_pin(m, m.pin(rxd)), "serial", s.name + "_rxd");
+        }
     }
     for (Mcu* m : board_->mcus()) {
         // Only MCUs on a board's I2C bus: the others have nobody to talk to.
