@@ -38,5 +38,8 @@ void check_input_file(const std::string& path, const std::string& what, std::uin
 std::string escaped(const std::string& text);
 // The same in single quotes, a quote inside written \'.
 std::string quoted_text(const std::string& text);
+// Bytes as one line (a serial transcript): printable ASCII as it is, every
+// other byte as \xNN, line ends included.
+std::string hex_escaped(const std::string& bytes);
 
 }  // namespace avrbench

@@ -48,20 +48,7 @@ std::string strip_comments(std::string_view raw) {
 }
 
 // Printable form of a transcript text for tail(): control bytes as \xNN.
-std::string printable(const std::string& text) {
-    std::string out;
-    for (char ch : text) {
-        const auto c = static_cast<unsigned char>(ch);
-        if (c >= 0x20 && c < 0x7f) {
-            out.push_back(ch);
-        } else {
-            char buf[8];
-            std::snprintf(buf, sizeof buf, "\\x%02x", c);
-            out += buf;
-        }
-    }
-    return out;
-}
+std::string printable(const std::string& text) { return hex_escaped(text); }
 
 }  // namespace
 

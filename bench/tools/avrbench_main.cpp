@@ -154,21 +154,6 @@ private:
     bool enabled_;
 };
 
-// Bytes as one line of text: printable ASCII kept, anything else as \xNN.
-std::string printable(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-        const auto u = static_cast<unsigned char>(c);
-        if (u >= 0x20 && u < 0x7f) {
-            out.push_back(c);
-        } else {
-            char buf[8];
-            std::snprintf(buf, sizeof buf, "\\x%02x", u);
-            out += buf;
-        }
-    }
-    return out;
-}
 
 std::string with_extension(const std::string& path, const std::string& extension) {
     const auto slash = path.find_last_of('/');
@@ -292,7 +277,7 @@ void print_text_tail(const std::string& text, std::size_t max_lines) {
     }
     if (!line.empty()) lines.push_back(line);
     const std::size_t from = lines.size() > max_lines ? lines.size() - max_lines : 0;
-    for (std::size_t i = from; i < lines.size(); ++i) std::printf("    %s\n", printable(lines[i]).c_str());
+    for (std::size_t i = from; i < lines.size(); ++i) std::printf("    %s\n", hex_escaped(lines[i]).c_str());
 }
 
 // A crash of the firmware (the MCU's own oracles); part, net and host findings
