@@ -18,6 +18,7 @@ using Cycle = std::uint64_t;
 using Picoseconds = std::uint64_t;
 
 constexpr Picoseconds kPsPerSecond = 1'000'000'000'000ULL;
+constexpr Picoseconds kPsPerMs = 1'000'000'000ULL;
 
 // The longest simulated span one run accepts: 10^6 s (11.6 days). 2^64 ps is
 // 1.8e7 s, so sums of two spans within this limit never overflow.

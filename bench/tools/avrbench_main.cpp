@@ -35,6 +35,7 @@
 #include "parts/ThermalPlant.hpp"
 #include "core/OutputFile.hpp"
 #include "trace/GtkwWriter.hpp"
+#include "trace/WaveformFiles.hpp"
 #include "trace/Junit.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/HtmlReport.hpp"
@@ -154,78 +155,6 @@ private:
     bool enabled_;
 };
 
-
-std::string with_extension(const std::string& path, const std::string& extension) {
-    const auto slash = path.find_last_of('/');
-    const auto dot = path.find_last_of('.');
-    if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) return path.substr(0, dot) + extension;
-    return path + extension;
-}
-
-// Writes the VCD and, beside it, a gtkwave save file zoomed to the whole run
-// (which ends at `clock`'s current cycle). Returns the save file's path.
-// --vcd: the dump and its gtkwave save file. Written as the run goes
-// (VcdStream: memory does not grow with the run's length) unless the whole
-// timeline is wanted afterwards (--report), then at the end from memory.
-class Waveforms {
-public:
-    // Events may be recorded up to one UART frame after the time they stamp
-    // (a byte is stamped with its start bit): 100 ms covers frames down to
-    // 100 baud. The dump is written up to this far behind the simulation.
-    static constexpr Picoseconds kSettleLagPs = 100 * kPsPerMs;
-
-    Waveforms(Timeline& timeline, std::string vcd_path, bool stream, const VcdOptions& layout)
-        : timeline_(timeline), path_(std::move(vcd_path)), stream_wanted_(stream && !path_.empty()), layout_(layout) {}
-
-    // Once every signal is registered.
-    void start() {
-        if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_, layout_);
-    }
-    void drain(Picoseconds now_ps) {
-        if (stream_) stream_->drain(timeline_, now_ps > kSettleLagPs ? now_ps - kSettleLagPs : 0);
-    }
-    // Writes the rest (or all) and the save file; returns the save file's path.
-    std::string finish(const Mcu& clock) {
-        if (path_.empty()) return "";
-        VcdOptions vcd_options = layout_;
-        vcd_options.end_cycle = clock.cycle();
-        vcd_options.end_clock_hz = clock.frequency_hz();
-        const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, path_, vcd_options);
-        const std::string gtkw_path = with_extension(path_, ".gtkw");
-        GtkwOptions gtkw_options;
-        gtkw_options.buses = layout_.buses;
-        gtkw_options.fit_end_time = vcd.end_time;
-        gtkw_options.fit_timescale = vcd.timescale;
-        // A window a laptop screen holds; the run fills the wave pane (about
-        // 1400 - 330 pixels of signal names and margins).
-        gtkw_options.window_width = 1400;
-        gtkw_options.window_height = 900;
-        gtkw_options.fit_width_pixels = 1000;
-        gtkw_options.background_scopes = background_scopes_;
-        // The save file names the dump relative to its own folder, which gtkwave
-        // resolves from wherever it is started.
-        std::error_code ec;
-        const auto gtkw_folder = std::filesystem::absolute(gtkw_path, ec).parent_path();
-        std::string dump = std::filesystem::relative(std::filesystem::absolute(path_, ec), gtkw_folder, ec).generic_string();
-        if (ec || dump.empty()) dump = std::filesystem::absolute(path_, ec).string();
-        write_gtkw(timeline_, gtkw_path, dump, gtkw_options);
-        return gtkw_path;
-    }
-
-private:
-    Timeline& timeline_;
-    std::string path_;
-    bool stream_wanted_;
-    VcdOptions layout_;
-    std::vector<std::string> background_scopes_;
-
-public:
-    // On a board: the MCUs' scopes go last in the save file, collapsed.
-    void set_background_scopes(std::vector<std::string> scopes) { background_scopes_ = std::move(scopes); }
-
-private:
-    std::unique_ptr<VcdStream> stream_;
-};
 
 // --vcd-format: portable (every reader, sigrok included) or compact (gtkwave's vectors and shared codes).
 VcdOptions vcd_layout(const RunArgs& args) {
@@ -607,12 +536,9 @@ int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome
 int run_board_command(const RunArgs& args) {
     BoardRun run = prepare_board_run(args);
     Bench& bench = *run.bench;
-    Waveforms waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_layout(args));
-    {
-        std::vector<std::string> mcu_scopes;
-        for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
-        waveforms.set_background_scopes(std::move(mcu_scopes));
-    }
+    std::vector<std::string> mcu_scopes;
+    for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
+    WaveformFiles waveforms(bench.timeline(), args.vcd, args.report.empty(), vcd_layout(args), mcu_scopes);
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -646,7 +572,7 @@ int run_board_command(const RunArgs& args) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
     if (bench.timeline().overflowed()) throw BadInput(bench.timeline().overflow_message());
-    const std::string gtkw_path = waveforms.finish(bench.mcu());
+    const std::string gtkw_path = waveforms.finish(bench.mcu().cycle(), bench.mcu().frequency_hz());
     for (const auto& pf : run.uart_out) write_output_file(pf.path, bench.serial(pf.port).transmitted_text(), "--uart-out");
     const auto findings = bench.findings();
     if (!args.report.empty()) {
@@ -705,7 +631,7 @@ int run_command(const RunArgs& args) {
     if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
 
     const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
-    Waveforms waveforms(timeline, args.vcd, true, vcd_layout(args));
+    WaveformFiles waveforms(timeline, args.vcd, true, vcd_layout(args));
     waveforms.start();
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     const auto wall_start = std::chrono::steady_clock::now();
@@ -723,7 +649,7 @@ int run_command(const RunArgs& args) {
 
     if (!uart_out.empty()) write_output_file(uart_out.front().path, uart0->transmitted_text(), "--uart-out");
     if (timeline.overflowed()) throw BadInput(timeline.overflow_message());
-    const std::string gtkw_path = waveforms.finish(mcu);
+    const std::string gtkw_path = waveforms.finish(mcu.cycle(), mcu.frequency_hz());
 
     const double simulated_s = mcu.seconds();
     std::printf("avrbench run: %s on %s at %.6g MHz\n", args.elf.c_str(), mcu.mcu_type().c_str(),
@@ -817,6 +743,7 @@ struct CheckArgs {
     std::vector<std::string> scenarios;
     std::string junit;
     std::string report_dir;
+    std::string vcd_dir;
     std::string firmware_dir;
 };
 
@@ -859,9 +786,17 @@ int check_command(const CheckArgs& args, bool update_golden) {
             throw BadInput("--report-dir: " + args.report_dir + ": cannot create the folder");
         }
     }
+    if (!args.vcd_dir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(args.vcd_dir, ec);
+        if (ec || !std::filesystem::is_directory(args.vcd_dir, ec)) {
+            throw BadInput("--vcd-dir: " + args.vcd_dir + ": cannot create the folder");
+        }
+    }
     if (!args.junit.empty()) check_output_path(args.junit, "--junit");
     ScenarioRunOptions options;
     options.report_dir = args.report_dir;
+    options.vcd_dir = args.vcd_dir;
     options.update_golden = update_golden;
     options.force = args.force;
     std::vector<ScenarioResult> results;
@@ -994,6 +929,8 @@ int main(int argc, char** argv) {
     check_cmd->add_option("scenarios", check.scenarios, "scenario files (tests/scenarios/*.yaml)")->required();
     check_cmd->add_option("--junit", check.junit, "write JUnit XML for CI");
     check_cmd->add_option("--report-dir", check.report_dir, "write an HTML report per scenario here");
+    check_cmd->add_option("--vcd-dir", check.vcd_dir,
+                          "write each scenario's waveforms here: <name>.vcd (sigrok-readable) and <name>.gtkw");
     check_cmd->add_option("--firmware-dir", check.firmware_dir, "where bare firmware names resolve (default: beside avrbench)");
     CheckArgs golden;
     CLI::App* golden_cmd = app.add_subcommand("golden", "manage golden timelines");

@@ -25,7 +25,6 @@
 
 namespace avrbench {
 
-constexpr Picoseconds kPsPerMs = 1'000'000'000ULL;
 
 enum class IdleResult {
     Idle,        // every host finished its job and no STEP edge for the settle time

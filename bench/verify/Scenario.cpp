@@ -1,5 +1,7 @@
 #include "verify/Scenario.hpp"
 
+#include "trace/WaveformFiles.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
@@ -426,6 +428,7 @@ std::string ScenarioResult::text() const {
     for (const auto& f : failures) out += "  " + f + "\n";
     if (comparison && !comparison->passed) out += "\n" + comparison->report();
     if (!report_path.empty()) out += "  report: " + report_path + "\n";
+    if (!vcd_path.empty()) out += "  waveforms: " + vcd_path + " (gtkwave " + with_extension(vcd_path, ".gtkw") + ")\n";
     return out;
 }
 

@@ -93,6 +93,7 @@ struct ScenarioResult {
     double simulated_s = 0;
     double wall_s = 0;
     std::string report_path;   // HTML report, if written
+    std::string vcd_path;      // VCD (with a .gtkw beside it), if written
     std::string text() const;  // the human-readable outcome (failures, then the diff report)
 };
 
@@ -102,6 +103,7 @@ ScenarioResult error_result(const std::string& path, const std::string& message)
 
 struct ScenarioRunOptions {
     std::string report_dir;      // write <report_dir>/<name>.html when set
+    std::string vcd_dir;         // write <vcd_dir>/<name>.vcd and .gtkw when set
     bool update_golden = false;  // write the golden timeline instead of comparing
     bool force = false;          // update_golden: also when steps or expectations failed
 };

@@ -12,6 +12,7 @@
 #include "core/InputFile.hpp"
 #include "core/FileHash.hpp"
 #include "core/UserStop.hpp"
+#include "trace/WaveformFiles.hpp"
 #include "trace/HtmlReport.hpp"
 #include "core/OutputFile.hpp"
 #include "trace/TimelineText.hpp"
@@ -377,6 +378,15 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     result.simulated_s = bench.now_seconds();
     result.passed = result.failures.empty();
     if (!options.report_dir.empty()) result.report_path = write_scenario_report(spec, options.report_dir, bench, result, golden);
+    if (!options.vcd_dir.empty()) {
+        // The name was checked when the file loaded: the files stay inside vcd_dir.
+        std::vector<std::string> mcu_scopes;
+        for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
+        WaveformFiles files(bench.timeline(), (fs::path(options.vcd_dir) / (spec.name + ".vcd")).string(), false, {},
+                            mcu_scopes);
+        files.finish(bench.mcu().cycle(), bench.mcu().frequency_hz());
+        result.vcd_path = files.vcd_path();
+    }
     result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     return result;
 }

@@ -9,6 +9,7 @@
 
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
+#include "trace/VcdReader.hpp"
 
 namespace avrbench {
 namespace {
@@ -46,6 +47,27 @@ TEST(CheckBatch, ABrokenScenarioIsOneErrorResultAndTheOthersStillRun) {
     const std::string xml = test::slurp(junit);
     EXPECT_NE(xml.find("tests=\"3\" failures=\"0\" errors=\"1\""), std::string::npos) << xml;
     EXPECT_NE(xml.find("<error message=\"" + where), std::string::npos) << xml;
+}
+
+// check --vcd-dir: each scenario's waveforms beside its verdict, the run as
+// `run --vcd` would record it. blink_timer1 toggles PB5 every 1 ms (Timer1
+// CTC, (249 + 1) x 64 cycles at 16 MHz): 20 ms give 20 edges, 19 when the
+// last falls after the run's end (the boot takes a few microseconds).
+TEST(CheckBatch, VcdDirHoldsEachScenariosWaveforms) {
+    const auto dir = test::scratch_dir("vcd-dir");
+    const fs::path blink = write(dir / "blink.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 20ms\n");
+    const auto r = test::run_command(kCli + " check " + blink.string() + kFw + " --vcd-dir " + (dir / "waves").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("  waveforms: " + (dir / "waves/blink.vcd").string() + " (gtkwave " + (dir / "waves/blink.gtkw").string() + ")"),
+              std::string::npos)
+        << r.out;
+    const VcdDump dump = read_vcd((dir / "waves/blink.vcd").string());
+    const VcdVariable& led = dump.at("labels.led");  // the UNO's D13 LED, PB5, under its board-file name
+    std::size_t edges = 0;
+    for (std::size_t i = 1; i < led.changes.size(); ++i) edges += led.changes[i].value != led.changes[i - 1].value;
+    EXPECT_GE(edges, 19u);
+    EXPECT_LE(edges, 20u);
+    EXPECT_TRUE(fs::exists(dir / "waves/blink.gtkw"));
 }
 
 // Every reference is checked before anything is simulated: the error comes
