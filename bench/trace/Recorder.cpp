@@ -56,17 +56,25 @@ SignalId Recorder::trace_pin(Mcu& mcu, Pin& pin) {
     return id;
 }
 
+namespace {
+
+// A USART's bytes in one direction: "uart<n>_tx" or "uart<n>_rx", shown as text.
+SignalInfo uart_bytes(const Mcu& mcu, const Uart& uart, const char* direction) {
+    return {mcu.name(), "uart" + std::to_string(uart.index()) + "_" + direction, SignalKind::Bus, 8, mcu.frequency_hz(),
+            true};
+}
+
+}  // namespace
+
 SignalId Recorder::trace_uart_tx(Mcu& mcu, Uart& uart) {
-    const SignalId id = timeline_.add_signal(
-        {mcu.name(), "uart" + std::to_string(uart.index()) + "_tx", SignalKind::Bus, 8, mcu.frequency_hz(), true});
+    const SignalId id = timeline_.add_signal(uart_bytes(mcu, uart, "tx"));
     Timeline* timeline = &timeline_;
     uart.on_transmit([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
     return id;
 }
 
 SignalId Recorder::trace_uart_rx(Mcu& mcu, Uart& uart) {
-    const SignalId id = timeline_.add_signal(
-        {mcu.name(), "uart" + std::to_string(uart.index()) + "_rx", SignalKind::Bus, 8, mcu.frequency_hz(), true});
+    const SignalId id = timeline_.add_signal(uart_bytes(mcu, uart, "rx"));
     Timeline* timeline = &timeline_;
     uart.on_receive([timeline, id](Cycle cycle, std::uint8_t byte) { timeline->record(id, cycle, byte); });
     return id;
