@@ -281,6 +281,22 @@ RunReport Bench::make_report(const std::string& title) const {
     std::snprintf(buf, sizeof buf, "simulated: %.6f s", now_seconds());
     r.facts.push_back(buf);
     r.timeline = &timeline_;
+    // The I2C traffic each MCU's TWI took part in (its `twi` byte signal).
+    for (Mcu* m : board_->mcus()) {
+        const long twi = timeline_.find(m->name(), "twi");
+        if (twi < 0) continue;
+        std::size_t bytes = 0;
+        Cycle first_cycle = 0;
+        for (const TimelineEvent& e : timeline_.events()) {
+            if (e.signal != static_cast<SignalId>(twi)) continue;
+            if (bytes++ == 0) first_cycle = e.cycle;
+        }
+        if (bytes == 0) continue;
+        char text[160];
+        std::snprintf(text, sizeof text, "%zu bytes (addresses and data), the first at %.6f s", bytes,
+                      static_cast<double>(first_cycle) / m->frequency_hz());
+        r.facts.push_back("I2C " + m->name() + ".twi: " + text);
+    }
     Mcu& first = *board_->mcus().front();
     r.end_cycle = first.cycle();
     r.end_clock_hz = first.frequency_hz();

@@ -8,6 +8,7 @@
 // sigrok-cli comes from ci/setup; a missing tool fails the test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -187,6 +188,13 @@ TEST(SigrokReadsOurVcd, FiveMcuPrinterI2cBytesAndStepEdgesAgreeWithTheBench) {
         else sigrok_bytes += "D" + value + "|";
     }
     EXPECT_EQ(sigrok_bytes, bench_bytes);
+    // The report says so too: one fact with the byte count the TWI model made.
+    const std::string count_fact =
+        "I2C interp.twi: " + std::to_string(std::count(bench_bytes.begin(), bench_bytes.end(), '|')) + " bytes";
+    const RunReport report = bench->make_report("printer");
+    EXPECT_TRUE(std::any_of(report.facts.begin(), report.facts.end(),
+                            [&](const std::string& f) { return f.rfind(count_fact, 0) == 0; }))
+        << count_fact;
 
     const std::string counted =
         sigrok(dir, dir.file("p.vcd"), "-P counter:data=x_step:data_edge=rising -A counter=edge_count");
