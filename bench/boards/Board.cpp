@@ -5,7 +5,7 @@
 #include <cmath>
 #include <set>
 
-#include "boards/PartRegistry.hpp"
+#include "parts/PartRegistry.hpp"
 #include "core/Adc.hpp"
 #include "core/Units.hpp"
 

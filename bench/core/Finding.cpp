@@ -1,36 +1,53 @@
 #include "core/Finding.hpp"
 
 #include <algorithm>
+#include <deque>
+#include <stdexcept>
 
 #include <cstdio>
 
 namespace avrbench {
 
-const char* to_string(FindingKind kind) {
-    switch (kind) {
-        case FindingKind::SimavrCrash: return "simavr-crash";
-        case FindingKind::InvalidOpcode: return "invalid-opcode";
-        case FindingKind::PcOutsideProgram: return "pc-outside-program";
-        case FindingKind::StackOverflow: return "stack-overflow";
-        case FindingKind::BadInterrupt: return "bad-interrupt";
-        case FindingKind::WatchdogReset: return "watchdog-reset";
-        case FindingKind::JumpToReset: return "jump-to-reset";
-        case FindingKind::StepHighTooShort: return "step-high-too-short";
-        case FindingKind::StepLowTooShort: return "step-low-too-short";
-        case FindingKind::DirSetupViolation: return "dir-setup-violation";
-        case FindingKind::DirHoldViolation: return "dir-hold-violation";
-        case FindingKind::StepRateTooHigh: return "step-rate-too-high";
-        case FindingKind::AxisOutOfTravel: return "axis-out-of-travel";
-        case FindingKind::MotorStall: return "motor-stall";
-        case FindingKind::Overheat: return "overheat";
-        case FindingKind::HostProtocol: return "host-protocol";
-        case FindingKind::SerialFraming: return "serial-framing";
-        case FindingKind::ServoPulseOutOfRange: return "servo-pulse-out-of-range";
-        case FindingKind::TargetOutOfReach: return "target-out-of-reach";
-        case FindingKind::NetContention: return "net-contention";
-        case FindingKind::FloatingInputRead: return "floating-input-read";
+const char* to_string(Severity severity) { return severity == Severity::Error ? "error" : "warning"; }
+
+namespace {
+
+// Declared kinds, in declaration order; a deque never moves its elements,
+// so a FindingKind's pointer stays valid. Function-local: declarations run
+// during static initialisation, in any order of translation units.
+std::deque<FindingKind::Info>& declared_kinds() {
+    static std::deque<FindingKind::Info> kinds;
+    return kinds;
+}
+
+const FindingKind::Info kUnspecified{"unspecified", "a finding whose kind was never set", Severity::Warning};
+
+}  // namespace
+
+FindingKind::FindingKind() : info_(&kUnspecified) {}
+
+FindingKind FindingKind::declare(std::string name, std::string meaning, Severity severity) {
+    for (const Info& info : declared_kinds()) {
+        if (info.name != name) continue;
+        if (info.severity != severity) throw std::logic_error("finding kind '" + name + "' declared with two severities");
+        return FindingKind(&info);
     }
-    return "unknown";
+    declared_kinds().push_back({std::move(name), std::move(meaning), severity});
+    return FindingKind(&declared_kinds().back());
+}
+
+std::optional<FindingKind> FindingKind::find(std::string_view name) {
+    for (const Info& info : declared_kinds()) {
+        if (info.name == name) return FindingKind(&info);
+    }
+    return std::nullopt;
+}
+
+std::vector<FindingKind> FindingKind::all() {
+    std::vector<FindingKind> out;
+    for (const Info& info : declared_kinds()) out.push_back(FindingKind(&info));
+    std::sort(out.begin(), out.end(), [](FindingKind a, FindingKind b) { return a.name() < b.name(); });
+    return out;
 }
 
 std::string Finding::describe() const {

@@ -5,43 +5,55 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/Time.hpp"
 
 namespace avrbench {
 
-enum class FindingKind {
-    SimavrCrash,       // simavr stopped the core (e.g. write outside RAM)
-    InvalidOpcode,     // an opcode the AVR core does not decode
-    PcOutsideProgram,  // PC left the loaded program (erased flash or past flashend)
-    StackOverflow,     // SP went below the end of .data/.bss/.noinit
-    BadInterrupt,      // an enabled interrupt without a handler reached __bad_interrupt
-    WatchdogReset,     // the watchdog timed out in system-reset mode
-    JumpToReset,       // execution reached the reset vector without a hardware reset
+// How much a finding weighs in a run's verdict (docs/CLI.md "exit codes").
+enum class Severity : std::uint8_t {
+    Warning,  // a part, a net or a host saw something wrong: fails a run under --strict
+    Error,    // the firmware itself failed (crash, reset): fails every run
+};
+const char* to_string(Severity severity);
 
-    // Found by parts watching the firmware's pins (parts/).
-    StepHighTooShort,    // STEP active shorter than the driver's minimum
-    StepLowTooShort,     // STEP inactive shorter than the driver's minimum
-    DirSetupViolation,   // DIR changed too shortly before an active STEP edge
-    DirHoldViolation,    // DIR changed too shortly after an active STEP edge
-    StepRateTooHigh,     // STEP period shorter than the driver's maximum rate allows
-    AxisOutOfTravel,     // an axis was driven past either end of its travel (a crash)
-    MotorStall,          // a stepper motor's rotor lost synchronism with its excitation (lost steps)
-    Overheat,            // a thermal plant passed its safe maximum temperature
-    HostProtocol,        // the UART host saw error / ALARM / !! or got no answer
-    SerialFraming,       // a pin-level serial frame with a bad stop bit or edges off the bit grid
-    ServoPulseOutOfRange,  // an RC servo pulse wider or narrower than its calibrated range
-    TargetOutOfReach,    // the firmware answered ok to a move the machine cannot make (a delta's arms or servos)
+// What kind of finding. The set is open: whoever detects a kind declares it
+// once, in its own source file (the MCU's oracles in core, nets in wiring, a
+// part in its .cpp, a host in stimulus), so no lower layer lists the parts'
+// kinds. Two kinds are equal when they are the same declaration.
+class FindingKind {
+public:
+    struct Info {
+        std::string name;     // "step-high-too-short": what reports, scenarios and --expect use
+        std::string meaning;  // one line for people ("STEP active shorter than the driver's minimum")
+        Severity severity;
+    };
+    // Declares a kind (a namespace-scope constant of the declarer). Declaring
+    // a name twice with the same severity gives the same kind; a different
+    // severity for a known name is a programming error (std::logic_error).
+    static FindingKind declare(std::string name, std::string meaning, Severity severity);
+    // A declared kind by name, for scenario files and command lines.
+    static std::optional<FindingKind> find(std::string_view name);
+    // Every declared kind, sorted by name (for messages and `avrbench findings`).
+    static std::vector<FindingKind> all();
 
-    // Found by the nets (wiring/).
-    NetContention,       // two outputs drive one net to opposite levels
-    FloatingInputRead,   // the firmware read an input pin whose net nothing drives
-    kLast = FloatingInputRead,
+    // A kind nobody declared ("unspecified"): only a default-constructed Finding has it.
+    FindingKind();
+    const std::string& name() const { return info_->name; }
+    const std::string& meaning() const { return info_->meaning; }
+    Severity severity() const { return info_->severity; }
+    friend bool operator==(FindingKind a, FindingKind b) { return a.info_ == b.info_; }
+
+private:
+    explicit FindingKind(const Info* info) : info_(info) {}
+    const Info* info_;
 };
 
-const char* to_string(FindingKind kind);
+inline const char* to_string(FindingKind kind) { return kind.name().c_str(); }
 
 struct Finding {
     FindingKind kind;

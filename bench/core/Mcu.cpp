@@ -31,6 +31,14 @@ extern "C" {
 
 namespace avrbench {
 
+const FindingKind Mcu::kSimavrCrash = FindingKind::declare("simavr-crash", "simavr stopped the core (e.g. a write outside RAM)", Severity::Error);
+const FindingKind Mcu::kInvalidOpcode = FindingKind::declare("invalid-opcode", "an opcode the AVR core does not decode", Severity::Error);
+const FindingKind Mcu::kPcOutsideProgram = FindingKind::declare("pc-outside-program", "PC left the loaded program (erased flash or past flashend)", Severity::Error);
+const FindingKind Mcu::kStackOverflow = FindingKind::declare("stack-overflow", "SP went below the end of .data/.bss/.noinit", Severity::Error);
+const FindingKind Mcu::kBadInterrupt = FindingKind::declare("bad-interrupt", "an enabled interrupt without a handler reached __bad_interrupt", Severity::Error);
+const FindingKind Mcu::kWatchdogReset = FindingKind::declare("watchdog-reset", "the watchdog timed out in system-reset mode", Severity::Error);
+const FindingKind Mcu::kJumpToReset = FindingKind::declare("jump-to-reset", "execution reached the reset vector without a hardware reset", Severity::Error);
+
 struct ResetHook {
     // avr_reset() zeroes the I/O space and then calls every module's reset;
     // the watchdog module sets MCUSR.WDRF in its own reset when the reset was
@@ -453,7 +461,7 @@ void Mcu::reset_external() {
 bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     char detail[160];
     if (state == cpu_Crashed) {
-        add_finding(FindingKind::SimavrCrash, avr_->pc,
+        add_finding(kSimavrCrash, avr_->pc,
                     last_error_log_.empty() ? "simavr stopped the core" : last_error_log_, true);
         return false;
     }
@@ -486,11 +494,11 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
             watchdog_reset_seen_ = false;
             // A boot loader leaving through a watchdog reset (optiboot does) is not a finding.
             if (!in_boot_section(pc_before)) {
-                add_finding(FindingKind::WatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
+                add_finding(kWatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
             }
         } else {
             std::snprintf(detail, sizeof detail, "execution jumped to the reset vector from %s", describe_pc(pc_before).c_str());
-            add_finding(FindingKind::JumpToReset, pc_before, detail, false);
+            add_finding(kJumpToReset, pc_before, detail, false);
         }
         return true;
     }
@@ -500,20 +508,20 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
         std::snprintf(detail, sizeof detail,
                       "interrupt vector %u (at 0x%04x) has no handler; avr-libc would reset the MCU",
                       pc_before / vector_bytes, pc_before);
-        add_finding(FindingKind::BadInterrupt, pc, detail, true);
+        add_finding(kBadInterrupt, pc, detail, true);
         return false;
     }
     if (pc >= code_end_bytes_) {
         std::snprintf(detail, sizeof detail, "PC 0x%04x is past the end of the program (0x%04x), came from %s",
                       pc, code_end_bytes_, describe_pc(pc_before).c_str());
-        add_finding(FindingKind::PcOutsideProgram, pc, detail, true);
+        add_finding(kPcOutsideProgram, pc, detail, true);
         return false;
     }
     const unsigned sp = avr_->data[R_SPL] | (avr_->data[R_SPH] << 8);
     if (sp < stack_floor_ && !sp_half_written(avr_, pc_before)) {
         std::snprintf(detail, sizeof detail, "SP 0x%04x is below the end of .data/.bss (0x%04x): the stack overwrote static data",
                       sp, elf_.ram_end_of_static_data());
-        add_finding(FindingKind::StackOverflow, pc_before, detail, true);
+        add_finding(kStackOverflow, pc_before, detail, true);
         return false;
     }
     return true;
@@ -546,7 +554,7 @@ void Mcu::on_simavr_error(const char* message) {
         const unsigned opcode = avr_->flash[pc] | (avr_->flash[pc + 1] << 8);
         char detail[64];
         std::snprintf(detail, sizeof detail, "opcode 0x%04x is not an AVR instruction", opcode);
-        add_finding(FindingKind::InvalidOpcode, pc, detail, true);
+        add_finding(kInvalidOpcode, pc, detail, true);
     }
 }
 

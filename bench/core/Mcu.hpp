@@ -169,6 +169,14 @@ public:
     Adc& adc() { return *adc_; }
 
     const std::vector<Finding>& findings() const { return findings_; }
+    // The firmware's own failures, which the core's oracles find (errors: they fail every run).
+    static const FindingKind kSimavrCrash;       // simavr stopped the core (e.g. a write outside RAM)
+    static const FindingKind kInvalidOpcode;     // an opcode the AVR core does not decode
+    static const FindingKind kPcOutsideProgram;  // PC left the loaded program
+    static const FindingKind kStackOverflow;     // SP went below the end of .data/.bss/.noinit
+    static const FindingKind kBadInterrupt;      // an enabled interrupt without a handler
+    static const FindingKind kWatchdogReset;     // the watchdog reset the MCU
+    static const FindingKind kJumpToReset;       // execution reached the reset vector without a reset
     // Number of avr_run() steps taken: instructions plus sleep fast-forwards.
     std::uint64_t steps() const { return steps_; }
     // Switches idle-loop skipping on or off (McuOptions::skip_idle_loops).

@@ -1,11 +1,29 @@
 #include "parts/Axis.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cmath>
 #include <cstdio>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+namespace {
+
+// linear_axis and rotary_axis: one model; the type name fixes its kind.
+PartType axis_type(const std::string& kind) {
+    PartType t = simple_part_type<Axis>(kind + "_axis");
+    t.implied = {{"kind", kind}};
+    return t;
+}
+
+}  // namespace
+
+REGISTER_PART_TYPE(axis_type("linear"));
+REGISTER_PART_TYPE(axis_type("rotary"));
+
+const FindingKind Axis::kAxisOutOfTravel = FindingKind::declare("axis-out-of-travel", "an axis was driven past either end of its travel (a crash)", Severity::Warning);
 
 std::vector<ParamSpec> Axis::param_specs() {
     using PT = ParamType;
@@ -106,7 +124,7 @@ void Axis::on_step(int delta_256) {
             std::snprintf(detail, sizeof detail, "carriage driven past the %s end of travel (%.4f mm of 0..%.3f mm)",
                           wanted < 0 ? "lower" : "upper", static_cast<double>(wanted) * metres_per_256_ * 1e3,
                           travel_m_ * 1e3);
-            report(FindingKind::AxisOutOfTravel, detail);
+            report(Axis::kAxisOutOfTravel, detail);
         }
         carriage_256_ = wanted < 0 ? 0 : travel_256_;  // the carriage stays at the end it hit
     } else {

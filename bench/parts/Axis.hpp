@@ -6,6 +6,8 @@
 // carriage stays at the end it hit, as a real one would.
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <functional>
 #include <vector>
 
@@ -17,6 +19,8 @@ namespace avrbench {
 
 class Axis final : public Part {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kAxisOutOfTravel;  // axis-out-of-travel
     static std::vector<ParamSpec> param_specs();
 
     Axis(std::string name, Mcu& clock, const ParamValues& params);

@@ -1,5 +1,7 @@
 #include "parts/DeltaRobot.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cstdio>
 
@@ -7,6 +9,10 @@
 #include "parts/RcServo.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(DeltaRobot, "delta_robot");
+
+const FindingKind DeltaRobot::kTargetOutOfReach = FindingKind::declare("target-out-of-reach", "the firmware answered ok to a move the machine cannot make (a delta's arms or servos)", Severity::Warning);
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
@@ -120,7 +126,7 @@ void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std
                 if (pose(near)) return;
             }
         }
-        report(FindingKind::TargetOutOfReach, std::string("no pose of the arms below the base reaches the target; ") + line +
+        report(DeltaRobot::kTargetOutOfReach, std::string("no pose of the arms below the base reaches the target; ") + line +
                                                   " was answered ok, target " + where);
         return;
     }
@@ -131,7 +137,7 @@ void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std
         char detail[200];
         std::snprintf(detail, sizeof detail, " was answered ok, target %s needs %s at %.1f deg, its travel %g..%g deg", where,
                       horns_[k]->name().c_str(), horn, lo, hi);
-        report(FindingKind::TargetOutOfReach, "arm " + std::to_string(k + 1) + " beyond its servo's travel; " + line + detail);
+        report(DeltaRobot::kTargetOutOfReach, "arm " + std::to_string(k + 1) + " beyond its servo's travel; " + line + detail);
         return;
     }
 }

@@ -6,6 +6,8 @@
 // port `effector` provides it to tools (an electromagnet).
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <array>
 #include <functional>
 #include <vector>
@@ -22,6 +24,8 @@ class RcServo;
 
 class DeltaRobot final : public Part {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kTargetOutOfReach;  // target-out-of-reach
     static std::vector<ParamSpec> param_specs();
 
     DeltaRobot(std::string name, Mcu& clock, const ParamValues& params);

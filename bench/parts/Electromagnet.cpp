@@ -1,5 +1,7 @@
 #include "parts/Electromagnet.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cstdio>
 #include <sstream>
 
@@ -7,6 +9,8 @@
 #include "parts/DeltaRobot.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(Electromagnet, "electromagnet");
 namespace {
 
 // "a:b,c:d" -> {{a, b}, {c, d}}

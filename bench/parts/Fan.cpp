@@ -1,5 +1,7 @@
 #include "parts/Fan.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -7,6 +9,8 @@
 #include "parts/ThermalPlant.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(Fan, "fan");
 
 std::vector<ParamSpec> Fan::param_specs() {
     using PT = ParamType;

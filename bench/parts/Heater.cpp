@@ -1,11 +1,15 @@
 #include "parts/Heater.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 
 #include "core/Errors.hpp"
 #include "parts/ThermalPlant.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(Heater, "heater");
 
 std::vector<ParamSpec> Heater::param_specs() {
     using PT = ParamType;

@@ -1,5 +1,7 @@
 #include "parts/HybridStepper.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -8,6 +10,28 @@
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+namespace {
+
+// A bipolar (hybrid_stepper) or unipolar (unipolar_stepper) motor: one model,
+// built with its winding layout.
+PartType stepper_type(const std::string& type_name, bool unipolar) {
+    PartType t;
+    t.name = type_name;
+    t.params = HybridStepper::param_specs(unipolar);
+    t.presets = HybridStepper::presets();
+    t.build = [unipolar](const std::string& name, Mcu& clock, const ParamValues& params) {
+        return std::make_unique<HybridStepper>(name, clock, params, unipolar);
+    };
+    return t;
+}
+
+}  // namespace
+
+REGISTER_PART_TYPE(stepper_type("hybrid_stepper", false));
+REGISTER_PART_TYPE(stepper_type("unipolar_stepper", true));
+
+const FindingKind HybridStepper::kMotorStall = FindingKind::declare("motor-stall", "a stepper motor's rotor lost synchronism with its excitation (lost steps)", Severity::Warning);
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -428,7 +452,7 @@ void HybridStepper::check_slip() {
                   "rotor lost synchronism with its excitation (excitation at %.0f rpm): rotor %.1f deg, commanded "
                   "%.1f deg, %ld full steps lost so far",
                   ev.commanded_rpm, ev.rotor_deg, ev.commanded_deg, ev.lost_steps);
-    report(FindingKind::MotorStall, detail);
+    report(HybridStepper::kMotorStall, detail);
     for (auto& fn : stall_listeners_) fn(ev);
 }
 

@@ -16,6 +16,8 @@
 // so stalls are seen without pin edges. Never the wall clock.
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -33,6 +35,8 @@ namespace avrbench {
 
 class HybridStepper final : public Part, public ShaftMotion {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kMotorStall;  // motor-stall
     static std::vector<ParamSpec> param_specs(bool unipolar);
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 

@@ -1,8 +1,12 @@
 #include "parts/L293D.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(L293D, "l293d");
 
 std::vector<ParamSpec> L293D::param_specs() {
     using PT = ParamType;

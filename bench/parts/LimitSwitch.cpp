@@ -1,5 +1,7 @@
 #include "parts/LimitSwitch.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -8,6 +10,8 @@
 #include "core/Units.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(LimitSwitch, "limit_switch");
 
 std::vector<ParamSpec> LimitSwitch::param_specs() {
     using PT = ParamType;

@@ -1,8 +1,12 @@
 #include "parts/LowSideSwitch.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(LowSideSwitch, "low_side_switch");
 
 std::vector<ParamSpec> LowSideSwitch::param_specs() {
     using PT = ParamType;

@@ -1,5 +1,7 @@
 #include "parts/PenLift.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cstdio>
 
@@ -8,6 +10,8 @@
 #include "parts/RcServo.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(PenLift, "pen_lift");
 
 std::vector<ParamSpec> PenLift::param_specs() {
     using PT = ParamType;

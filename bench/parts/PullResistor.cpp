@@ -1,10 +1,14 @@
 #include "parts/PullResistor.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cmath>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(PullResistor, "pull_resistor");
 
 std::vector<ParamSpec> PullResistor::param_specs() {
     using PT = ParamType;

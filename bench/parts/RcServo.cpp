@@ -1,5 +1,7 @@
 #include "parts/RcServo.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +10,10 @@
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(RcServo, "rc_servo");
+
+const FindingKind RcServo::kServoPulseOutOfRange = FindingKind::declare("servo-pulse-out-of-range", "an RC servo pulse wider or narrower than its calibrated range", Severity::Warning);
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
@@ -108,7 +114,7 @@ void RcServo::on_input(std::size_t pin, bool level) {
             char detail[160];
             std::snprintf(detail, sizeof detail, "pulse of %.1f us is outside the %.0f..%.0f us the servo accepts; ignored",
                           width_us, min_pulse_us_, max_pulse_us_);
-            report(FindingKind::ServoPulseOutOfRange, detail);
+            report(RcServo::kServoPulseOutOfRange, detail);
         }
         out_of_range_ = true;
         return;
@@ -125,7 +131,7 @@ void RcServo::on_pulse(double width_us, Cycle end) {
         char detail[160];
         std::snprintf(detail, sizeof detail, "pulse of %.1f us is outside the calibrated %.0f..%.0f us; clamped to %.1f deg",
                       width_us, table_.front().us, table_.back().us, angle_for_pulse_us(width_us));
-        report(FindingKind::ServoPulseOutOfRange, detail);
+        report(RcServo::kServoPulseOutOfRange, detail);
     }
     out_of_range_ = outside;
     const double now_deg = angle_at(end);

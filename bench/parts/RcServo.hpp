@@ -6,6 +6,8 @@
 // and reported (servo-pulse-out-of-range, once per spell).
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <cstdint>
 #include <vector>
 
@@ -16,6 +18,8 @@ namespace avrbench {
 
 class RcServo final : public Part {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kServoPulseOutOfRange;  // servo-pulse-out-of-range
     static std::vector<ParamSpec> param_specs();
 
     RcServo(std::string name, Mcu& clock, const ParamValues& params);

@@ -1,10 +1,14 @@
 #include "parts/Relay.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(Relay, "relay");
 
 std::vector<ParamSpec> Relay::param_specs() {
     using PT = ParamType;

@@ -1,11 +1,17 @@
 #include "parts/SerialPeer.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cmath>
 #include <cstdio>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(SerialPeer, "serial_peer");
+
+const FindingKind SerialPeer::kSerialFraming = FindingKind::declare("serial-framing", "a pin-level serial frame with a bad stop bit or edges off the bit grid", Severity::Warning);
 
 std::vector<ParamSpec> SerialPeer::param_specs() {
     using PT = ParamType;
@@ -82,7 +88,7 @@ void SerialPeer::on_input(std::size_t pin, bool level) {
         char detail[128];
         std::snprintf(detail, sizeof detail, "edge %.3f bits into a frame: off the %g-baud bit grid by more than %g bit",
                       bits, baud_, tolerance_bits_);
-        report(FindingKind::SerialFraming, detail);
+        report(SerialPeer::kSerialFraming, detail);
     }
 }
 
@@ -97,7 +103,7 @@ void SerialPeer::sample(unsigned bit_index) {
     if (bit_index == 9) {
         receiving_ = false;
         if (!level) {
-            report(FindingKind::SerialFraming, "stop bit read 0 (framing error)");
+            report(SerialPeer::kSerialFraming, "stop bit read 0 (framing error)");
             return;
         }
         received_.push_back(static_cast<char>(shift_));

@@ -12,6 +12,8 @@
 // budget of §20.8, Table 20-2 for 8N1 is about +-4.5 %, both ends together).
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <string>
 #include <vector>
 
@@ -22,6 +24,8 @@ namespace avrbench {
 
 class SerialPeer final : public Part {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kSerialFraming;  // serial-framing
     static std::vector<ParamSpec> param_specs();
 
     SerialPeer(std::string name, Mcu& clock, const ParamValues& params);

@@ -1,6 +1,10 @@
 #include "parts/ShiftRegister595.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 namespace avrbench {
+
+REGISTER_PART(ShiftRegister595, "shift_register_595");
 
 std::vector<ParamSpec> ShiftRegister595::param_specs() {
     using PT = ParamType;

@@ -1,11 +1,21 @@
 #include "parts/StepDirDriver.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <cmath>
 #include <cstdio>
 
 #include "core/Errors.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(StepDirDriver, "step_dir_driver");
+
+const FindingKind StepDirDriver::kStepHighTooShort = FindingKind::declare("step-high-too-short", "STEP active shorter than the driver's minimum", Severity::Warning);
+const FindingKind StepDirDriver::kStepLowTooShort = FindingKind::declare("step-low-too-short", "STEP inactive shorter than the driver's minimum", Severity::Warning);
+const FindingKind StepDirDriver::kDirSetupViolation = FindingKind::declare("dir-setup-violation", "DIR changed too shortly before an active STEP edge", Severity::Warning);
+const FindingKind StepDirDriver::kDirHoldViolation = FindingKind::declare("dir-hold-violation", "DIR changed too shortly after an active STEP edge", Severity::Warning);
+const FindingKind StepDirDriver::kStepRateTooHigh = FindingKind::declare("step-rate-too-high", "STEP period shorter than the driver's maximum rate allows", Severity::Warning);
 namespace {
 
 // Microstep resolution from the MSx pin levels, bit i = pin i.
@@ -202,7 +212,7 @@ void StepDirDriver::on_input(std::size_t pin, bool level) {
 void StepDirDriver::on_dir_change() {
     const Cycle now = clock().cycle();
     if (enabled() && have_active_edge_ && now - last_active_edge_ < dir_hold_cycles_) {
-        report(FindingKind::DirHoldViolation,
+        report(StepDirDriver::kDirHoldViolation,
                "DIR changed " + std::to_string(now - last_active_edge_) + " cycles after the STEP edge; " + preset_ +
                    " needs " + std::to_string(dir_hold_cycles_) + " cycles of hold");
     }
@@ -214,7 +224,7 @@ void StepDirDriver::on_step_edge(bool active) {
     const Cycle now = clock().cycle();
     if (!active) {
         if (enabled() && have_active_edge_ && now - last_active_edge_ < step_high_min_cycles_) {
-            report(FindingKind::StepHighTooShort,
+            report(StepDirDriver::kStepHighTooShort,
                    "STEP active for " + std::to_string(now - last_active_edge_) + " cycles (" +
                        format_us(static_cast<double>(now - last_active_edge_) / clock().frequency_hz()) + "); " +
                        preset_ + " needs " + std::to_string(step_high_min_cycles_) + " cycles");
@@ -228,12 +238,12 @@ void StepDirDriver::on_step_edge(bool active) {
         return;
     }
     if (have_inactive_edge_ && now - last_inactive_edge_ < step_low_min_cycles_) {
-        report(FindingKind::StepLowTooShort,
+        report(StepDirDriver::kStepLowTooShort,
                "STEP inactive for " + std::to_string(now - last_inactive_edge_) + " cycles before this edge; " +
                    preset_ + " needs " + std::to_string(step_low_min_cycles_) + " cycles");
     }
     if (have_dir_change_ && now - last_dir_change_ < dir_setup_cycles_) {
-        report(FindingKind::DirSetupViolation,
+        report(StepDirDriver::kDirSetupViolation,
                "DIR changed " + std::to_string(now - last_dir_change_) + " cycles before the STEP edge; " + preset_ +
                    " needs " + std::to_string(dir_setup_cycles_) + " cycles of setup");
     }
@@ -244,7 +254,7 @@ void StepDirDriver::on_step_edge(bool active) {
             if (rate > peak_step_rate_hz_) peak_step_rate_hz_ = rate;
         }
         if (period < min_step_period_cycles_) {
-            report(FindingKind::StepRateTooHigh,
+            report(StepDirDriver::kStepRateTooHigh,
                    "STEP period " + std::to_string(period) + " cycles; " + preset_ + " allows at most " +
                        std::to_string(static_cast<long long>(max_step_rate_hz_)) + " steps/s");
         }

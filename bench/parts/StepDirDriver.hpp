@@ -4,6 +4,8 @@
 // finding with its cycle.
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -20,6 +22,12 @@ namespace avrbench {
 
 class StepDirDriver final : public Part, public DriveSource, public ShaftMotion {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kStepHighTooShort;  // step-high-too-short
+    static const FindingKind kStepLowTooShort;  // step-low-too-short
+    static const FindingKind kDirSetupViolation;  // dir-setup-violation
+    static const FindingKind kDirHoldViolation;  // dir-hold-violation
+    static const FindingKind kStepRateTooHigh;  // step-rate-too-high
     static std::vector<ParamSpec> param_specs();
     // Datasheet timing per preset (name -> parameter -> value with unit).
     static const std::map<std::string, std::map<std::string, std::string>>& presets();

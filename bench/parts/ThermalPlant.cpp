@@ -1,5 +1,7 @@
 #include "parts/ThermalPlant.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +10,10 @@
 #include "parts/ShaftMotion.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(ThermalPlant, "thermal_plant");
+
+const FindingKind ThermalPlant::kOverheat = FindingKind::declare("overheat", "a thermal plant passed its safe maximum temperature", Severity::Warning);
 
 std::vector<ParamSpec> ThermalPlant::param_specs() {
     using PT = ParamType;
@@ -150,7 +156,7 @@ void ThermalPlant::advance() {
         // parameters still combine past it, that is a finding (this code runs
         // inside simavr's callbacks, where no exception may pass), and the
         // summary says "not a number" instead of printing one.
-        if (!diverged_) report(FindingKind::Overheat, "the block's temperature is no longer a finite number "
+        if (!diverged_) report(ThermalPlant::kOverheat, "the block's temperature is no longer a finite number "
                                                       "(parameters outside any physical range?)");
         diverged_ = true;
         return;
@@ -160,7 +166,7 @@ void ThermalPlant::advance() {
         char detail[120];
         std::snprintf(detail, sizeof detail, "block at %.1f degC, above the plant's maximum of %.1f degC", block,
                       max_degC_);
-        report(FindingKind::Overheat, detail);
+        report(ThermalPlant::kOverheat, detail);
     } else if (overheated_ && block < max_degC_ - 5.0) {
         overheated_ = false;  // re-armed after cooling 5 K below the limit
     }

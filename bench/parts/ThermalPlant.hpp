@@ -14,6 +14,8 @@
 // changes or somebody reads a temperature, at the plant clock's cycle.
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <cstdint>
 #include <map>
 #include <string>
@@ -29,6 +31,8 @@ class ShaftMotion;
 
 class ThermalPlant final : public Part {
 public:
+    // What this part finds (docs/FINDINGS.md).
+    static const FindingKind kOverheat;  // overheat
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 

@@ -1,5 +1,7 @@
 #include "parts/Thermistor.hpp"
 
+#include "parts/PartRegistry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,6 +11,8 @@
 #include "parts/ThermalPlant.hpp"
 
 namespace avrbench {
+
+REGISTER_PART(Thermistor, "thermistor");
 namespace {
 
 constexpr double kKelvin = 273.15;

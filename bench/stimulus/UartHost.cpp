@@ -19,6 +19,8 @@
 
 namespace avrbench {
 
+const FindingKind UartHost::kHostProtocol = FindingKind::declare("host-protocol", "the UART host saw error / ALARM / !! or got no answer", Severity::Warning);
+
 namespace {
 
 bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }

@@ -15,6 +15,8 @@
 // wall clock.
 #pragma once
 
+#include "core/Finding.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -178,6 +180,8 @@ struct HostEvent {
 
 class UartHost {
 public:
+    // What this one finds (docs/FINDINGS.md).
+    static const FindingKind kHostProtocol;  // host-protocol
     using LineListener = std::function<void(const TranscriptEntry& entry)>;
 
     // Attaches to USART `uart_index` of `mcu` from its current cycle on (the

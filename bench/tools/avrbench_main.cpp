@@ -270,7 +270,8 @@ std::pair<Picoseconds, std::string> parse_realtime(const std::string& item) {
     return {at, bytes};
 }
 
-bool is_mcu_finding(const Finding& f) { return f.kind <= FindingKind::JumpToReset; }
+// A finding that fails every run (the firmware crashed or reset), not only --strict ones.
+bool fails_every_run(const Finding& f) { return f.kind.severity() == Severity::Error; }
 
 // How much of the run the idle-loop skipper covered (core/IdleLoopSkip.hpp).
 void print_idle_skip(const Mcu& mcu, bool name_it) {
@@ -500,7 +501,7 @@ void print_board_summary(const RunArgs& args, BoardRun& run, IdleResult outcome,
 // The exit code (docs/CLI.md), with the one-line reason on stderr.
 int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome, const std::vector<Finding>& findings) {
     for (const auto& f : findings) {
-        if (is_mcu_finding(f) || (args.strict && f.kind != FindingKind::HostProtocol)) return kExitFinding;
+        if (fails_every_run(f) || (args.strict && f.kind != UartHost::kHostProtocol)) return kExitFinding;
     }
     if (run.plot && run.plot->failed()) {
         std::fprintf(stderr, "avrbench: timeout: %s\n", run.plot->failure().c_str());
@@ -527,7 +528,7 @@ int board_exit_code(const RunArgs& args, const BoardRun& run, IdleResult outcome
     }
     if (args.strict) {
         for (const auto& f : findings) {
-            if (f.kind == FindingKind::HostProtocol) return kExitFinding;
+            if (f.kind == UartHost::kHostProtocol) return kExitFinding;
         }
     }
     return kExitOk;
@@ -677,6 +678,18 @@ int run_command(const RunArgs& args) {
     if (args.until_sleep && !slept && !mcu.halted()) {
         std::fprintf(stderr, "avrbench: timeout: the firmware did not execute SLEEP within %s\n", args.duration.c_str());
         return kExitTimeout;
+    }
+    return kExitOk;
+}
+
+// `avrbench findings`: every finding kind the linked layers and parts declare.
+int findings_command() {
+    std::size_t width = 0;
+    for (const FindingKind kind : FindingKind::all()) width = std::max(width, kind.name().size());
+    std::printf("Finding kinds (error: fails every run; warning: fails under --strict)\n");
+    for (const FindingKind kind : FindingKind::all()) {
+        std::printf("  %-*s  %-7s  %s\n", static_cast<int>(width), kind.name().c_str(), to_string(kind.severity()),
+                    kind.meaning().c_str());
     }
     return kExitOk;
 }
@@ -942,6 +955,8 @@ int main(int argc, char** argv) {
 
     CLI::App* boards_cmd = app.add_subcommand("boards", "list the standard boards (names for --board and scenarios) with their descriptions");
 
+    CLI::App* findings_cmd = app.add_subcommand("findings", "list the finding kinds with their severity and meaning");
+
     CamArgs cam;
     CLI::App* cam_cmd = app.add_subcommand("cam", "seed 002's CAM: a DXF drawing (lines, arcs, circles) to G-code");
     cam_cmd->add_option("dxf", cam.dxf, "the drawing, machine millimetres from home")->required();
@@ -991,6 +1006,7 @@ int main(int argc, char** argv) {
         if (update_cmd->parsed()) code = check_command(golden, true);
         if (cam_cmd->parsed()) code = cam_command(cam);
         if (boards_cmd->parsed()) code = boards_command();
+        if (findings_cmd->parsed()) code = findings_command();
         if (fuzz_cmd->parsed()) code = fuzz_command(fuzz);
     } catch (const BadInput& e) {
         // Escaped: a message that quotes a user's string stays one line and

@@ -256,7 +256,7 @@ std::vector<Finding> Bench::findings() const {
     for (const auto& [name, host] : hosts_) {
         for (const auto& e : host->events()) {
             Finding f;
-            f.kind = FindingKind::HostProtocol;
+            f.kind = UartHost::kHostProtocol;
             f.source = name;
             f.cycle = e.cycle;
             f.clock_hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();

@@ -235,7 +235,7 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
         if (item.value.IsSequence()) {
             ExpectFindingKinds kinds;
             std::set<std::string> known;
-            for (int i = 0; i <= static_cast<int>(FindingKind::kLast); ++i) known.insert(to_string(static_cast<FindingKind>(i)));
+            for (const FindingKind kind : FindingKind::all()) known.insert(kind.name());
             for (const auto& entry : item.value) {
                 const std::string kind = scalar(entry, item.path, "findings entry");
                 if (known.count(kind) == 0) {

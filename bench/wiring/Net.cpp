@@ -4,6 +4,9 @@
 
 namespace avrbench {
 
+const FindingKind Net::kNetContention = FindingKind::declare("net-contention", "two outputs drive one net to opposite levels", Severity::Warning);
+const FindingKind Net::kFloatingInputRead = FindingKind::declare("floating-input-read", "the firmware read an input pin whose net nothing drives", Severity::Warning);
+
 void Terminal::drive_changed() {
     if (net_ != nullptr) net_->update();
 }
@@ -41,7 +44,7 @@ void Net::update() {
         resolution_ = next;
         if (contention_starts && clock_ != nullptr) {
             Finding f;
-            f.kind = FindingKind::NetContention;
+            f.kind = Net::kNetContention;
             f.source = name_;
             f.cycle = clock_->cycle();
             f.clock_hz = clock_->frequency_hz();
@@ -84,7 +87,7 @@ void Net::floating_read(Mcu& reader, const std::string& pin_label) {
     if (!something_else_drives) return;
     floating_read_reported_ = true;
     Finding f;
-    f.kind = FindingKind::FloatingInputRead;
+    f.kind = Net::kFloatingInputRead;
     f.source = name_;
     f.cycle = reader.cycle();
     f.clock_hz = reader.frequency_hz();

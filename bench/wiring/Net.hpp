@@ -60,6 +60,9 @@ private:
 
 class Net {
 public:
+    // What this one finds (docs/FINDINGS.md).
+    static const FindingKind kNetContention;  // net-contention
+    static const FindingKind kFloatingInputRead;  // floating-input-read
     explicit Net(std::string name) : name_(std::move(name)) {}
     Net(const Net&) = delete;
     Net& operator=(const Net&) = delete;

@@ -4,7 +4,7 @@
 #include <fstream>
 
 #include "boards/Board.hpp"
-#include "boards/PartRegistry.hpp"
+#include "parts/PartRegistry.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 

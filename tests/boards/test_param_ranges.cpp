@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "boards/PartRegistry.hpp"
+#include "parts/PartRegistry.hpp"
 #include "core/Errors.hpp"
 #include "parts/Params.hpp"
 

@@ -86,7 +86,7 @@ nets:
     // The 3000 us pulses: one finding for the whole spell of them.
     int out_of_range = 0;
     for (const Finding& f : board.findings()) {
-        if (f.kind != FindingKind::ServoPulseOutOfRange) continue;
+        if (f.kind != RcServo::kServoPulseOutOfRange) continue;
         ++out_of_range;
         EXPECT_NE(f.detail.find("pulse of 3000.0 us is outside the calibrated 1000..2000 us"), std::string::npos)
             << f.detail;
@@ -115,7 +115,7 @@ nets:
     EXPECT_DOUBLE_EQ(servo.last_pulse_us(), 1000.0) << "the 3000 us pulses are not taken";
     int reported = 0;
     for (const Finding& f : board.findings()) {
-        if (f.kind != FindingKind::ServoPulseOutOfRange) continue;
+        if (f.kind != RcServo::kServoPulseOutOfRange) continue;
         ++reported;
         EXPECT_NE(f.detail.find("pulse of 3000.0 us is outside the 400..2500 us the servo accepts; ignored"), std::string::npos)
             << f.detail;

@@ -36,7 +36,7 @@ TEST(SerialPeer, ReportsASenderTenPercentFast) {
     std::string received;
     const auto findings = talk("10560", received);
     ASSERT_FALSE(findings.empty());
-    EXPECT_EQ(findings.front().kind, FindingKind::SerialFraming);
+    EXPECT_EQ(findings.front().kind, SerialPeer::kSerialFraming);
     EXPECT_EQ(findings.front().source, "listener");
 }
 

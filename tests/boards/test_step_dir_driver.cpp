@@ -52,7 +52,7 @@ TEST(StepDirDriver, CountsStepsAndIgnoresThemWhileDisabled) {
 
 TEST(StepDirDriver, ReportsTheShortPulseAtItsFallingEdge) {
     PatternRun run;
-    const auto shorts = of_kind(run.board->findings(), FindingKind::StepHighTooShort);
+    const auto shorts = of_kind(run.board->findings(), StepDirDriver::kStepHighTooShort);
     ASSERT_EQ(shorts.size(), 1u);
     // The pin trace has the pulse: find the one high interval shorter than
     // 16 cycles (1 us at 16 MHz); the finding carries its falling edge.
@@ -72,8 +72,8 @@ TEST(StepDirDriver, ReportsTheShortPulseAtItsFallingEdge) {
 
 TEST(StepDirDriver, ReportsDirSetupAndHoldViolations) {
     PatternRun run;
-    const auto setup = of_kind(run.board->findings(), FindingKind::DirSetupViolation);
-    const auto hold = of_kind(run.board->findings(), FindingKind::DirHoldViolation);
+    const auto setup = of_kind(run.board->findings(), StepDirDriver::kDirSetupViolation);
+    const auto hold = of_kind(run.board->findings(), StepDirDriver::kDirHoldViolation);
     ASSERT_EQ(setup.size(), 1u);
     ASSERT_EQ(hold.size(), 1u);
     // Both happen 2 cycles (one SBI/CBI) from the STEP edge; the A4988 needs
@@ -84,8 +84,8 @@ TEST(StepDirDriver, ReportsDirSetupAndHoldViolations) {
 
 TEST(StepDirDriver, ReportsShortLowTimeAndExcessRate) {
     PatternRun run;
-    const auto low = of_kind(run.board->findings(), FindingKind::StepLowTooShort);
-    const auto rate = of_kind(run.board->findings(), FindingKind::StepRateTooHigh);
+    const auto low = of_kind(run.board->findings(), StepDirDriver::kStepLowTooShort);
+    const auto rate = of_kind(run.board->findings(), StepDirDriver::kStepRateTooHigh);
     ASSERT_EQ(low.size(), 1u);
     // Phase 7: 2 delay cycles + the 2-cycle SBI = 4 cycles low.
     EXPECT_NE(low[0].detail.find("inactive for 4 cycles"), std::string::npos) << low[0].detail;
@@ -111,15 +111,15 @@ nets:
     Board board(parse_board_text(board_text, "drv8825-test.yaml"), {{"uno", test::firmware("step_pattern")}});
     board.run_for_seconds(0.05);
     const auto findings = board.findings();
-    const auto rate = of_kind(findings, FindingKind::StepRateTooHigh);
+    const auto rate = of_kind(findings, StepDirDriver::kStepRateTooHigh);
     ASSERT_EQ(rate.size(), 1u);
     EXPECT_NE(rate[0].detail.find("STEP period 36 cycles"), std::string::npos) << rate[0].detail;
     // Phase 2's 8-cycle pulse and phase 7's 4-cycle low time violate 31 cycles too.
-    EXPECT_EQ(of_kind(findings, FindingKind::StepHighTooShort).size(), 1u);
-    EXPECT_EQ(of_kind(findings, FindingKind::StepLowTooShort).size(), 1u);
+    EXPECT_EQ(of_kind(findings, StepDirDriver::kStepHighTooShort).size(), 1u);
+    EXPECT_EQ(of_kind(findings, StepDirDriver::kStepLowTooShort).size(), 1u);
     // 650 ns setup/hold = 10.4 -> 11 cycles: the 2-cycle DIR changes violate both.
-    EXPECT_EQ(of_kind(findings, FindingKind::DirSetupViolation).size(), 1u);
-    EXPECT_EQ(of_kind(findings, FindingKind::DirHoldViolation).size(), 1u);
+    EXPECT_EQ(of_kind(findings, StepDirDriver::kDirSetupViolation).size(), 1u);
+    EXPECT_EQ(of_kind(findings, StepDirDriver::kDirHoldViolation).size(), 1u);
 }
 
 TEST(StepDirDriver, NoFindingsForGoodSteps) {

@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "wiring/Net.hpp"
 #include "boards/Board.hpp"
 #include "boards/BoardFile.hpp"
 #include "support/Paths.hpp"
@@ -54,14 +55,14 @@ void expect_nets_resolve(const std::string& mcu_type, const std::string& firmwar
 
     int floating = 0, contention = 0;
     for (const Finding& f : board.findings()) {
-        if (f.kind == FindingKind::FloatingInputRead) {
+        if (f.kind == Net::kFloatingInputRead) {
             ++floating;
             EXPECT_EQ(f.source, "divider_47k");
             // The PC of the instruction that read PINB, in the firmware's read_pin_b().
             EXPECT_NE(f.symbol.find("read_pin_b"), std::string::npos) << f.describe();
             EXPECT_NE(f.detail.find("0.57 VCC"), std::string::npos) << f.detail;
         }
-        if (f.kind == FindingKind::NetContention) {
+        if (f.kind == Net::kNetContention) {
             ++contention;
             EXPECT_EQ(f.source, "fight");
             EXPECT_NE(f.detail.find("m.PB5 high"), std::string::npos) << f.detail;

@@ -19,7 +19,7 @@ TEST(Oracles, InvalidOpcodeIsReportedAtItsAddress) {
     Mcu mcu(ElfImage::load(test::firmware("crash_bad_opcode")));
     EXPECT_EQ(mcu.run_for(16000000), StopReason::Halted);
     const Finding& f = only_finding(mcu);
-    EXPECT_EQ(f.kind, FindingKind::InvalidOpcode);
+    EXPECT_EQ(f.kind, Mcu::kInvalidOpcode);
     EXPECT_EQ(f.pc_bytes, *mcu.elf().symbol_address("bad_opcode_here"));
     EXPECT_EQ(f.symbol, "bad_opcode_here");
     EXPECT_GT(f.cycle, 0u);
@@ -30,7 +30,7 @@ TEST(Oracles, StackIntoBssIsReported) {
     Mcu mcu(ElfImage::load(test::firmware("crash_stack_overflow")));
     EXPECT_EQ(mcu.run_for(16000000), StopReason::Halted);
     const Finding& f = only_finding(mcu);
-    EXPECT_EQ(f.kind, FindingKind::StackOverflow);
+    EXPECT_EQ(f.kind, Mcu::kStackOverflow);
     EXPECT_NE(f.detail.find("below the end of .data/.bss"), std::string::npos) << f.detail;
     // Caught at the first instruction that moved SP below __bss_end - 1: a
     // push, a call, or recurse()'s prologue allocating its 16-byte volatile
@@ -47,7 +47,7 @@ TEST(Oracles, UnhandledInterruptReachesBadInterrupt) {
     Mcu mcu(ElfImage::load(test::firmware("crash_bad_interrupt")));
     EXPECT_EQ(mcu.run_for(16000000), StopReason::Halted);
     const Finding& f = only_finding(mcu);
-    EXPECT_EQ(f.kind, FindingKind::BadInterrupt);
+    EXPECT_EQ(f.kind, Mcu::kBadInterrupt);
     EXPECT_EQ(f.symbol, "__bad_interrupt");
     // TIMER0_OVF is vector 17 in the datasheet's 1-based table (ATmega328P
     // §12.4 table 12-6), program address 0x0020 words = 0x0040 bytes.
@@ -62,7 +62,7 @@ TEST(Oracles, WatchdogResetIsReportedAndTheFirmwareSeesWdrf) {
     mcu.run_for(16000 * 40);  // 40 ms
     ASSERT_EQ(mcu.findings().size(), 1u);
     const Finding& f = mcu.findings().front();
-    EXPECT_EQ(f.kind, FindingKind::WatchdogReset);
+    EXPECT_EQ(f.kind, Mcu::kWatchdogReset);
     // WDTO_15MS: WDP = 0, 2K cycles of the 128 kHz watchdog oscillator = 16 ms
     // (ATmega328P §10.9.2 table 10-3). The reset comes 16 ms after the
     // watchdog was enabled, which happens within the first few hundred cycles.
@@ -79,7 +79,7 @@ TEST(Oracles, JumpPastTheProgramIsReported) {
     Mcu mcu(ElfImage::load(test::firmware("crash_pc_outside_flash")));
     EXPECT_EQ(mcu.run_for(16000000), StopReason::Halted);
     const Finding& f = only_finding(mcu);
-    EXPECT_EQ(f.kind, FindingKind::PcOutsideProgram);
+    EXPECT_EQ(f.kind, Mcu::kPcOutsideProgram);
     EXPECT_EQ(f.pc_bytes, 0x3000u * 2);  // the firmware calls word address 0x3000
     EXPECT_NE(f.describe().find("cycle"), std::string::npos);
 }

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "parts/DeltaRobot.hpp"
 #include "support/Paths.hpp"
 #include "verify/Bench.hpp"
 
@@ -28,7 +29,7 @@ std::vector<std::string> reach_findings(const std::string& firmware, const std::
     EXPECT_TRUE(bench.host().done()) << bench.host().tail(10);
     std::vector<std::string> out;
     for (const auto& f : bench.board().findings()) {
-        if (f.kind == FindingKind::TargetOutOfReach) out.push_back(f.describe());
+        if (f.kind == DeltaRobot::kTargetOutOfReach) out.push_back(f.describe());
     }
     return out;
 }
@@ -75,7 +76,7 @@ TEST(DeltaMoveOracle, ABoardForAnotherFrameTurnsTheCheckOff) {
     Bench bench(std::move(spec), {{"mega", test::firmware("delta_thesis")}});
     bench.host().add_lines(kJob);
     bench.run_until_idle(10.0);
-    for (const auto& f : bench.board().findings()) EXPECT_NE(f.kind, FindingKind::TargetOutOfReach) << f.describe();
+    for (const auto& f : bench.board().findings()) EXPECT_NE(f.kind, DeltaRobot::kTargetOutOfReach) << f.describe();
 }
 
 }  // namespace

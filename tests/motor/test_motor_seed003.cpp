@@ -120,7 +120,7 @@ TEST(MotorSeed003, StartFromRestAt196RpmLosesSteps) {
     EXPECT_EQ(run.motor.lost_steps() % 4, 0);
     EXPECT_GE(run.motor.stalls(), 1u);
     bool flagged = false;
-    for (const auto& f : run.board.findings()) flagged = flagged || f.kind == FindingKind::MotorStall;
+    for (const auto& f : run.board.findings()) flagged = flagged || f.kind == HybridStepper::kMotorStall;
     EXPECT_TRUE(flagged);
 }
 
@@ -170,7 +170,7 @@ TEST(MotorSeed003, ThesisDelayTruncationIsFlaggedAsLostSteps) {
     // The truncated delays drive the motor above its pull-out speed.
     std::vector<Finding> stalls;
     for (const auto& f : run.board.findings()) {
-        if (f.kind == FindingKind::MotorStall) stalls.push_back(f);
+        if (f.kind == HybridStepper::kMotorStall) stalls.push_back(f);
     }
     ASSERT_FALSE(stalls.empty());
     EXPECT_EQ(stalls.front().source, "motor");

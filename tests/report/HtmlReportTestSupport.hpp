@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "parts/StepDirDriver.hpp"
 #include "trace/RunReport.hpp"
 #include "trace/Timeline.hpp"
 
@@ -124,9 +125,9 @@ inline void add_everything(DemoRun& run) {
         run.report.transcript.push_back({static_cast<Cycle>(i) * 800000, kClock, true, "G1 X" + std::to_string(i)});
         run.report.transcript.push_back({static_cast<Cycle>(i) * 800000 + 4000, kClock, false, "ok"});
     }
-    Finding crash{FindingKind::StackOverflow, "mcu", 1234567, kClock, true, 0x1a4, "recurse+0x6",
+    Finding crash{Mcu::kStackOverflow, "mcu", 1234567, kClock, true, 0x1a4, "recurse+0x6",
                   "SP 0x0213 below __bss_end 0x0300"};
-    Finding part{FindingKind::StepHighTooShort, "x_driver", 2000000, kClock, false, 0, "", "STEP high 0.5 us < 1.0 us"};
+    Finding part{StepDirDriver::kStepHighTooShort, "x_driver", 2000000, kClock, false, 0, "", "STEP high 0.5 us < 1.0 us"};
     run.report.findings = {crash, part};
 }
 

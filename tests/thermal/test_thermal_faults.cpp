@@ -128,7 +128,7 @@ TEST(HeaterFault, StuckOnTripsMaxtempAndTheOverheatFinding) {
     EXPECT_EQ(board->mcu().read_ram_u8("error"), 4) << "MAXTEMP";
     EXPECT_TRUE(board->part_as<Heater>("hotend_heater").on());
     bool overheat = false;
-    for (const auto& f : board->findings()) overheat = overheat || (f.kind == FindingKind::Overheat && f.source == "hotend");
+    for (const auto& f : board->findings()) overheat = overheat || (f.kind == ThermalPlant::kOverheat && f.source == "hotend");
     EXPECT_TRUE(overheat);
 }
 

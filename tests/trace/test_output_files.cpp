@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "parts/HybridStepper.hpp"
+#include "parts/StepDirDriver.hpp"
 #include "core/Errors.hpp"
 #include "core/Finding.hpp"
 #include "core/OutputFile.hpp"
@@ -80,7 +82,7 @@ TEST(Findings, AFloodIsSummarizedAsTheFirstFewThenACountPerKind) {
     std::vector<Finding> findings;
     for (int i = 0; i < 5000; ++i) {
         Finding f;
-        f.kind = FindingKind::StepHighTooShort;
+        f.kind = StepDirDriver::kStepHighTooShort;
         f.source = "x_driver";
         f.cycle = 16000u * static_cast<unsigned>(i);
         f.clock_hz = 16000000;
@@ -88,7 +90,7 @@ TEST(Findings, AFloodIsSummarizedAsTheFirstFewThenACountPerKind) {
         findings.push_back(f);
     }
     Finding stall;
-    stall.kind = FindingKind::MotorStall;
+    stall.kind = HybridStepper::kMotorStall;
     stall.source = "motor";
     stall.clock_hz = 16000000;
     stall.has_pc = false;

@@ -1,6 +1,12 @@
 // The part types a board file may name: for each, its parameters, presets
 // and how to build it. A part's pins and ports are its own (Part); the
 // board's nets connect them.
+//
+// Each part registers itself in its own source file, next to its code
+// (REGISTER_PART(StepDirDriver, "step_dir_driver");), so a new part is its two
+// files and nothing else: no list of types lives anywhere. The parts library
+// is linked whole (bench/CMakeLists.txt), so a registration is never dropped
+// by the linker for want of a reference.
 #pragma once
 
 #include <functional>
@@ -37,10 +43,23 @@ PartType simple_part_type(const std::string& type_name) {
     return t;
 }
 
-// Every part type the bench ships, by name.
+// Adds a type (during static initialisation; see REGISTER_PART). A name
+// registered twice is a programming error: std::logic_error.
+bool register_part_type(PartType type);
+
+// Every registered part type, by name.
 const std::map<std::string, PartType>& part_types();
 
-// The motor layer's types (bridges, switches, 74HC595, steppers), in boards/MotorPartTypes.cpp.
-std::vector<PartType> motor_part_types();
+#define AVRBENCH_CONCAT_INNER(a, b) a##b
+#define AVRBENCH_CONCAT(a, b) AVRBENCH_CONCAT_INNER(a, b)
+// At namespace scope in a part's .cpp: the board-file type `name` builds T
+// from its parameters (T::param_specs(), T::presets() if it has them).
+#define REGISTER_PART(T, name) \
+    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __LINE__) = \
+        ::avrbench::register_part_type(::avrbench::simple_part_type<T>(name))
+// The same for a type built some other way (a PartType expression).
+#define REGISTER_PART_TYPE(part_type) \
+    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __LINE__) = \
+        ::avrbench::register_part_type(part_type)
 
 }  // namespace avrbench

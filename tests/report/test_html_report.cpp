@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "stimulus/UartHost.hpp"
 #include "report/HtmlReportTestSupport.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/TraceTestSupport.hpp"
@@ -333,7 +334,7 @@ TEST(HtmlReport, EscapesEveryPieceOfText) {
     run.report.facts = {"path: \"x\" 'y'"};
     run.report.transcript = {{100, kClock, false, "<script>alert(\"x\")</script>"},
                              {200, kClock, true, std::string("ctl\x01 bad\xff deg \xc2\xb0" "C")}};
-    run.report.findings = {{FindingKind::HostProtocol, "host<1>", 16000, kClock, false, 0, "", "got <b>error</b> & quit"}};
+    run.report.findings = {{UartHost::kHostProtocol, "host<1>", 16000, kClock, false, 0, "", "got <b>error</b> & quit"}};
     const SignalId odd = run.timeline->add_signal({"<x>", "pos&", SignalKind::Real, 64, kClock});
     run.timeline->record_real(odd, 0, 0);
     run.timeline->record_real(odd, 16000, 1);
