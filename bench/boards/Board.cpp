@@ -146,7 +146,7 @@ std::string pins_and_ports(Part& p) {
     for (std::size_t i = 0; i < p.pin_count(); ++i) list += (list.empty() ? "" : ", ") + p.pin(i).name();
     std::string ports;
     for (std::size_t i = 0; i < p.port_count(); ++i) {
-        ports += (ports.empty() ? "" : ", ") + p.port(i).name + " (" + std::string(port_kind_name(p.port(i).kind)) +
+        ports += (ports.empty() ? "" : ", ") + p.port(i).name + " (" + std::string(p.port(i).kind->name) +
                  (p.port(i).provides ? "" : " in") + ")";
     }
     return "pins: " + (list.empty() ? std::string("none") : list) + "; ports: " + (ports.empty() ? "none" : ports);
@@ -160,6 +160,7 @@ void Board::build_nets() {
         Part* part;
         std::size_t port;
         Part* provider;
+        std::size_t provider_port;
     };
     std::vector<PortLink> links;
     for (const auto& decl : spec_.nets) {
@@ -196,41 +197,34 @@ void Board::build_nets() {
         for (const PortEnd& end : ports) {
             const PortInfo& info = end.part->port(end.port);
             if (info.kind != first.kind) {
-                throw BadInput(decl.location + ": net '" + decl.name + "' joins a " + std::string(port_kind_name(first.kind)) +
+                throw BadInput(decl.location + ": net '" + decl.name + "' joins a " + std::string(first.kind->name) +
                                " port (" + ports.front().endpoint->text() + ") and a " +
-                               std::string(port_kind_name(info.kind)) + " port (" + end.endpoint->text() + ")");
+                               std::string(info.kind->name) + " port (" + end.endpoint->text() + ")");
             }
             if (!info.provides) continue;
             if (provider != nullptr) {
                 throw BadInput(decl.location + ": net '" + decl.name + "' has two " +
-                               std::string(port_kind_name(info.kind)) + " providers: " + provider->endpoint->text() +
+                               std::string(info.kind->name) + " providers: " + provider->endpoint->text() +
                                " and " + end.endpoint->text());
             }
             provider = &end;
         }
         if (provider == nullptr) {
             throw BadInput(decl.location + ": net '" + decl.name + "' has no part providing its " +
-                           std::string(port_kind_name(first.kind)) + " port (" + ports.front().endpoint->text() +
-                           " needs one, e.g. " + (first.kind == PortKind::Thermal   ? "a thermal_plant's body"
-                                                  : first.kind == PortKind::Steps   ? "a step_dir_driver's steps"
-                                                  : first.kind == PortKind::Carriage ? "a linear axis' carriage"
-                                                  : first.kind == PortKind::Windings ? "an l293d's windings"
-                                                  : first.kind == PortKind::Horn     ? "an rc_servo's horn"
-                                                  : first.kind == PortKind::Effector ? "a delta_robot's effector"
-                                                                                     : "an analog output") +
-                           ")");
+                           std::string(first.kind->name) + " port (" + ports.front().endpoint->text() +
+                           " needs one, e.g. " + std::string(first.kind->example) + ")");
         }
-        if (first.kind == PortKind::Analog) {
+        if (first.kind == &kAnalogPort) {
             build_analog_net(decl, *provider->part, provider->port, pins);
             continue;
         }
         if (!pins.empty()) {
             throw BadInput(pins.front()->location + ": net '" + decl.name + "' joins the pin " + pins.front()->text() +
-                           " and the " + std::string(port_kind_name(first.kind)) + " port " +
+                           " and the " + std::string(first.kind->name) + " port " +
                            provider->endpoint->text() + ": only analog outputs share a net with pins");
         }
         for (const PortEnd& end : ports) {
-            if (&end != provider) links.push_back({end.part, end.port, provider->part});
+            if (&end != provider) links.push_back({end.part, end.port, provider->part, provider->port});
         }
     }
 
@@ -252,7 +246,7 @@ void Board::build_nets() {
                 continue;
             }
             try {
-                p->connect_port(port, *link->provider);
+                p->connect_port(port, *link->provider, link->provider_port);
             } catch (const BadInput& e) {
                 throw BadInput(location + ": " + e.what());
             }

@@ -69,13 +69,14 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
         if (start_m_ < 0 || start_m_ > travel_m_) {
             throw BadInput("part '" + this->name() + "': start_position outside 0..travel");
         }
-        provide_port("carriage", PortKind::Carriage, "the carriage position limit switches watch");
+        provide_port<Carriage>("carriage", *this, "the carriage position limit switches watch");
     }
-    require_port("drive", PortKind::Steps, true, "a step_dir_driver's steps or a stepper motor's shaft");
+    require_port<ShaftMotion>("drive", true, "a step_dir_driver's steps or a stepper motor's shaft",
+                              [this](ShaftMotion& driver) { connect_drive(driver); });
 }
 
-void Axis::connect_port(std::size_t, Part& provider) {
-    driver_ = &dynamic_cast<ShaftMotion&>(provider);
+void Axis::connect_drive(ShaftMotion& driver) {
+    driver_ = &driver;
     // Steps are counted in 1/256 full steps: one is (256 / microsteps)^-1 of a configured step.
     const double microsteps = driver_->configured_microsteps();
     if (rotary_) {

@@ -6,25 +6,23 @@
 // carriage stays at the end it hit, as a real one would.
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <functional>
 #include <vector>
 
+#include "parts/Carriage.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 #include "parts/ShaftMotion.hpp"
 
 namespace avrbench {
 
-class Axis final : public Part {
+class Axis final : public Part, public Carriage {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kAxisOutOfTravel;  // axis-out-of-travel
     static std::vector<ParamSpec> param_specs();
 
     Axis(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return rotary_ ? "rotary_axis" : "linear_axis"; }
 
     bool rotary() const { return rotary_; }
@@ -33,15 +31,16 @@ public:
     // Net steps at the driver's configured resolution (signed).
     double position_steps() const;
     // Linear: carriage position in mm (0 .. travel). Rotary: degrees.
-    double position_mm() const { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
+    double position_mm() const override { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
     double position_deg() const;
-    double travel_mm() const { return travel_m_ * 1e3; }
+    double travel_mm() const override { return travel_m_ * 1e3; }
     std::string summary() override;
     unsigned crashes() const { return crashes_; }
 
-    void on_move(std::function<void(double position_m)> fn) { move_listeners_.push_back(std::move(fn)); }
+    void on_move(std::function<void(double position_m)> fn) override { move_listeners_.push_back(std::move(fn)); }
 
 private:
+    void connect_drive(ShaftMotion& driver);
     void on_step(int delta_256);
 
     ShaftMotion* driver_ = nullptr;

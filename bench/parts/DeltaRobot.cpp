@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "core/Errors.hpp"
-#include "parts/RcServo.hpp"
 
 namespace avrbench {
 
@@ -63,21 +62,20 @@ DeltaRobot::DeltaRobot(std::string name, Mcu& clock, const ParamValues& params) 
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     for (int k = 0; k < 3; ++k) {
-        horn_ports_[static_cast<std::size_t>(k)] =
-            require_port("horn" + std::to_string(k + 1), PortKind::Horn, true, "an rc_servo's horn");
+        const auto arm = static_cast<std::size_t>(k);
+        require_port<ServoHorn>("horn" + std::to_string(k + 1), true, "an rc_servo's horn",
+                                [this, arm](ServoHorn& horn, Part& servo) {
+                                    horns_[arm] = &horn;
+                                    horn_names_[arm] = servo.name();
+                                });
     }
-    provide_port("effector", PortKind::Effector, "the effector centre, for a tool such as an electromagnet");
+    provide_port<Effector>("effector", *this, "the effector centre, for a tool such as an electromagnet");
     sig_x_ = add_signal({"x_mm", true, "mm", SignalRole::Position, ""}, 0);
     sig_y_ = add_signal({"y_mm", true, "mm", SignalRole::Position, ""}, 0);
     sig_z_ = add_signal({"z_mm", true, "mm", SignalRole::Position, ""}, 0);
     sig_reachable_ = add_signal("reachable", false, 0);
 }
 
-void DeltaRobot::connect_port(std::size_t port, Part& provider) {
-    for (std::size_t k = 0; k < 3; ++k) {
-        if (horn_ports_[k] == port) horns_[k] = &dynamic_cast<RcServo&>(provider);
-    }
-}
 
 void DeltaRobot::start() { tick(); }
 
@@ -136,7 +134,7 @@ void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std
         if (horn >= lo - kTravelMarginDeg && horn <= hi + kTravelMarginDeg) continue;
         char detail[200];
         std::snprintf(detail, sizeof detail, " was answered ok, target %s needs %s at %.1f deg, its travel %g..%g deg", where,
-                      horns_[k]->name().c_str(), horn, lo, hi);
+                      horn_names_[k].c_str(), horn, lo, hi);
         report(DeltaRobot::kTargetOutOfReach, "arm " + std::to_string(k + 1) + " beyond its servo's travel; " + line + detail);
         return;
     }

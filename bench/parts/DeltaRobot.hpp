@@ -6,8 +6,6 @@
 // port `effector` provides it to tools (an electromagnet).
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <array>
 #include <functional>
 #include <vector>
@@ -15,14 +13,14 @@
 #include <Eigen/Dense>
 
 #include "parts/DeltaKinematics.hpp"
+#include "parts/Effector.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ServoHorn.hpp"
 
 namespace avrbench {
 
-class RcServo;
-
-class DeltaRobot final : public Part {
+class DeltaRobot final : public Part, public Effector {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kTargetOutOfReach;  // target-out-of-reach
@@ -30,16 +28,15 @@ public:
 
     DeltaRobot(std::string name, Mcu& clock, const ParamValues& params);
     std::string_view type() const override { return "delta_robot"; }
-    void connect_port(std::size_t port, Part& provider) override;
     void start() override;
     std::string summary() override;
 
     const DeltaGeometry& geometry() const { return geometry_; }
     // The effector centre as of the last sample (mm), and whether the arms' angles reach one.
-    const Eigen::Vector3d& effector_mm() const { return effector_mm_; }
+    const Eigen::Vector3d& effector_mm() const override { return effector_mm_; }
     bool reachable() const { return reachable_; }
     std::array<double, 3> arm_angles_deg() const;
-    void on_move(std::function<void(const Eigen::Vector3d&)> fn) { move_listeners_.push_back(std::move(fn)); }
+    void on_move(std::function<void(const Eigen::Vector3d&)> fn) override { move_listeners_.push_back(std::move(fn)); }
 
     // Whether G0/G1 X Y Z lines the firmware accepts are targets in this
     // part's frame (mm, origin at the base centre, z negative below it; the
@@ -63,8 +60,8 @@ private:
 
     DeltaGeometry geometry_;
     std::array<double, 3> offset_deg_{};
-    std::array<RcServo*, 3> horns_{};
-    std::array<std::size_t, 3> horn_ports_{};
+    std::array<ServoHorn*, 3> horns_{};
+    std::array<std::string, 3> horn_names_;  // the servos', for findings
     Cycle sample_cycles_;
     Eigen::Vector3d effector_mm_ = Eigen::Vector3d::Zero();
     bool reachable_ = false;

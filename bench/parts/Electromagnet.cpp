@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "core/Errors.hpp"
-#include "parts/DeltaRobot.hpp"
 
 namespace avrbench {
 
@@ -68,14 +67,14 @@ Electromagnet::Electromagnet(std::string name, Mcu& clock, const ParamValues& pa
     box_[2] = box[1].first;
     box_[3] = box[1].second;
     coil_pin_ = add_pin("coil", TerminalRole::Input);
-    require_port("effector", PortKind::Effector, true, "a delta_robot's effector");
+    require_port<Effector>("effector", true, "a delta_robot's effector", [this](Effector& effector) { connect_effector(effector); });
     sig_on_ = add_signal("energized", false, 0);
     sig_carried_ = add_signal("carried", true, 0);
     sig_in_box_ = add_signal("in_box", true, 0);
 }
 
-void Electromagnet::connect_port(std::size_t, Part& provider) {
-    robot_ = &dynamic_cast<DeltaRobot&>(provider);
+void Electromagnet::connect_effector(Effector& effector) {
+    robot_ = &effector;
     robot_->on_move([this](const Eigen::Vector3d&) { update(); });
 }
 

@@ -10,12 +10,12 @@
 
 #include <Eigen/Dense>
 
+#include "parts/Effector.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 
 namespace avrbench {
 
-class DeltaRobot;
 
 class Electromagnet final : public Part {
 public:
@@ -23,7 +23,6 @@ public:
 
     Electromagnet(std::string name, Mcu& clock, const ParamValues& params);
     std::string_view type() const override { return "electromagnet"; }
-    void connect_port(std::size_t port, Part& provider) override;
     void start() override;
     std::string summary() override;
 
@@ -37,11 +36,12 @@ public:
     unsigned in_box() const;
 
 private:
+    void connect_effector(Effector& effector);
     void on_input(std::size_t pin, bool level) override;
     void update();
 
     std::size_t coil_pin_;
-    DeltaRobot* robot_ = nullptr;
+    Effector* robot_ = nullptr;
     std::vector<Piece> pieces_;
     double table_z_mm_, pick_distance_mm_;
     double box_[4];  // x min, x max, y min, y max (mm)

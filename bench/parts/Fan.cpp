@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "core/Errors.hpp"
-#include "parts/ThermalPlant.hpp"
+#include "parts/ThermalBody.hpp"
 
 namespace avrbench {
 
@@ -37,10 +37,12 @@ Fan::Fan(std::string name, Mcu& clock, const ParamValues& params) : Part(std::mo
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     pwm_pin_ = add_pin("pwm", TerminalRole::Input);
     sig_speed_ = add_signal("speed", true, 0);
-    require_port("body", PortKind::Thermal, true, "the thermal_plant it cools");
+    require_port<ThermalBody>("body", true, "the thermal_plant it cools",
+                              [this](ThermalBody& body) { connect_body(body); });
 }
 
-void Fan::connect_port(std::size_t, Part& provider) { plant_ = &dynamic_cast<ThermalPlant&>(provider); }
+void Fan::connect_body(ThermalBody& body) {
+    plant_ = &body; }
 
 void Fan::start() {
     last_cycle_ = clock().cycle();

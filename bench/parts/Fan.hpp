@@ -14,7 +14,7 @@
 
 namespace avrbench {
 
-class ThermalPlant;
+class ThermalBody;
 
 class Fan final : public Part {
 public:
@@ -24,7 +24,6 @@ public:
 
     // Port `body` requires the thermal_plant it cools.
     Fan(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "fan"; }
     void start() override;
 
@@ -34,13 +33,14 @@ public:
     std::vector<std::string> fault_names() const override { return {"stopped"}; }
 
 private:
+    void connect_body(ThermalBody& body);
     void on_input(std::size_t pin, bool level) override;
     void apply_fault(const std::string& fault) override;
     void update();
     void settle_speed();
     void on_sample(Cycle scheduled);
 
-    ThermalPlant* plant_ = nullptr;
+    ThermalBody* plant_ = nullptr;
     std::size_t pwm_pin_;
     bool active_level_;
     double tau_s_;

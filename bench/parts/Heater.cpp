@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "core/Errors.hpp"
-#include "parts/ThermalPlant.hpp"
+#include "parts/ThermalBody.hpp"
 
 namespace avrbench {
 
@@ -66,19 +66,20 @@ Heater::Heater(std::string name, Mcu& clock, const ParamValues& params)
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    require_port("body", PortKind::Thermal, true, "the thermal_plant it heats");
+    require_port<ThermalBody>("body", true, "the thermal_plant it heats",
+                              [this](ThermalBody& body, Part& plant) { connect_body(body, plant); });
 }
 
-void Heater::connect_port(std::size_t, Part& provider) {
-    plant_ = &dynamic_cast<ThermalPlant&>(provider);
+void Heater::connect_body(ThermalBody& body, Part& plant) {
+    plant_ = &body;
     try {
         source_ = plant_->add_heat_source(node_, power_on_W_);
     } catch (const BadInput& e) {
         throw BadInput("part '" + name() + "': " + e.what());
     }
-    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant_->name()}, 0);
-    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant_->name()}, 0);
-    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant_->name()}, 0);
+    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant.name()}, 0);
+    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant.name()}, 0);
+    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant.name()}, 0);
 }
 
 void Heater::start() {

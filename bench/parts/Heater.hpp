@@ -29,7 +29,7 @@
 
 namespace avrbench {
 
-class ThermalPlant;
+class ThermalBody;
 
 class Heater final : public Part {
 public:
@@ -40,14 +40,12 @@ public:
 
     // Port `body` requires a thermal_plant's `body`.
     Heater(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "heater"; }
     void start() override;
 
     bool on() const { return waving_ ? gate_on_now() : on_; }
     // The gate is a periodic wave the heater follows with its mean power.
     bool follows_wave() const { return waving_; }
-    const ThermalPlant& plant() const { return *plant_; }
     double power_on_W() const { return power_on_W_; }  // dissipation while on
     double power_W() const { return on() ? power_on_W_ : 0.0; }
     // Energy dissipated since power-on (exact to the cycle), J.
@@ -59,6 +57,7 @@ public:
     std::vector<std::string> fault_names() const override { return {"disconnected", "stuck_on"}; }
 
 private:
+    void connect_body(ThermalBody& body, Part& plant);
     void on_input(std::size_t pin, bool level) override;
     bool begin_input_wave(std::size_t pin, const PeriodicWave& wave) override;
     void end_input_wave(std::size_t pin, Cycle at) override;
@@ -69,7 +68,7 @@ private:
     void update();
     void on_sample(Cycle scheduled);
 
-    ThermalPlant* plant_ = nullptr;
+    ThermalBody* plant_ = nullptr;
     std::string node_;
     int source_ = -1;
     std::size_t gate_pin_;

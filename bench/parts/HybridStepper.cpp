@@ -225,8 +225,9 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
             taps_.push_back({phase, plus, minus, 0, 0});
         }
     }
-    require_port("windings", PortKind::Windings, true,
-                 unipolar_ ? "a low_side_switch's windings" : "an l293d's or a step_dir_driver's windings");
+    require_port<DriveSource>("windings", true,
+                              unipolar_ ? "a low_side_switch's windings" : "an l293d's or a step_dir_driver's windings",
+                              [this](DriveSource& source) { connect_windings(source); });
     if (unipolar_) {
         for (int pair = 0; pair < 2; ++pair) {
             provide_analog(pair == 0 ? "sense_ac" : "sense_bd",
@@ -240,7 +241,7 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
 
     shaft_256_ = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (kPi / 2) * 256.0));
     shaft_full_ = shaft_256_ >= 0 ? shaft_256_ / 256 : -((-shaft_256_ + 255) / 256);
-    provide_port("shaft", PortKind::Steps, "the rotor in full steps, for a linear_axis (a lead screw) to follow");
+    provide_port<ShaftMotion>("shaft", *this, "the rotor in full steps, for a linear_axis (a lead screw) to follow");
     sig_angle_ = add_signal("angle_deg", true);
     sig_command_ = add_signal("commanded_deg", true);
     sig_error_ = add_signal("following_error_deg", true);
@@ -259,8 +260,7 @@ void HybridStepper::listen(DriveSource& source) {
     source.on_drive_change([this] { on_drive_change(); });
 }
 
-void HybridStepper::connect_port(std::size_t, Part& provider) {
-    auto& source = dynamic_cast<DriveSource&>(provider);
+void HybridStepper::connect_windings(DriveSource& source) {
     for (const WindingTap& tap : taps_) {
         const std::string problem = source.tap_problem(tap);
         if (!problem.empty()) throw BadInput("part '" + name() + "': " + problem);

@@ -16,8 +16,6 @@
 // so stalls are seen without pin edges. Never the wall clock.
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -57,7 +55,6 @@ public:
     // A, B, C = A-, D = B-) its tap on that source comes from phase_a/phase_b
     // or coil_a..coil_d. A unipolar motor provides its sense resistors'
     // voltages on analog ports `sense_ac` and `sense_bd`.
-    void connect_port(std::size_t port, Part& provider) override;
     std::size_t winding_count() const { return model_.winding_count(); }
     // Unipolar: the centre-tap supply and the sense resistor, for the switches' drives.
     double supply_v() const { return supply_v_; }
@@ -94,6 +91,7 @@ public:
     std::string rate_summary() const override { return ""; }
 
 private:
+    void connect_windings(DriveSource& source);
     void listen(DriveSource& source);
     void on_drive_change();
     void refresh_drive();

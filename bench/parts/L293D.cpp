@@ -45,7 +45,7 @@ L293D::L293D(std::string name, Mcu& clock, const ParamValues& params)
     for (int i = 0; i < 4; ++i) in_pins_[i] = add_pin("in" + std::to_string(i + 1), TerminalRole::Input);
     // 1 = high, 0 = low, 0.5 = off (high impedance).
     for (int i = 0; i < 4; ++i) sig_out_[i] = add_signal("out" + std::to_string(i + 1), true, 0.5);
-    provide_port("windings", PortKind::Windings, "a bipolar motor's windings between pairs of outputs 1Y..4Y");
+    provide_port<DriveSource>("windings", *this, "a bipolar motor's windings between pairs of outputs 1Y..4Y");
 }
 
 std::string L293D::tap_problem(const WindingTap& tap) const {

@@ -63,11 +63,11 @@ LimitSwitch::LimitSwitch(std::string name, Mcu& clock, const ParamValues& params
                                                       std::int64_t{1} << 53))) {
     out_pin_ = add_pin("out", TerminalRole::Output);
     sig_closed_ = add_signal("closed", false);
-    require_port("axis", PortKind::Carriage, true, "a linear axis' carriage");
+    require_port<Carriage>("axis", true, "a linear axis' carriage", [this](Carriage& axis) { connect_axis(axis); });
 }
 
-void LimitSwitch::connect_port(std::size_t, Part& provider) {
-    axis_ = &dynamic_cast<Axis&>(provider);
+void LimitSwitch::connect_axis(Carriage& axis) {
+    axis_ = &axis;
     const double travel_m = axis_->travel_mm() * 1e-3;
     trip_m_ = position_given_ ? position_m_ : (min_side_ ? 0.0 : travel_m);
     if (trip_m_ < 0 || trip_m_ > travel_m) {

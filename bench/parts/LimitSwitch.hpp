@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <random>
 
-#include "parts/Axis.hpp"
+#include "parts/Carriage.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 
@@ -20,7 +20,6 @@ public:
     static std::vector<ParamSpec> param_specs();
 
     LimitSwitch(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "limit_switch"; }
 
     bool triggered() const { return triggered_; }
@@ -32,11 +31,12 @@ public:
     void start() override;
 
 private:
+    void connect_axis(Carriage& axis);
     void on_axis_move(double position_m);
     void set_contact(bool closed);
     void apply_contact(bool closed);
 
-    Axis* axis_ = nullptr;
+    Carriage* axis_ = nullptr;
     bool position_given_;
     double position_m_;  // the trip position as given (default: the side's end)
     std::size_t out_pin_;

@@ -39,7 +39,7 @@ LowSideSwitch::LowSideSwitch(std::string name, Mcu& clock, const ParamValues& pa
         in_pins_.push_back(add_pin("in" + std::to_string(i), TerminalRole::Input));
         sig_on_.push_back(add_signal("on" + std::to_string(i), false));
     }
-    provide_port("windings", PortKind::Windings, "a unipolar motor's half-windings, one per channel");
+    provide_port<DriveSource>("windings", *this, "a unipolar motor's half-windings, one per channel");
 }
 
 std::string LowSideSwitch::tap_problem(const WindingTap& tap) const {

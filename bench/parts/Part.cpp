@@ -46,19 +46,6 @@ std::size_t Part::add_pin(std::string name, TerminalRole role) {
     return pins_.size() - 1;
 }
 
-std::string_view port_kind_name(PortKind kind) {
-    switch (kind) {
-        case PortKind::Analog: return "analog";
-        case PortKind::Steps: return "steps";
-        case PortKind::Carriage: return "carriage";
-        case PortKind::Thermal: return "thermal";
-        case PortKind::Windings: return "windings";
-        case PortKind::Horn: return "horn";
-        case PortKind::Effector: return "effector";
-    }
-    return "?";
-}
-
 const PortInfo* Part::find_port(std::string_view name, std::size_t* index) const {
     for (std::size_t i = 0; i < ports_.size(); ++i) {
         if (ports_[i].name == name) {
@@ -69,27 +56,28 @@ const PortInfo* Part::find_port(std::string_view name, std::size_t* index) const
     return nullptr;
 }
 
-void Part::connect_port(std::size_t port, Part& provider) {
-    throw BadInput("part '" + name_ + "' (" + std::string(type()) + ") cannot connect port '" + ports_.at(port).name +
-                   "' to '" + provider.name() + "'");
+void Part::connect_port(std::size_t port, Part& provider, std::size_t provider_port) {
+    const PortInfo& info = ports_.at(port);
+    const PortInfo& offered = provider.ports_.at(provider_port);
+    if (info.provides || !offered.provides || info.kind != offered.kind || !connect_[port]) {
+        throw BadInput("part '" + name_ + "' (" + std::string(type()) + ") cannot connect port '" + info.name + "' to '" +
+                       provider.name() + "." + offered.name + "'");
+    }
+    connect_[port](provider.offered_[provider_port], provider);
 }
 
 double Part::analog_volts(std::size_t port, Cycle cycle) const { return analog_sources_.at(port)(cycle); }
 
-std::size_t Part::provide_port(std::string name, PortKind kind, std::string help) {
-    ports_.push_back({std::move(name), kind, true, false, std::move(help)});
-    analog_sources_.emplace_back();
-    return ports_.size() - 1;
-}
-
-std::size_t Part::require_port(std::string name, PortKind kind, bool required, std::string help) {
-    ports_.push_back({std::move(name), kind, false, required, std::move(help)});
+std::size_t Part::add_port(PortInfo info, void* offered, std::function<void(void*, Part&)> connect) {
+    ports_.push_back(std::move(info));
+    offered_.push_back(offered);
+    connect_.push_back(std::move(connect));
     analog_sources_.emplace_back();
     return ports_.size() - 1;
 }
 
 std::size_t Part::provide_analog(std::string name, std::function<double(Cycle)> volts, std::string help) {
-    const std::size_t index = provide_port(std::move(name), PortKind::Analog, std::move(help));
+    const std::size_t index = add_port({std::move(name), &kAnalogPort, true, false, std::move(help)}, nullptr, {});
     analog_sources_[index] = std::move(volts);
     return index;
 }

@@ -19,10 +19,12 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "core/Finding.hpp"
 #include "core/Mcu.hpp"
+#include "parts/PortType.hpp"
 #include "wiring/Net.hpp"
 
 namespace avrbench {
@@ -63,22 +65,11 @@ private:
     bool level_ = false;
 };
 
-// What a non-digital port carries. Two ports can share a net only if they
-// have the same kind; the kind fixes the C++ interface the provider offers.
-enum class PortKind : std::uint8_t {
-    Analog,   // a voltage an MCU's ADC samples (provider: Part::analog_volts)
-    Steps,    // a step/dir driver's shaft motion (provider: StepDirDriver)
-    Carriage, // a linear axis' carriage position (provider: Axis)
-    Thermal,  // a thermal body heaters, sensors and fans couple to (ThermalPlant)
-    Windings, // motor winding drives (provider: DriveSource)
-    Horn,     // an RC servo's output shaft angle (provider: RcServo)
-    Effector, // a mechanism's tool point in space (provider: DeltaRobot)
-};
-std::string_view port_kind_name(PortKind kind);
-
+// A non-digital port. Its kind is the interface the provider offers
+// (parts/PortType.hpp); two ports share a net only if their kinds are the same.
 struct PortInfo {
     std::string name;
-    PortKind kind = PortKind::Analog;
+    const PortType* kind = &kAnalogPort;
     bool provides = false;  // offers the kind's interface; else requires it
     bool required = false;  // a requiring port that must be connected
     std::string help;       // what to join it to, for messages and docs
@@ -121,13 +112,14 @@ public:
     PartPin& pin(std::size_t index) { return *pins_[index]; }
     PartPin* find_pin(std::string_view name);
 
-    // Ports (see the file comment). connect_port is called once per requiring
-    // port with the part that provides its kind; it throws BadInput when the
-    // provider does not fit (a channel the provider lacks).
+    // Ports (see the file comment). The board calls connect_port once per
+    // requiring port with the port of the same kind that provides it; the
+    // requirer's connection callback may throw BadInput when the provider
+    // does not fit (a channel the provider lacks).
     std::size_t port_count() const { return ports_.size(); }
     const PortInfo& port(std::size_t index) const { return ports_[index]; }
     const PortInfo* find_port(std::string_view name, std::size_t* index = nullptr) const;
-    virtual void connect_port(std::size_t port, Part& provider);
+    void connect_port(std::size_t port, Part& provider, std::size_t provider_port);
     // An Analog port's voltage at `cycle` of this part's clock.
     double analog_volts(std::size_t port, Cycle cycle) const;
 
@@ -165,8 +157,27 @@ public:
 
 protected:
     std::size_t add_pin(std::string name, TerminalRole role);
-    std::size_t provide_port(std::string name, PortKind kind, std::string help);
-    std::size_t require_port(std::string name, PortKind kind, bool required, std::string help);
+    // Offers `impl` (this part, or a member of it) as port `name` of the
+    // kind Interface::kPort.
+    template <class Interface>
+    std::size_t provide_port(std::string name, Interface& impl, std::string help) {
+        return add_port({std::move(name), &Interface::kPort, true, false, std::move(help)}, static_cast<void*>(&impl), {});
+    }
+    // Needs an Interface on port `name`; `on_connect(Interface&)` or
+    // `on_connect(Interface&, Part& provider)` runs when the board joins it.
+    template <class Interface, class OnConnect>
+    std::size_t require_port(std::string name, bool required, std::string help, OnConnect on_connect) {
+        auto connect = [fn = std::move(on_connect)](void* impl, Part& provider) mutable {
+            Interface& offered = *static_cast<Interface*>(impl);
+            if constexpr (std::is_invocable_v<OnConnect&, Interface&, Part&>) {
+                fn(offered, provider);
+            } else {
+                (void)provider;
+                fn(offered);
+            }
+        };
+        return add_port({std::move(name), &Interface::kPort, false, required, std::move(help)}, nullptr, std::move(connect));
+    }
     std::size_t provide_analog(std::string name, std::function<double(Cycle)> volts, std::string help);
     std::size_t add_signal(std::string name, bool real, double initial = 0);
     std::size_t add_signal(PartSignalInfo info, double initial);
@@ -207,7 +218,11 @@ private:
     std::string name_;
     Mcu* clock_;
     std::vector<std::unique_ptr<PartPin>> pins_;
+    std::size_t add_port(PortInfo info, void* offered, std::function<void(void*, Part&)> connect);
+
     std::vector<PortInfo> ports_;
+    std::vector<void*> offered_;                               // per port; the interface a provider offers
+    std::vector<std::function<void(void*, Part&)>> connect_;  // per port; a requirer's callback
     std::vector<std::function<double(Cycle)>> analog_sources_;  // per port; empty but for Analog providers
     std::vector<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;

@@ -6,8 +6,6 @@
 #include <cstdio>
 
 #include "core/Errors.hpp"
-#include "parts/Axis.hpp"
-#include "parts/RcServo.hpp"
 
 namespace avrbench {
 
@@ -30,22 +28,17 @@ PenLift::PenLift(std::string name, Mcu& clock, const ParamValues& params) : Part
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    horn_port_ = require_port("horn", PortKind::Horn, true, "the pen servo's horn");
-    x_port_ = require_port("x", PortKind::Carriage, true, "the X axis' carriage");
-    y_port_ = require_port("y", PortKind::Carriage, true, "the Y axis' carriage");
+    require_port<ServoHorn>("horn", true, "the pen servo's horn", [this](ServoHorn& horn) { servo_ = &horn; });
+    require_port<Carriage>("x", true, "the X axis' carriage", [this](Carriage& x) { connect_carriage(x_, x); });
+    require_port<Carriage>("y", true, "the Y axis' carriage", [this](Carriage& y) { connect_carriage(y_, y); });
     sig_down_ = add_signal("down", false, 0);
     sig_x_ = add_signal({"tip_x_mm", true, "mm", SignalRole::None, ""}, 0);
     sig_y_ = add_signal({"tip_y_mm", true, "mm", SignalRole::None, ""}, 0);
 }
 
-void PenLift::connect_port(std::size_t port, Part& provider) {
-    if (port == horn_port_) {
-        servo_ = &dynamic_cast<RcServo&>(provider);
-    } else {
-        Axis& axis = dynamic_cast<Axis&>(provider);
-        (port == x_port_ ? x_ : y_) = &axis;
-        axis.on_move([this](double) { on_carriage(); });
-    }
+void PenLift::connect_carriage(Carriage*& slot, Carriage& axis) {
+    slot = &axis;
+    axis.on_move([this](double) { on_carriage(); });
 }
 
 void PenLift::start() { tick(); }

@@ -7,13 +7,13 @@
 
 #include <vector>
 
+#include "parts/Carriage.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ServoHorn.hpp"
 
 namespace avrbench {
 
-class Axis;
-class RcServo;
 
 class PenLift final : public Part {
 public:
@@ -21,7 +21,6 @@ public:
 
     PenLift(std::string name, Mcu& clock, const ParamValues& params);
     std::string_view type() const override { return "pen_lift"; }
-    void connect_port(std::size_t port, Part& provider) override;
     void start() override;
     std::string summary() override;
 
@@ -33,14 +32,14 @@ public:
     const std::vector<std::vector<Point>>& strokes() const { return strokes_; }
 
 private:
+    void connect_carriage(Carriage*& slot, Carriage& axis);
     void tick();
     void on_carriage();
     void set_down(bool down);
 
-    std::size_t horn_port_, x_port_, y_port_;
-    RcServo* servo_ = nullptr;
-    Axis* x_ = nullptr;
-    Axis* y_ = nullptr;
+    ServoHorn* servo_ = nullptr;
+    Carriage* x_ = nullptr;
+    Carriage* y_ = nullptr;
     double down_angle_deg_;
     Cycle sample_cycles_;
     bool down_ = false;

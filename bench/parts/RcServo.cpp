@@ -75,7 +75,7 @@ RcServo::RcServo(std::string name, Mcu& clock, const ParamValues& params)
     sig_angle_ = add_signal({"angle_deg", true, "deg", SignalRole::ServoAngle, ""}, from_deg_);
     sig_target_ = add_signal({"target_deg", true, "deg", SignalRole::None, ""}, target_deg_);
     sig_pulse_ = add_signal({"pulse_us", true, "us", SignalRole::None, ""}, 0);
-    provide_port("horn", PortKind::Horn, "the output shaft a mechanism's arm is fixed to");
+    provide_port<ServoHorn>("horn", *this, "the output shaft a mechanism's arm is fixed to");
 }
 
 double RcServo::angle_for_pulse_us(double width_us) const {

@@ -6,17 +6,16 @@
 // and reported (servo-pulse-out-of-range, once per spell).
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <cstdint>
 #include <vector>
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ServoHorn.hpp"
 
 namespace avrbench {
 
-class RcServo final : public Part {
+class RcServo final : public Part, public ServoHorn {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kServoPulseOutOfRange;  // servo-pulse-out-of-range
@@ -27,13 +26,13 @@ public:
     std::string summary() override;
 
     // The horn's angle now, in degrees of the calibration table.
-    double angle_deg() const;
+    double angle_deg() const override;
     double target_deg() const { return target_deg_; }
     double last_pulse_us() const { return last_pulse_us_; }
     unsigned pulses() const { return pulses_; }
     // The horn's travel: the calibration table's first and last angle.
-    double min_angle_deg() const { return table_.front().deg; }
-    double max_angle_deg() const { return table_.back().deg; }
+    double min_angle_deg() const override { return table_.front().deg; }
+    double max_angle_deg() const override { return table_.back().deg; }
     // The table's angle for a pulse width (clamped to the table's ends).
     double angle_for_pulse_us(double width_us) const;
 

@@ -12,8 +12,6 @@
 // budget of §20.8, Table 20-2 for 8N1 is about +-4.5 %, both ends together).
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <string>
 #include <vector>
 

@@ -7,10 +7,13 @@
 #include <functional>
 #include <string>
 
+#include "parts/PortType.hpp"
+
 namespace avrbench {
 
 class ShaftMotion {
 public:
+    static constexpr PortType kPort{"steps", "a step_dir_driver's steps"};
     virtual ~ShaftMotion() = default;
     // The step an axis' steps_per_mm counts, in microsteps per full step
     // (a driver's configured resolution; 1 for a motor's full steps).

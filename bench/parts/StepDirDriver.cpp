@@ -157,8 +157,8 @@ StepDirDriver::StepDirDriver(std::string name, Mcu& clock, const ParamValues& pa
     sig_position_ = add_signal("position_steps", true);
     // Outputs on (1) or off (0), as the ENABLE input and its pull-down decide.
     sig_enabled_ = add_signal("enabled", false, 1);
-    provide_port("steps", PortKind::Steps, "the shaft motion an axis or an extruder's filament feed follows");
-    provide_port("windings", PortKind::Windings, "a bipolar motor's two windings, as an ideal chopper");
+    provide_port<ShaftMotion>("steps", *this, "the shaft motion an axis or an extruder's filament feed follows");
+    provide_port<DriveSource>("windings", *this, "a bipolar motor's two windings, as an ideal chopper");
 }
 
 std::string StepDirDriver::tap_problem(const WindingTap& tap) const {

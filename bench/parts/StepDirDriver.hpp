@@ -4,8 +4,6 @@
 // finding with its cycle.
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <array>
 #include <cstdint>
 #include <functional>

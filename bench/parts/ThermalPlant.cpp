@@ -117,13 +117,13 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     sig_sensor_ = add_signal({"sensor_degC", true, "degC", SignalRole::SensorTemperature, ""}, initial);
     if (surface_ >= 0) sig_surface_ = add_signal("surface_degC", true, initial);
     sig_fan_ = add_signal("fan_speed", true, 0);
-    provide_port("body", PortKind::Thermal, "the block heaters heat, thermistors read and fans cool");
-    require_port("filament", PortKind::Steps, false,
-                 "the extruder's step_dir_driver steps: they feed cold filament into the block");
+    provide_port<ThermalBody>("body", *this, "the block heaters heat, thermistors read and fans cool");
+    require_port<ShaftMotion>("filament", false, "the extruder's step_dir_driver steps: they feed cold filament into the block",
+                              [this](ShaftMotion& feed) { connect_filament(feed); });
 }
 
-void ThermalPlant::connect_port(std::size_t, Part& provider) {
-    filament_driver_ = &dynamic_cast<ShaftMotion&>(provider);
+void ThermalPlant::connect_filament(ShaftMotion& feed) {
+    filament_driver_ = &feed;
     filament_driver_->on_step([this](int delta_256) { feed_256_ += delta_256; });
 }
 

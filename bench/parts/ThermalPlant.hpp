@@ -14,8 +14,6 @@
 // changes or somebody reads a temperature, at the plant clock's cycle.
 #pragma once
 
-#include "core/Finding.hpp"
-
 #include <cstdint>
 #include <map>
 #include <string>
@@ -23,13 +21,13 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/ShaftMotion.hpp"
+#include "parts/ThermalBody.hpp"
 #include "parts/ThermalNetwork.hpp"
 
 namespace avrbench {
 
-class ShaftMotion;
-
-class ThermalPlant final : public Part {
+class ThermalPlant final : public Part, public ThermalBody {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kOverheat;  // overheat
@@ -40,14 +38,13 @@ public:
     // `filament` (optional) requires the extruder's step_dir_driver `steps`,
     // whose steps feed cold filament.
     ThermalPlant(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "thermal_plant"; }
     void start() override;
     std::string summary() override;
 
     // Temperatures now (advances the model to the clock's current cycle).
     double block_degC();
-    double sensor_degC();
+    double sensor_degC() override;
     double surface_degC();  // the block's if there is no surface node
     double ambient_degC() const { return network_.ambient(); }
     void set_ambient_degC(double degC);
@@ -56,16 +53,16 @@ public:
     // A heat source is one heater's contribution to one node ("block" or "surface").
     // A heater of at most `max_power_W` on "block" or "surface"; BadInput if
     // the pair would heat that node faster than kMaxHeatingRate_K_per_s.
-    int add_heat_source(const std::string& node, double max_power_W);
+    int add_heat_source(const std::string& node, double max_power_W) override;
     static constexpr double kMaxHeatingRate_K_per_s = 1000;
-    void set_heat_source_power(int source, double watts);
-    void set_fan_speed(double fraction);          // 0..1 of full speed
+    void set_heat_source_power(int source, double watts) override;
+    void set_fan_speed(double fraction) override;  // 0..1 of full speed
     void set_filament_feed_mm_per_s(double rate); // filament entering the melt zone
     // Sensor detached: it follows ambient instead of the block (a thermistor
     // fallen out of its bore).
-    void set_sensor_detached(bool detached);
+    void set_sensor_detached(bool detached) override;
 
-    double fan_speed() const { return fan_speed_; }
+    double fan_speed() const override { return fan_speed_; }
     double filament_feed_mm_per_s() const { return feed_mm_per_s_; }
     double heater_power_W() const;
     bool sensor_detached() const { return detached_; }
@@ -86,6 +83,7 @@ public:
     double max_degC() const { return max_degC_; }
 
 private:
+    void connect_filament(ShaftMotion& feed);
     void apply_conductance();
     void on_sample(Cycle scheduled);
 

@@ -8,7 +8,7 @@
 
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
-#include "parts/ThermalPlant.hpp"
+#include "parts/ThermalBody.hpp"
 
 namespace avrbench {
 
@@ -129,12 +129,13 @@ Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params)
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput(where + "sample_interval must be positive");
     publish_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
-    require_port("body", PortKind::Thermal, true, "the thermal_plant whose sensor node it is");
+    require_port<ThermalBody>("body", true, "the thermal_plant whose sensor node it is",
+                              [this](ThermalBody& body) { connect_body(body); });
     provide_analog("out", [this](Cycle c) { return sample(c); }, "the divider's output, for an ADC pin");
 }
 
-void Thermistor::connect_port(std::size_t, Part& provider) {
-    plant_ = &dynamic_cast<ThermalPlant&>(provider);
+void Thermistor::connect_body(ThermalBody& body) {
+    plant_ = &body;
     sig_temperature_ = add_signal("bead_degC", true, plant_->sensor_degC());
     sig_volts_ = add_signal("volts", true, divider_volts(plant_->sensor_degC()));
 }

@@ -26,7 +26,7 @@
 
 namespace avrbench {
 
-class ThermalPlant;
+class ThermalBody;
 
 // The Steinhart–Hart curve of one NTC part.
 struct NtcCurve {
@@ -50,7 +50,6 @@ public:
     // `out` provides the divider's voltage (a net joins it to an ADC pin of
     // `clock`, the MCU that samples it).
     Thermistor(std::string name, Mcu& clock, const ParamValues& params);
-    void connect_port(std::size_t port, Part& provider) override;
     std::string_view type() const override { return "thermistor"; }
 
     const NtcCurve& curve() const { return curve_; }
@@ -65,11 +64,12 @@ public:
     std::vector<std::string> fault_names() const override { return {"open", "shorted", "detached"}; }
 
 private:
+    void connect_body(ThermalBody& body);
     double sample(Cycle cycle);
     double gaussian();
     void apply_fault(const std::string& fault) override;
 
-    ThermalPlant* plant_ = nullptr;
+    ThermalBody* plant_ = nullptr;
     NtcCurve curve_;
     bool lower_leg_;
     double fixed_ohm_, reference_v_, noise_v_;

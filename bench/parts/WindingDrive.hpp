@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "parts/PortType.hpp"
+
 namespace avrbench {
 
 // What one winding sees. The current i is positive from the winding's first
@@ -64,6 +66,7 @@ struct WindingTap {
 // to that cycle with the drive it had, then asks for the new one.
 class DriveSource {
 public:
+    static constexpr PortType kPort{"windings", "an l293d's windings"};
     virtual ~DriveSource() = default;
     void on_drive_change(std::function<void()> fn) { drive_listeners_.push_back(std::move(fn)); }
 

@@ -1,0 +1,27 @@
+// What a thermal plant offers the parts coupled to it: heaters add power to
+// a node, fans cool it, a thermistor reads its sensor node.
+#pragma once
+
+#include <string>
+
+#include "parts/PortType.hpp"
+
+namespace avrbench {
+
+class ThermalBody {
+public:
+    static constexpr PortType kPort{"thermal", "a thermal_plant's body"};
+    virtual ~ThermalBody() = default;
+    // A heater of at most `max_power_W` on `node` ("block" or "surface");
+    // BadInput when the body cannot take it. Returns the source's handle.
+    virtual int add_heat_source(const std::string& node, double max_power_W) = 0;
+    virtual void set_heat_source_power(int source, double watts) = 0;
+    virtual double fan_speed() const = 0;             // 0..1 of full speed
+    virtual void set_fan_speed(double fraction) = 0;  // 0..1 of full speed
+    // The temperature at the sensor node now (degC).
+    virtual double sensor_degC() = 0;
+    // A sensor fallen out of its bore follows ambient instead.
+    virtual void set_sensor_detached(bool detached) = 0;
+};
+
+}  // namespace avrbench
