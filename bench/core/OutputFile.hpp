@@ -56,6 +56,8 @@ public:
     void input(const std::string& path, const std::string& what);
     // Also check_output_path().
     void output(const std::string& path, const std::string& what);
+    // Every file of `other`, after this one's.
+    void add(const RunFiles& other) { files_.insert(files_.end(), other.files_.begin(), other.files_.end()); }
     // Throws BadInput "<what>: <path> is also <other what>" for the first clash.
     void check() const;
 

@@ -86,7 +86,7 @@ void Axis::connect_drive(ShaftMotion& driver) {
         travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
         carriage_256_ = std::llround(start_m_ / metres_per_256_);
     }
-    sig_position_ = add_signal({rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? "deg" : "mm", SignalRole::Position, ""},
+    sig_position_ = add_signal({rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? "deg" : "mm", "position", ""},
                                rotary_ ? 0.0 : position_mm());
     driver_->on_step([this](int delta) { on_step(delta); });
 }

@@ -70,9 +70,9 @@ DeltaRobot::DeltaRobot(std::string name, Mcu& clock, const ParamValues& params) 
                                 });
     }
     provide_port<Effector>("effector", *this, "the effector centre, for a tool such as an electromagnet");
-    sig_x_ = add_signal({"x_mm", true, "mm", SignalRole::Position, ""}, 0);
-    sig_y_ = add_signal({"y_mm", true, "mm", SignalRole::Position, ""}, 0);
-    sig_z_ = add_signal({"z_mm", true, "mm", SignalRole::Position, ""}, 0);
+    sig_x_ = add_signal({"x_mm", true, "mm", "position", ""}, 0);
+    sig_y_ = add_signal({"y_mm", true, "mm", "position", ""}, 0);
+    sig_z_ = add_signal({"z_mm", true, "mm", "position", ""}, 0);
     sig_reachable_ = add_signal("reachable", false, 0);
 }
 

@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include "parts/AcceptedMoves.hpp"
 #include "parts/DeltaKinematics.hpp"
 #include "parts/Effector.hpp"
 #include "parts/Params.hpp"
@@ -20,7 +21,7 @@
 
 namespace avrbench {
 
-class DeltaRobot final : public Part, public Effector {
+class DeltaRobot final : public Part, public Effector, public AcceptedMoves {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kTargetOutOfReach;  // target-out-of-reach
@@ -41,7 +42,7 @@ public:
     // Whether G0/G1 X Y Z lines the firmware accepts are targets in this
     // part's frame (mm, origin at the base centre, z negative below it; the
     // `move_commands` parameter). Bench checks each one with check_accepted_move.
-    bool checks_move_commands() const { return check_moves_; }
+    bool checks_move_commands() const override { return check_moves_; }
     // The firmware answered ok to a move to `target_mm` (`line` quotes it):
     // a target-out-of-reach finding when no pose of the arms reaches it or an
     // arm would need its servo's horn beyond the servo's travel. Targets
@@ -50,7 +51,7 @@ public:
     // reachable space, or within kTravelMarginDeg of the travel's ends (half
     // a degree for a firmware that rounds angles to whole table entries, as
     // seed 004's does, and 0.1 deg for float32).
-    void check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line);
+    void check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) override;
     static constexpr double kReachMarginMm = 0.5;
     static constexpr double kTravelMarginDeg = 0.6;
 

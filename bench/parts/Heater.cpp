@@ -77,9 +77,9 @@ void Heater::connect_body(ThermalBody& body, Part& plant) {
     } catch (const BadInput& e) {
         throw BadInput("part '" + name() + "': " + e.what());
     }
-    sig_on_ = add_signal({"on", false, "", SignalRole::HeaterOn, plant.name()}, 0);
-    sig_duty_ = add_signal({"duty", true, "", SignalRole::HeaterDuty, plant.name()}, 0);
-    sig_power_ = add_signal({"power_W", true, "W", SignalRole::HeaterPower, plant.name()}, 0);
+    sig_on_ = add_signal({"on", false, "", "heater-on", plant.name()}, 0);
+    sig_duty_ = add_signal({"duty", true, "", "heater-duty", plant.name()}, 0);
+    sig_power_ = add_signal({"power_W", true, "W", "heater-power", plant.name()}, 0);
 }
 
 void Heater::start() {

@@ -83,7 +83,7 @@ std::size_t Part::provide_analog(std::string name, std::function<double(Cycle)> 
 }
 
 std::size_t Part::add_signal(std::string name, bool real, double initial) {
-    return add_signal({std::move(name), real, "", SignalRole::None, ""}, initial);
+    return add_signal({std::move(name), real, "", "", ""}, initial);
 }
 
 std::size_t Part::add_signal(PartSignalInfo info, double initial) {

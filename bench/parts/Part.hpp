@@ -75,25 +75,19 @@ struct PortInfo {
     std::string help;       // what to join it to, for messages and docs
 };
 
-// What a signal means to the views that show it (report plots, summaries),
-// so they find it by meaning rather than by part type or signal name.
-enum class SignalRole : std::uint8_t {
-    None,
-    Position,           // where a moving part is (unit "mm" or "deg")
-    Temperature,        // a body's temperature (degC)
-    SensorTemperature,  // what a temperature sensor on it reads (degC)
-    HeaterOn,           // a heater's gate (0/1), for the part in `concerns`
-    HeaterDuty,         // its duty over the last PWM period (0..1)
-    HeaterPower,        // its electrical power (W)
-    ServoAngle,         // an RC servo's horn angle (deg)
-};
-
 // A value a part exposes for tracing (a position, a temperature, a level).
 struct PartSignalInfo {
     std::string name;
     bool real = false;  // a real number, else a 0/1 wire
     std::string unit;   // "mm", "deg", "degC", "W", ... ("" for none)
-    SignalRole role = SignalRole::None;
+    // What the signal means to the views that show it (the report's plots
+    // find signals by it, never by part type): an open vocabulary a part
+    // picks from or extends, "" for none. The report's views read
+    // "position" (mm or deg: toolpath and velocity), "temperature" and
+    // "sensor-temperature" (degC: a thermal plot per part), "heater-on" and
+    // "heater-duty" (on the plot of the part in `concerns`), "servo-angle"
+    // (deg); others ("heater-power", ...) are for the VCD and front ends.
+    std::string role;
     std::string concerns;  // the part this signal is about, when not its own (a heater's plant)
 };
 
@@ -152,6 +146,10 @@ public:
     // One line about the part's state for the run summary ("" for none);
     // not const: a model may first catch up with the clock.
     virtual std::string summary() { return {}; }
+    // Called whenever the firmware makes this part act on a command (a
+    // driver takes a STEP pulse): the bench's idle detection listens to
+    // every part without knowing which ones take commands.
+    void on_activity(std::function<void()> fn) { activity_listeners_.push_back(std::move(fn)); }
     using SignalListener = std::function<void(std::size_t signal, Cycle cycle, double value)>;
     void watch_signals(SignalListener fn) { signal_listeners_.push_back(std::move(fn)); }
 
@@ -212,6 +210,9 @@ protected:
     bool connected(std::size_t pin) const { return pins_[pin]->connected(); }
 
     void report(FindingKind kind, std::string detail);
+    void note_activity() {
+        for (auto& fn : activity_listeners_) fn();
+    }
 
 private:
     friend class PartPin;
@@ -229,6 +230,7 @@ private:
     std::vector<double> signal_values_;
     std::vector<std::uint64_t> signal_changes_;
     std::vector<SignalListener> signal_listeners_;
+    std::vector<std::function<void()>> activity_listeners_;
     std::string fault_ = "none";
     std::vector<FaultEvent> fault_history_;
 };

@@ -32,8 +32,8 @@ PenLift::PenLift(std::string name, Mcu& clock, const ParamValues& params) : Part
     require_port<Carriage>("x", true, "the X axis' carriage", [this](Carriage& x) { connect_carriage(x_, x); });
     require_port<Carriage>("y", true, "the Y axis' carriage", [this](Carriage& y) { connect_carriage(y_, y); });
     sig_down_ = add_signal("down", false, 0);
-    sig_x_ = add_signal({"tip_x_mm", true, "mm", SignalRole::None, ""}, 0);
-    sig_y_ = add_signal({"tip_y_mm", true, "mm", SignalRole::None, ""}, 0);
+    sig_x_ = add_signal({"tip_x_mm", true, "mm", "", ""}, 0);
+    sig_y_ = add_signal({"tip_y_mm", true, "mm", "", ""}, 0);
 }
 
 void PenLift::connect_carriage(Carriage*& slot, Carriage& axis) {

@@ -72,9 +72,9 @@ RcServo::RcServo(std::string name, Mcu& clock, const ParamValues& params)
     from_deg_ = target_deg_ = std::clamp(initial, table_.front().deg, table_.back().deg);
     signal_pin_ = add_pin("signal", TerminalRole::Input);
 
-    sig_angle_ = add_signal({"angle_deg", true, "deg", SignalRole::ServoAngle, ""}, from_deg_);
-    sig_target_ = add_signal({"target_deg", true, "deg", SignalRole::None, ""}, target_deg_);
-    sig_pulse_ = add_signal({"pulse_us", true, "us", SignalRole::None, ""}, 0);
+    sig_angle_ = add_signal({"angle_deg", true, "deg", "servo-angle", ""}, from_deg_);
+    sig_target_ = add_signal({"target_deg", true, "deg", "", ""}, target_deg_);
+    sig_pulse_ = add_signal({"pulse_us", true, "us", "", ""}, 0);
     provide_port<ServoHorn>("horn", *this, "the output shaft a mechanism's arm is fixed to");
 }
 

@@ -269,6 +269,7 @@ void StepDirDriver::on_step_edge(bool active) {
     ++steps_taken_;
     publish(sig_position_, static_cast<double>(position_256_) * configured_microsteps_ / 256.0);
     for (auto& fn : step_listeners_) fn(delta);
+    note_activity();
     notify_drive_change();
 }
 

@@ -113,8 +113,8 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
 
-    sig_block_ = add_signal({"block_degC", true, "degC", SignalRole::Temperature, ""}, initial);
-    sig_sensor_ = add_signal({"sensor_degC", true, "degC", SignalRole::SensorTemperature, ""}, initial);
+    sig_block_ = add_signal({"block_degC", true, "degC", "temperature", ""}, initial);
+    sig_sensor_ = add_signal({"sensor_degC", true, "degC", "sensor-temperature", ""}, initial);
     if (surface_ >= 0) sig_surface_ = add_signal("surface_degC", true, initial);
     sig_fan_ = add_signal("fan_speed", true, 0);
     provide_port<ThermalBody>("body", *this, "the block heaters heat, thermistors read and fans cool");

@@ -12,10 +12,7 @@
 
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
-#include "parts/DeltaRobot.hpp"
-#include "parts/Heater.hpp"
-#include "parts/StepDirDriver.hpp"
-#include "parts/ThermalPlant.hpp"
+#include "parts/AcceptedMoves.hpp"
 #include "stimulus/CommandedTarget.hpp"
 
 namespace avrbench {
@@ -75,8 +72,8 @@ void Bench::watch_motion() {
             throw BadInput(decl.location + ": serial '" + decl.name + "': " + e.what());
         }
     }
-    for (StepDirDriver* driver : board_->parts_of_type<StepDirDriver>()) {
-        driver->on_step([this, driver](int) { last_step_ps_ = ps_at_cycle(driver->clock(), driver->clock().cycle()); });
+    for (Part* part : board_->parts()) {
+        part->on_activity([this, part] { last_step_ps_ = ps_at_cycle(part->clock(), part->clock().cycle()); });
     }
 }
 
@@ -123,9 +120,10 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
 }
 
 void Bench::check_accepted_moves(UartHost& host) {
-    std::vector<DeltaRobot*> robots;
-    for (DeltaRobot* robot : board_->parts_of_type<DeltaRobot>()) {
-        if (robot->checks_move_commands()) robots.push_back(robot);
+    std::vector<AcceptedMoves*> robots;
+    for (Part* part : board_->parts()) {
+        auto* checker = dynamic_cast<AcceptedMoves*>(part);
+        if (checker != nullptr && checker->checks_move_commands()) robots.push_back(checker);
     }
     if (robots.empty()) return;
     // Every answer that acknowledges a line (ok or error) moves
@@ -144,7 +142,7 @@ void Bench::check_accepted_moves(UartHost& host) {
         const auto target = seen->target.accept(line.text);
         if (!target) return;
         const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
-        for (DeltaRobot* robot : robots) robot->check_accepted_move(Eigen::Vector3d{(*target)[0], (*target)[1], (*target)[2]}, quoted);
+        for (AcceptedMoves* robot : robots) robot->check_accepted_move(Eigen::Vector3d{(*target)[0], (*target)[1], (*target)[2]}, quoted);
     });
 }
 
@@ -312,19 +310,19 @@ RunReport Bench::make_report(const std::string& title) const {
     for (Part* p : board_->parts()) {
         for (std::size_t i = 0; i < p->signals().size(); ++i) {
             const PartSignalInfo& info = p->signals()[i];
-            if (info.role == SignalRole::None) continue;
+            if (info.role.empty()) continue;
             const long id = timeline_.find(p->name(), info.name);
             if (id >= 0) declared.push_back({p, &info, static_cast<SignalId>(id), i});
         }
     }
     std::vector<Part*> plants;  // parts with a temperature, in board order
     for (const Declared& d : declared) {
-        if (d.info->role == SignalRole::Position) {
+        if (d.info->role == "position") {
             // A position that never changed has nothing to plot.
             if (d.part->signal_changes(d.index) > 0) r.axes.push_back({d.part->name(), d.id, d.info->unit == "deg"});
-        } else if (d.info->role == SignalRole::Temperature) {
+        } else if (d.info->role == "temperature") {
             plants.push_back(d.part);
-        } else if (d.info->role == SignalRole::ServoAngle) {
+        } else if (d.info->role == "servo-angle") {
             r.servos.push_back({d.part->name(), d.id});
         }
     }
@@ -363,11 +361,11 @@ RunReport Bench::make_report(const std::string& title) const {
         TemperatureSeries series;
         series.name = plant->name();
         for (const Declared& d : declared) {
-            if (d.part == plant && d.info->role == SignalRole::Temperature) series.temperature_degC = d.id;
-            if (d.part == plant && d.info->role == SignalRole::SensorTemperature) series.sensor_degC = d.id;
+            if (d.part == plant && d.info->role == "temperature") series.temperature_degC = d.id;
+            if (d.part == plant && d.info->role == "sensor-temperature") series.sensor_degC = d.id;
             if (d.info->concerns != plant->name()) continue;
-            if (d.info->role == SignalRole::HeaterOn) series.heater_on = d.id;
-            if (d.info->role == SignalRole::HeaterDuty) series.duty = d.id;
+            if (d.info->role == "heater-on") series.heater_on = d.id;
+            if (d.info->role == "heater-duty") series.duty = d.id;
         }
         series.target_steps = targets[plant];
         r.temperatures.push_back(series);
