@@ -527,6 +527,34 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
     return true;
 }
 
+std::uint8_t Mcu::peek(std::uint32_t data_address) const {
+    if (data_address > avr_->ramend) throw BadInput("data address " + std::to_string(data_address) + " is past RAMEND");
+    return avr_->data[data_address];
+}
+
+void Mcu::poke(std::uint32_t data_address, std::uint8_t value) {
+    if (data_address > avr_->ramend) throw BadInput("data address " + std::to_string(data_address) + " is past RAMEND");
+    avr_->data[data_address] = value;
+}
+
+std::vector<std::uint8_t> Mcu::data_memory() const { return {avr_->data, avr_->data + avr_->ramend + 1}; }
+
+int Mcu::ioctl(std::uint32_t command, void* data) { return avr_ioctl(avr_, command, data); }
+
+std::uint8_t Mcu::lockbits() const { return avr_->lockbits; }
+
+std::size_t Mcu::cycle_timers_armed() const {
+    std::size_t n = 0;
+    for (auto* t = avr_->cycle_timers.timer; t != nullptr; t = t->next) ++n;
+    return n;
+}
+
+bool Mcu::sleeps_in_virtual_time() const { return avr_->sleep != &avr_callback_sleep_raw; }
+
+avr_io_t* Mcu::io_module(const char* kind, char name) const { return find_io_module(avr_, kind, name); }
+
+std::uint16_t Mcu::pud_register() const { return part_facts(avr_).pud_register; }
+
 void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt) {
     Finding f;
     f.kind = kind;

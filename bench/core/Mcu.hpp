@@ -169,6 +169,9 @@ public:
     Adc& adc() { return *adc_; }
 
     const std::vector<Finding>& findings() const { return findings_; }
+    // The I/O register (data address) holding PUD, the pull-up disable bit
+    // (MCUCR or SFIOR by family); 0 for a part without one.
+    std::uint16_t pud_register() const;
     // The firmware's own failures, which the core's oracles find (errors: they fail every run).
     static const FindingKind kSimavrCrash;       // simavr stopped the core (e.g. a write outside RAM)
     static const FindingKind kInvalidOpcode;     // an opcode the AVR core does not decode
@@ -204,6 +207,23 @@ public:
     std::uint16_t read_ram_u16(const std::string& symbol) const;
     // `count` bytes from the RAM symbol on (an array); throws BadInput past RAMEND.
     std::vector<std::uint8_t> read_ram(const std::string& symbol, std::size_t count) const;
+    // The data space by address (registers, I/O, SRAM up to RAMEND): a peek
+    // and a poke for tests and debuggers; BadInput past RAMEND.
+    std::uint8_t peek(std::uint32_t data_address) const;
+    void poke(std::uint32_t data_address, std::uint8_t value);
+    // All of it, 0..RAMEND (to compare two runs' end states).
+    std::vector<std::uint8_t> data_memory() const;
+    // simavr's ioctl on this core (AVR_IOCTL_EEPROM_GET, AVR_IOCTL_UART_GET_FLAGS, ...).
+    int ioctl(std::uint32_t command, void* data);
+    // The lock bits as the boot loader or an SPM left them.
+    std::uint8_t lockbits() const;
+    // simavr's cycle timers armed now (a fix that forgets to cancel one leaks them).
+    std::size_t cycle_timers_armed() const;
+    // Whether SLEEP jumps in simulated time (simavr's own callback waits with usleep()).
+    bool sleeps_in_virtual_time() const;
+    // A simavr I/O module ("adc", "uart" '0', "timer" '1'): for conformance
+    // probes on simavr's own IRQs; nullptr if the part has none.
+    avr_io_t* io_module(const char* kind, char name = 0) const;
 
     // The boot section when a boot loader was loaded (McuOptions::bootloader_hex).
     const std::optional<BootSection>& boot() const { return boot_; }

@@ -5,8 +5,7 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/fixes/Fix.hpp"
-#include "core/fixes/Interrupts.hpp"
+#include "core/IoHook.hpp"
 
 namespace avrbench {
 
@@ -78,9 +77,8 @@ void McuPinTerminal::receive(const Resolution& resolution) {
 }
 
 McuPortWatch::McuPortWatch(Mcu& mcu) : mcu_(mcu) {
-    const PartFacts facts = part_facts(mcu.avr());
-    if (facts.pud_register != 0) {
-        write_hooks_.push_back(std::make_unique<IoWriteHook>(mcu.avr(), facts.pud_register, &on_pud_write, this));
+    if (const std::uint16_t pud = mcu.pud_register(); pud != 0) {
+        write_hooks_.push_back(std::make_unique<IoWriteHook>(mcu.avr(), pud, &on_pud_write, this));
     }
     mcu.on_reset([this] { refresh_all(); });
     direction_listener_ = mcu.on_pin_direction_change([this] { refresh_all(); });

@@ -204,7 +204,7 @@ TEST(GrblStepper, SettingsLiveInEepromAndSetTheRate) {
     avr_eeprom_desc_t desc{};
     desc.offset = 0;
     desc.size = 4;
-    avr_ioctl(g.mcu().avr(), AVR_IOCTL_EEPROM_GET, &desc);  // simavr returns -1 even when it worked
+    g.mcu().ioctl(AVR_IOCTL_EEPROM_GET, &desc);  // simavr returns -1 even when it worked
     ASSERT_NE(desc.ee, nullptr);
     EXPECT_EQ(desc.ee[0], 1);    // version
     EXPECT_EQ(desc.ee[1], 5);    // $0

@@ -40,12 +40,12 @@ struct AdcProbe {
     }
 
     explicit AdcProbe(Mcu& mcu) {
-        avr_t* avr = mcu.avr();
-        auto* adc = reinterpret_cast<avr_adc_t*>(find_io_module(avr, "adc"));
+        auto* adc = reinterpret_cast<avr_adc_t*>(mcu.io_module("adc"));
+        avr_t* avr = adc->io.avr;
         watch(avr, adc->adc, adif);
-        auto* t1 = reinterpret_cast<avr_timer_t*>(find_io_module(avr, "timer", '1'));
+        auto* t1 = reinterpret_cast<avr_timer_t*>(mcu.io_module("timer", '1'));
         watch(avr, t1->comp[AVR_TIMER_COMPB].interrupt, trigger_t1b);
-        auto* t0 = reinterpret_cast<avr_timer_t*>(find_io_module(avr, "timer", '0'));
+        auto* t0 = reinterpret_cast<avr_timer_t*>(mcu.io_module("timer", '0'));
         watch(avr, t0->overflow, trigger_t0ovf);
         adcsra_hook = std::make_unique<IoWriteHook>(
             avr, adc->r_adcsra,

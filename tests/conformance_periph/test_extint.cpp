@@ -15,12 +15,6 @@ using test::kSbi;
 using test::Markers;
 using test::Part;
 
-std::size_t cycle_timers_armed(avr_t* avr) {
-    std::size_t n = 0;
-    for (auto* t = avr->cycle_timers.timer; t != nullptr; t = t->next) ++n;
-    return n;
-}
-
 class ExtintLevel : public ::testing::TestWithParam<const Part*> {};
 
 TEST_P(ExtintLevel, HeldLowLevelRetriggersAfterRetiPlusOneInstruction) {
@@ -56,7 +50,7 @@ TEST_P(ExtintLevel, LowPinWithTheInterruptDisabledArmsNoPolling) {
     Mcu mcu = test::load("extint_level", part);
     Markers m(mcu);
     mcu.run_for(1000);
-    const std::size_t before = cycle_timers_armed(mcu.avr());
+    const std::size_t before = mcu.cycle_timers_armed();
     for (int i = 0; i < 5; ++i) {  // falling edges, INT0 still disabled
         mcu.pin(part.int0_pin).drive(false);
         mcu.run_for(10);
@@ -65,7 +59,7 @@ TEST_P(ExtintLevel, LowPinWithTheInterruptDisabledArmsNoPolling) {
     }
     mcu.pin(part.int0_pin).drive(false);
     mcu.run_for(10);
-    EXPECT_EQ(cycle_timers_armed(mcu.avr()), before) << part.name;
+    EXPECT_EQ(mcu.cycle_timers_armed(), before) << part.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(Parts, ExtintLevel,

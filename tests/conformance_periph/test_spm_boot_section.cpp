@@ -94,7 +94,7 @@ TEST_P(SpmBootSection, ResetStartsInTheBootSectionAndOnlyItsSpmProgramsFlash) {
     // 16 ms watchdog reset (WDRF), and starts the application again.
     // RAM survives the reset: clear `done` so that only the next run sets it
     // (the application's start-up code zeroes it too, a few hundred cycles in).
-    mcu.avr()->data[*mcu.elf().symbol_address("done") - 0x800000] = 0;
+    mcu.poke(*mcu.elf().symbol_address("done") - 0x800000, 0);
     mcu.reset_external();
     ASSERT_TRUE(run_until_done(mcu, 2));
     EXPECT_EQ(mcu.read_ram_u8("reset_cause"), 0x08) << "MCUSR.WDRF (bit 3) as the boot loader saw it";
@@ -103,7 +103,7 @@ TEST_P(SpmBootSection, ResetStartsInTheBootSectionAndOnlyItsSpmProgramsFlash) {
     EXPECT_EQ(mcu.read_ram_u16("boot_self_pattern_bytes"), part.boot_section_writable ? part.page_bytes : 0u)
         << "SPM writes to the boot section unless BLB11 is programmed";
     EXPECT_EQ(mcu.read_ram_u16("boot_locked_pattern_bytes"), 0u) << "the boot loader programmed BLB11 first";
-    EXPECT_EQ(mcu.avr()->lockbits & 0x10, 0) << "BLB11 programmed by SPM with BLBSET";
+    EXPECT_EQ(mcu.lockbits() & 0x10, 0) << "BLB11 programmed by SPM with BLBSET";
     EXPECT_EQ(mcu.resets(), 2u) << "the external reset and the boot loader's watchdog reset";
     EXPECT_TRUE(mcu.findings().empty()) << mcu.findings().front().describe();
     EXPECT_TRUE(mcu.elf_matches_flash()) << "the pages programmed lie outside the application's image";

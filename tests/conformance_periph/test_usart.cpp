@@ -75,9 +75,9 @@ TEST_P(UsartModes, ReceivedFramesSetRxcOneFrameAfterTheirStart) {
     Mcu mcu = test::load("usart_modes", part);
     Markers m(mcu);
     Uart& uart = mcu.uart(0);
-    auto* u = reinterpret_cast<avr_uart_t*>(find_io_module(mcu.avr(), "uart", '0'));
+    auto* u = reinterpret_cast<avr_uart_t*>(mcu.io_module("uart", '0'));
     std::vector<Cycle> rxc;
-    std::pair<avr_t*, std::vector<Cycle>*> param{mcu.avr(), &rxc};
+    std::pair<avr_t*, std::vector<Cycle>*> param{u->io.avr, &rxc};
     avr_irq_register_notify(
         u->rxc.irq + AVR_INT_IRQ_PENDING,
         [](avr_irq_t*, std::uint32_t value, void* p) {

@@ -22,8 +22,7 @@ struct End {
 
 End run_to(Mcu& mcu, Cycle cycle) {
     mcu.run_until(cycle);
-    const avr_t* avr = mcu.avr();
-    return {mcu.cycle(), mcu.pc_bytes(), std::vector<std::uint8_t>(avr->data, avr->data + avr->ramend + 1)};
+    return {mcu.cycle(), mcu.pc_bytes(), mcu.data_memory()};
 }
 
 // twi_master starts with _delay_us(50): avr-gcc's __builtin_avr_delay_cycles

@@ -33,8 +33,7 @@ EndState end_state(Bench& bench) {
         s.cycles.push_back(m->cycle());
         s.pcs.push_back(m->pc_bytes());
         // All of the data space: registers, I/O, SRAM.
-        const avr_t* avr = m->avr();
-        s.ram.emplace_back(avr->data, avr->data + avr->ramend + 1);
+        s.ram.push_back(m->data_memory());
     }
     s.catch_ups = bench.board().lockstep().catch_ups();
     return s;

@@ -140,8 +140,7 @@ RunResult run(const std::string& name, bool accept_waves, Cycle cycles) {
     RunResult r;
     r.cycle = mcu.cycle();
     r.pc = mcu.pc_bytes();
-    const avr_t* avr = mcu.avr();
-    r.data.assign(avr->data, avr->data + avr->ramend + 1);
+    r.data = mcu.data_memory();
     // The last cycles may hold an edge one side has delivered and the other not yet.
     for (const auto& p : pins) {
         r.edges.push_back(p->edges(cycles - 2000));

@@ -91,7 +91,7 @@ TEST(RunLoop, CoveringRunEndsWhereThePlainRunEndsAndCountsEdges) {
             }
             EXPECT_EQ(plain.cycle(), covered.cycle()) << name;
             EXPECT_EQ(plain.pc_bytes(), covered.pc_bytes()) << name;
-            EXPECT_TRUE(std::equal(plain.avr()->data, plain.avr()->data + plain.avr()->ramend + 1, covered.avr()->data)) << name;
+            EXPECT_TRUE(plain.data_memory() == covered.data_memory()) << name;
             const auto distinct = std::count_if(map.begin(), map.end(), [](std::uint8_t c) { return c != 0; });
             EXPECT_GE(distinct, 5) << name;
             if (std::string(name) == "busy_poll") {

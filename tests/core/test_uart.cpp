@@ -60,7 +60,7 @@ TEST(Uart, PollingNeverSleepsOnTheWallClock) {
     // stdout (AVR_UART_FLAG_STDIO); the bench clears both.
     Mcu mcu(ElfImage::load(test::firmware("uart_echo")));
     std::uint32_t flags = 0xffffffff;
-    ASSERT_EQ(avr_ioctl(mcu.avr(), AVR_IOCTL_UART_GET_FLAGS('0'), &flags), 0);
+    ASSERT_EQ(mcu.ioctl(AVR_IOCTL_UART_GET_FLAGS('0'), &flags), 0);
     EXPECT_EQ(flags & (AVR_UART_FLAG_POLL_SLEEP | AVR_UART_FLAG_STDIO), 0u);
 }
 

@@ -86,7 +86,7 @@ TEST(Pty, OpeningThePortCanResetTheMcuAsAnArduinoDoes) {
     uno.reset_external();
     EXPECT_EQ(uno.pc_bytes(), 0u);
     // MCUSR (0x54 in data space on the 328P): EXTRF is bit 1.
-    EXPECT_EQ(uno.avr()->data[0x54] & 0x02, 0x02);
+    EXPECT_EQ(uno.peek(0x54) & 0x02, 0x02);
     bench.board().run_for_seconds(0.005);
     EXPECT_EQ(bench.serial("host").transmitted_text(), "avrbench uart_echo\r\navrbench uart_echo\r\n");
     EXPECT_EQ(uno.resets(), 1u);

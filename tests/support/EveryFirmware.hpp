@@ -70,8 +70,7 @@ inline TracedEnd run_traced(const std::string& name, McuOptions options) {
     TracedEnd s;
     s.cycle = mcu.cycle();
     s.pc = mcu.pc_bytes();
-    const avr_t* avr = mcu.avr();
-    s.data.assign(avr->data, avr->data + avr->ramend + 1);
+    s.data = mcu.data_memory();
     s.events = timeline.events();
     for (const auto& f : mcu.findings()) s.findings.push_back(f.describe());
     s.steps = mcu.steps();

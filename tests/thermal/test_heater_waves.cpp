@@ -55,8 +55,7 @@ HeaterRun run_heater(bool waves, bool skip_idle_loops, bool faults = false) {
     r.on_cycles = heater.on_cycles();
     r.block_degC = plant.block_degC();
     r.sensor_degC = plant.sensor_degC();
-    const avr_t* avr = mcu.avr();
-    r.data.assign(avr->data, avr->data + avr->ramend + 1);
+    r.data = mcu.data_memory();
     return r;
 }
 

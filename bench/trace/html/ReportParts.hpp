@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "trace/HtmlReport.hpp"
 #include "trace/RunReport.hpp"
+#include "trace/html/ReportLayout.hpp"
 #include "trace/Timeline.hpp"
 
 namespace avrbench::html_report {
