@@ -69,6 +69,8 @@ public:
     // Advances every MCU to `end_ps` of simulated time: afterwards now_ps() >=
     // end_ps exactly, unless the board halted or a callback asked to stop.
     StopReason run_until_ps(Picoseconds end_ps) { return lockstep_.run_until_ps(end_ps); }
+    // Ends the present run_until_ps after the running MCU's instruction (Lockstep::request_stop).
+    void request_stop() { lockstep_.request_stop(); }
     // The time of the MCU furthest behind.
     Picoseconds now_ps() const { return lockstep_.now_ps(); }
     // Conveniences for a single call (never for a loop's condition).

@@ -48,6 +48,14 @@ public:
     // the first instruction boundary at or after it). Halted MCUs drop out.
     // Returns Requested as soon as any callback asked one MCU to stop.
     StopReason run_until_ps(std::uint64_t end_ps);
+    // From a callback inside a run (a pin or a line someone waits for): the
+    // present run_until_ps returns Requested after the running MCU's
+    // instruction. Outside a run it does nothing.
+    void request_stop() {
+        if (running_ == nullptr) return;
+        requested_stop_ = true;
+        running_->request_stop();
+    }
 
     // Whole-board simulated time in picoseconds: the time of the MCU furthest behind.
     std::uint64_t now_ps() const;

@@ -95,30 +95,45 @@ private:
     }
     std::string operator()(const WaitForTextStep& s) {
         UartHost& host = bench_.host();
-        std::size_t checked = 0;
+        for (const auto& entry : host.transcript()) {
+            if (entry.direction == Direction::Received && entry.text.find(s.text) != std::string::npos) return "";
+        }
+        // Woken by the line itself: the run stops after the instruction that
+        // completed it, at its exact cycle. The listener outlives the step
+        // (a host keeps its listeners); `waiting` makes it inert afterwards.
+        auto waiting = std::make_shared<bool>(true);
+        auto seen = std::make_shared<bool>(false);
+        Board& board = bench_.board();
+        host.on_line_received([waiting, seen, &board, text = s.text](const TranscriptEntry& entry) {
+            if (!*waiting || entry.direction != Direction::Received || entry.text.find(text) == std::string::npos) return;
+            *seen = true;
+            board.request_stop();
+        });
         // Each pass either returns or runs the board to a later time (core/Time.hpp).
-        for (;;) {
-            const auto& transcript = host.transcript();
-            for (; checked < transcript.size(); ++checked) {
-                if (transcript[checked].direction == Direction::Received &&
-                    transcript[checked].text.find(s.text) != std::string::npos) {
-                    return "";
-                }
-            }
+        while (!*seen) {
             const Picoseconds now = bench_.now_ps();
             if (now >= deadline_ || host.failed() || user_stop_requested() || bench_.timeline().overflowed()) break;
-            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kSlicePs))) == StopReason::Halted) break;
+            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kGuardSlicePs))) == StopReason::Halted) break;
         }
+        *waiting = false;
+        if (*seen) return "";
         return "the firmware sent no line containing '" + s.text + "' by " + seconds_text(deadline_) +
                " (the time limit)";
     }
     std::string operator()(const WaitPinStep& s) {
         Pin& pin = bench_.board().pin(s.pin);
+        // Woken by the edge itself, at its exact cycle (as the text wait).
+        auto waiting = std::make_shared<bool>(true);
+        Board& board = bench_.board();
+        pin.on_change([waiting, &board, level = s.level](Cycle, bool now) {
+            if (*waiting && now == level) board.request_stop();
+        });
         while (pin.level() != s.level) {
             const Picoseconds now = bench_.now_ps();
             if (now >= deadline_ || user_stop_requested() || bench_.timeline().overflowed()) break;
-            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kPinSlicePs))) == StopReason::Halted) break;
+            if (bench_.board().run_until_ps(std::min(deadline_, add_ps(now, kGuardSlicePs))) == StopReason::Halted) break;
         }
+        *waiting = false;
         if (pin.level() == s.level) return "";
         return s.pin + " did not become " + (s.level ? "1" : "0") + " by " + seconds_text(deadline_) + " (the time limit)";
     }
@@ -136,8 +151,9 @@ private:
         return "";
     }
 
-    static constexpr Picoseconds kSlicePs = 100'000'000;    // 100 us between transcript checks
-    static constexpr Picoseconds kPinSlicePs = 10'000'000;  // 10 us between pin checks
+    // Waits wake on their event; slices only bound how long a SIGINT or a
+    // full recorder goes unnoticed.
+    static constexpr Picoseconds kGuardSlicePs = 10 * kPsPerMs;
     Bench& bench_;
     Picoseconds deadline_;
 };

@@ -9,6 +9,9 @@
 
 #include "support/Paths.hpp"
 #include "trace/TimelineText.hpp"
+#include "verify/Scenario.hpp"
+
+#include <cmath>
 #include "support/RunCommand.hpp"
 
 namespace avrbench {
@@ -120,6 +123,37 @@ TEST(Scenarios, MalformedScenarioIsOneLineWithExitCode2) {
     EXPECT_EQ(r.err, "avrbench: error: " + path.string() +
                          ":4: unknown step 'dance' (known: delay, inject_fault, release_input, send, send_file, set_input, "
                          "wait_for_text, wait_idle, wait_pin)\n");
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// A wait wakes on the edge it waits for, at its cycle: blink_timer1's first
+// OC1A toggle (PB1 high) is in the committed golden; the scenario ends with
+// the wait, so its simulated time is the edge's, within one step of the core
+// after it (the compare match also raises the interrupt: the 4-cycle response
+// plus the instruction in progress, at most 8 cycles), not the next poll (a
+// poll every 10 us, 160 cycles, ended it at 16160).
+TEST(Scenarios, WaitPinEndsAtTheEdgesCycle) {
+    const auto dir = test::scratch_dir("scenario-wait-pin");
+    const fs::path path = dir / "wait.yaml";
+    std::ofstream(path) << "name: wait\n"
+                        << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
+                        << "firmware: {uno: blink_timer1}\n"
+                        << "time_limit: 10ms\n"
+                        << "steps:\n  - wait_pin: {pin: uno.PB1, level: 1}\n";
+    const ParsedTimeline golden = read_timeline_text(test::source_path("golden/blink_timer1.timeline"));
+    const long pb1 = golden.timeline.find("uno", "PB1");
+    ASSERT_GE(pb1, 0);
+    const Cycle edge = changes_of(golden.timeline, static_cast<SignalId>(pb1)).at(1).cycle;
+    const ScenarioResult r = run_scenario(load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR), {});
+    ASSERT_TRUE(r.passed) << r.text();
+    const auto end_cycle = static_cast<Cycle>(std::llround(r.simulated_s * 16e6));
+    EXPECT_GE(end_cycle, edge);
+    EXPECT_LE(end_cycle, edge + 8) << "the wait ended " << end_cycle - edge << " cycles after the edge";
 }
 
 }  // namespace
