@@ -23,6 +23,7 @@ extern "C" {
 #include "core/McuPins.hpp"
 #include "core/IdleLoopSkip.hpp"
 #include "core/IntelHex.hpp"
+#include "core/TimingProfile.hpp"
 #include "core/Twi.hpp"
 #include "core/UserStop.hpp"
 #include "core/fixes/CompareOutputPins.hpp"
@@ -229,6 +230,7 @@ std::string Mcu::describe_pc(std::uint32_t pc_bytes) const {
 }
 
 Mcu::~Mcu() {
+    profiler_.reset();  // unhooks from the core's IRQs
     uarts_.clear();
     pins_.clear();
     adc_.reset();
@@ -309,16 +311,27 @@ bool Mcu::run_until_sleep(Cycle end_cycle) {
 }
 
 StopReason Mcu::run_until(Cycle target_cycle) {
-    return run_coverage_ != nullptr ? run_until_impl<true>(target_cycle, run_coverage_)
-                                    : run_until_impl<false>(target_cycle, nullptr);
+    if (__builtin_expect(profiler_ != nullptr, 0)) {
+        return run_coverage_ != nullptr ? run_until_impl<true, true>(target_cycle, run_coverage_)
+                                        : run_until_impl<false, true>(target_cycle, nullptr);
+    }
+    return run_coverage_ != nullptr ? run_until_impl<true, false>(target_cycle, run_coverage_)
+                                    : run_until_impl<false, false>(target_cycle, nullptr);
 }
 
-StopReason Mcu::run_until_covering(Cycle target_cycle, PcEdgeMap& edges) { return run_until_impl<true>(target_cycle, &edges); }
+StopReason Mcu::run_until_covering(Cycle target_cycle, PcEdgeMap& edges) {
+    return profiler_ != nullptr ? run_until_impl<true, true>(target_cycle, &edges)
+                                : run_until_impl<true, false>(target_cycle, &edges);
+}
+
+void Mcu::enable_profile() {
+    if (!profiler_) profiler_ = std::make_unique<TimingProfiler>(*this);
+}
 
 // kCover: every instruction's new PC goes into `edges` (fuzzing); without it
 // the loop is the plain run loop (a separate instantiation, so the coverage
 // costs the ordinary runs nothing).
-template <bool kCover>
+template <bool kCover, bool kProfile>
 StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     stop_requested_ = false;
     real_stop_ = false;
@@ -353,12 +366,16 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     while (avr->cycle < target_cycle) {
         if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
         const std::uint32_t pc_before = avr->pc;
+        [[maybe_unused]] const Cycle cycle_before = avr->cycle;
+        [[maybe_unused]] const bool was_sleeping = avr->state == cpu_Sleeping;
         const int state = __builtin_expect(reference, 0) ? stepper.reference_step() : stepper.step();
         ++steps_;
+        if constexpr (kProfile) profiler_->after_step(cycle_before, was_sleeping, pc_before);
         check(state, pc_before);
         if constexpr (kCover) edges->hit(avr->pc);
         if (__builtin_expect(stop_requested_, 0)) break;
-        if (reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
+        // A profile sees every step: no fast path.
+        if (kProfile || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
         // Fast path: while the core runs, no interrupt is on its way and no
         // cycle timer is due, a step of SimavrStepper is avr_run_one and the
@@ -430,6 +447,7 @@ void Mcu::after_reset() {
     // And the run's horizon: run_until's fast path counts on it.
     if (avr_->cycle < run_target_) avr_cycle_timer_register(avr_, run_target_ - avr_->cycle, &horizon_timer, this);
     if (twi_) twi_->reset();
+    if (profiler_) profiler_->reset();
     for (auto& fn : reset_listeners_) fn();
 }
 

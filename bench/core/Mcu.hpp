@@ -30,6 +30,7 @@ namespace avrbench {
 
 class Adc;
 class IdleLoopSkipper;
+class TimingProfiler;
 class Mcu;
 class Twi;
 
@@ -122,6 +123,11 @@ public:
     // also when a board's lockstep drives this MCU among others (fuzzing a
     // multi-MCU board through one of them).
     void set_run_coverage(PcEdgeMap* edges) { run_coverage_ = edges; }
+    // Collects the timing profile (core/TimingProfile.hpp) from now on;
+    // every instruction then takes the run loop's general step.
+    void enable_profile();
+    // nullptr until enable_profile().
+    const TimingProfiler* profile() const { return profiler_.get(); }
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
@@ -245,7 +251,7 @@ private:
     void application_started();
     bool in_boot_section(std::uint32_t pc_bytes) const { return boot_ && pc_bytes >= boot_->start_bytes; }
     bool check_after_step(int state, std::uint32_t pc_before);
-    template <bool kCover>
+    template <bool kCover, bool kProfile>
     StopReason run_until_impl(Cycle target_cycle, PcEdgeMap* edges);
     void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);
@@ -266,6 +272,7 @@ private:
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
     PcEdgeMap* run_coverage_ = nullptr;
+    std::unique_ptr<TimingProfiler> profiler_;
     bool real_stop_ = false;  // stop_requested_ came from request_stop, not request_yield
     PeerSync* peer_sync_ = nullptr;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;

@@ -14,6 +14,7 @@
 #include "core/InputFile.hpp"
 #include "core/Mcu.hpp"
 #include "core/OutputFile.hpp"
+#include "core/TimingProfile.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
 #include "tools/Commands.hpp"
@@ -56,6 +57,7 @@ struct RunArgs {
     bool wait_banner = false;
     std::string settle = "50ms";
     std::string report;
+    std::string profile;  // --profile: the timing profile as JSON
     std::string family;        // --family: overrides the board's
     std::string line_timeout;  // --line-timeout: overrides the board's
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
@@ -211,6 +213,7 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
     o.vcd = args.vcd;
     o.vcd_layout = vcd_layout(args);
     o.report = args.report;
+    o.profile = args.profile;
     o.trace = args.trace;
     o.trace_only = args.trace_only;
     o.on_progress = [&progress](double fraction, double simulated_s) { progress.show(fraction, simulated_s); };
@@ -266,11 +269,13 @@ int run_command(const RunArgs& args) {
         files.output(with_extension(args.vcd, ".gtkw"), "--vcd's gtkwave save file");
     }
     for (const auto& pf : uart_out) files.output(pf.path, "--uart-out");
+    if (!args.profile.empty()) files.output(args.profile, "--profile");
     files.check();
     std::string uart_in_bytes;
     if (!uart_in.empty()) uart_in_bytes = read_uart_input(uart_in.front().path);
 
     Mcu mcu(elf, options);
+    if (!args.profile.empty()) mcu.enable_profile();
     Timeline timeline;
     Recorder recorder(timeline);
     const bool tracing = !args.vcd.empty() || !args.trace.empty() || !args.trace_only.empty();
@@ -326,6 +331,10 @@ int run_command(const RunArgs& args) {
     if (uart0 != nullptr) {
         std::printf("  uart0      %zu bytes from firmware, %llu bytes to firmware\n", uart0->transmitted().size(),
                     static_cast<unsigned long long>(uart0->bytes_delivered()));
+    }
+    if (const TimingProfiler* profile = mcu.profile()) {
+        for (const std::string& line : profile->summary_lines()) std::printf("  profile    %s\n", line.c_str());
+        write_output_file(args.profile, "{\"mcus\": [" + profile->json() + "]}\n", "--profile");
     }
     print_findings(mcu.findings());
     if (!args.vcd.empty()) {
@@ -397,6 +406,9 @@ Command add_run_command(CLI::App& app) {
                         "feed hold/resume), 1s=^X, 3s=0x85 (repeatable; needs --gcode)");
     run_cmd->add_option("--settle", run.settle, "motion has stopped after no STEP edge for this long (default 50ms)");
     run_cmd->add_option("--report", run.report, "write an HTML report of the run (with --board)");
+    run_cmd->add_option("--profile", run.profile,
+                        "collect each MCU's timing profile (ISR time and latency, interrupts off, CPU load, stack "
+                        "high-water mark): in the summary, and as JSON in this file (docs/CLI.md)");
     run_cmd->add_flag("--until-sleep", run.until_sleep, "stop when the firmware first executes SLEEP (bounded by --for)");
     run_cmd->add_option("--uart-in", run.uart_in,
                         "FILE or PORT=FILE: raw bytes to send to a serial port (the board's first, or USART0; repeatable)");

@@ -9,6 +9,7 @@
 
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
+#include "core/TimingProfile.hpp"
 #include "core/Twi.hpp"
 #include "core/Units.hpp"
 #include "stimulus/PtyBridge.hpp"
@@ -131,6 +132,9 @@ BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
     bench_ = std::make_unique<Bench>(std::move(spec), options_.firmware);
     Board& board = bench_->board();
     for (Mcu* m : board.mcus()) m->set_skip_idle_loops(options_.skip_idle_loops);
+    if (!options_.profile.empty()) {
+        for (Mcu* m : board.mcus()) m->enable_profile();
+    }
     if (!options_.periodic_waves) board.set_periodic_waves(false);
     const bool job = options_.gcode || static_cast<bool>(options_.records);
     if (board.spec().serial.empty() && (!options_.uart_in.empty() || !options_.uart_out.empty() || job)) {
@@ -172,6 +176,7 @@ void BoardRun::check_files(const BoardSpec& spec) {
         files.output(with_extension(options_.vcd, ".gtkw"), "--vcd's gtkwave save file");
     }
     if (!options_.report.empty()) files.output(options_.report, "--report");
+    if (!options_.profile.empty()) files.output(options_.profile, "--profile");
     for (const auto& pb : options_.uart_out) files.output(pb.path, "--uart-out");
     files.check();
 }
@@ -310,6 +315,11 @@ IdleResult BoardRun::run() {
         write_output_file(pb.path, bench.serial(pb.port).transmitted_text(), "--uart-out");
     }
     findings_ = bench.findings();
+    if (!options_.profile.empty()) {
+        std::string json = "{\"mcus\": [";
+        for (Mcu* m : bench.board().mcus()) json += std::string(json.back() == '[' ? "" : ", ") + m->profile()->json();
+        write_output_file(options_.profile, json + "]}\n", "--profile");
+    }
     if (!options_.report.empty()) {
         write_html_report(bench.make_report(std::string(bench.mcu().elf().path()) + " on " + bench.board().spec().name),
                           options_.report);
@@ -401,6 +411,10 @@ std::vector<std::string> BoardRun::summary() const {
     }
     for (Part* part : board.parts()) {
         if (const std::string line = part->summary(); !line.empty()) out.push_back("  " + line);
+    }
+    for (Mcu* m : board.mcus()) {
+        if (m->profile() == nullptr) continue;
+        for (const std::string& line : m->profile()->summary_lines()) out.push_back("  profile    " + m->name() + ": " + line);
     }
     out.push_back(format("  findings   %zu", findings_.size()));
     for (const auto& line : summarize_findings(findings_)) out.push_back("    " + line);

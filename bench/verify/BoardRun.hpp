@@ -80,6 +80,9 @@ struct BoardRunOptions {
     std::string report;
     std::string trace;       // pins added to the board's defaults (MCU.PIN or PIN lists)
     std::string trace_only;  // pins recorded instead of the defaults
+    // The timing profile of every MCU (core/TimingProfile.hpp), written
+    // here as JSON and shown in the summary; "" = not collected.
+    std::string profile;
     // Files the caller reads or writes besides these (checked with them: each
     // output a file of its own, none an input).
     RunFiles more_files;
