@@ -63,6 +63,23 @@ std::string relative_to(const std::string& path, const fs::path& base_dir) {
     return ec || rel.empty() ? fs::path(path).filename().string() : rel.generic_string();
 }
 
+// Every name each board net is recorded under: its endpoints ("uno.PD2",
+// "x_driver.step"), "nets.<net>" and "labels.<label>" for labels on it.
+std::vector<std::vector<std::string>> wire_names(const BoardSpec& spec) {
+    std::vector<std::vector<std::string>> wires;
+    for (const auto& net : spec.nets) {
+        std::vector<std::string> names{"nets." + net.name};
+        for (const auto& e : net.endpoints) names.push_back(e.text());
+        for (const auto& label : spec.labels) {
+            for (const auto& e : net.endpoints) {
+                if (label.endpoint.text() == e.text()) names.push_back("labels." + label.name);
+            }
+        }
+        wires.push_back(std::move(names));
+    }
+    return wires;
+}
+
 class StepRunner {
 public:
     StepRunner(Bench& bench, Picoseconds deadline_ps) : bench_(bench), deadline_(deadline_ps) {}
@@ -305,6 +322,7 @@ std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, cons
     ParsedTimeline golden = read_timeline_text(spec.golden_path, bench.now_seconds());
     CompareOptions compare;
     compare.rules = spec.tolerances;
+    compare.wires = wire_names(bench.board().spec());
     compare.golden_end_cycle = golden.header.end_cycle;
     compare.actual_end_cycle = header.end_cycle;
     result.comparison = compare_timelines(golden.timeline, actual, compare);

@@ -330,8 +330,30 @@ const ChannelResult* CompareResult::first_divergence() const {
     return first;
 }
 
+namespace {
+
+// The first rule whose pattern matches the signal or another name of its wire.
+ChannelRule rule_for(const std::string& signal, const CompareOptions& options,
+                     const std::map<std::string, const std::vector<std::string>*>& wire_of) {
+    const auto wire = wire_of.find(signal);
+    for (const auto& candidate : options.rules) {
+        if (glob_match(candidate.pattern, signal)) return candidate;
+        if (wire == wire_of.end()) continue;
+        for (const auto& other : *wire->second) {
+            if (glob_match(candidate.pattern, other)) return candidate;
+        }
+    }
+    return ChannelRule{};
+}
+
+}  // namespace
+
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options) {
     CompareResult result;
+    std::map<std::string, const std::vector<std::string>*> wire_of;
+    for (const auto& wire : options.wires) {
+        for (const auto& name : wire) wire_of[name] = &wire;
+    }
     // Each timeline's events grouped by signal in one pass.
     const auto golden_changes = changes_by_signal(golden);
     const auto actual_changes = changes_by_signal(actual);
@@ -345,13 +367,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
         r.clock_hz = info.clock_hz;
         r.verdict = "ok";
         seen[r.signal] = true;
-        ChannelRule rule;
-        for (const auto& candidate : options.rules) {
-            if (glob_match(candidate.pattern, r.signal)) {
-                rule = candidate;
-                break;
-            }
-        }
+        const ChannelRule rule = rule_for(r.signal, options, wire_of);
         r.rule = rule.kind;
         const auto& g = golden_changes[gid];
         r.golden_changes = g.size();
@@ -376,13 +392,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
     }
     for (const auto& [name, id] : actual_ids) {
         if (seen.count(name)) continue;
-        ChannelRule rule;
-        for (const auto& candidate : options.rules) {
-            if (glob_match(candidate.pattern, name)) {
-                rule = candidate;
-                break;
-            }
-        }
+        const ChannelRule rule = rule_for(name, options, wire_of);
         if (rule.kind == RuleKind::Ignore) continue;
         ChannelResult r;
         r.signal = name;

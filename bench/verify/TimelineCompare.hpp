@@ -37,6 +37,11 @@ struct ChannelRule {
 
 struct CompareOptions {
     std::vector<ChannelRule> rules;  // first match wins; none matching: Exact
+    // Names that are one electrical wire (an MCU pin, the part pins on its
+    // net, the net's and labels' names): a rule whose pattern matches any
+    // of them applies to every one, so a tolerance belongs to the wire,
+    // whatever name it is written with.
+    std::vector<std::vector<std::string>> wires;
     std::size_t context_events = 3;
     // Ends of the two runs (for windowed rules); 0: the last event.
     Cycle golden_end_cycle = 0;

@@ -172,3 +172,46 @@ TEST(TimelineCompare, RulesMatchByGlobFirstMatchWins) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// One wire recorded under two names (the MCU pin and the driver's STEP
+// input on its net), both 3 cycles late at one step.
+Timeline one_wire_two_names(Cycle shift_by) {
+    Timeline t;
+    const SignalId pin = t.add_signal({"uno", "PD2", SignalKind::Wire, 1, kHz});
+    const SignalId input = t.add_signal({"x_driver", "step", SignalKind::Wire, 1, kHz});
+    for (const SignalId id : {pin, input}) {
+        t.record(id, 0, 0);
+        for (int i = 0; i < 10; ++i) {
+            const Cycle at = 1000 + static_cast<Cycle>(i) * 400 + (i == 5 ? shift_by : 0);
+            t.record(id, at, 1);
+            t.record(id, at + 32, 0);
+        }
+    }
+    return t;
+}
+
+// Issue 36: a tolerance written for uno.PD2 covers x_driver.step and
+// nets.x_step, the same electrical wire.
+TEST(TimelineCompare, ATolerancesBelongsToTheWireNotToOneOfItsNames) {
+    CompareOptions o;
+    ChannelRule r;
+    r.pattern = "uno.PD2";
+    r.kind = RuleKind::Steps;
+    r.tolerance_cycles = 4;
+    o.rules.push_back(r);
+    const auto without_wires = compare_timelines(one_wire_two_names(0), one_wire_two_names(3), o);
+    EXPECT_FALSE(without_wires.passed) << "x_driver.step falls back to exact";
+    o.wires = {{"nets.x_step", "uno.PD2", "x_driver.step"}};
+    const auto with_wires = compare_timelines(one_wire_two_names(0), one_wire_two_names(3), o);
+    EXPECT_TRUE(with_wires.passed) << with_wires.report();
+    for (const auto& c : with_wires.channels) EXPECT_EQ(c.rule, RuleKind::Steps) << c.signal;
+    // The same rule written with the net's name.
+    o.rules[0].pattern = "nets.x_step";
+    EXPECT_TRUE(compare_timelines(one_wire_two_names(0), one_wire_two_names(3), o).passed);
+}
+
+}  // namespace
+}  // namespace avrbench

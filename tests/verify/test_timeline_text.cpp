@@ -90,6 +90,13 @@ TEST(TimelineText, ParseErrorsNameTheLine) {
     } catch (const BadInput& e) {
         EXPECT_STREQ(e.what(), "g.txt:5: 'x' is not a whole number");
     }
+    // Two changes on one line are an error, not the first change alone (issue 36).
+    try {
+        parse_timeline_text("avrbench-timeline 1\nsignal uno.PD2 wire 1 16000000\n@uno.PD2\n0 1\n+17 0 +15 1\n", "g.txt");
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "g.txt:5: '+15' after a change (one item per line)");
+    }
 }
 
 // Golden values no run can have: one line naming file and line, never an
