@@ -125,6 +125,13 @@ public:
         if (!ok) throw BadInput(location + ": " + decl->type + " has no pin '" + pin + "' (in '" + text + "')");
     }
 
+    void check_mcu(const std::string& name, const std::string& location) const {
+        if (board_.find_mcu(name) != nullptr) return;
+        std::string list;
+        for (const auto& m : board_.mcus) list += (list.empty() ? "" : ", ") + m.name;
+        throw BadInput(location + ": the board has no MCU '" + name + "' (MCUs: " + list + ")");
+    }
+
     void check_part(const std::string& name, const std::string& location) const {
         if (board_.find_part(name) == nullptr) {
             std::string list;
@@ -200,6 +207,41 @@ ScenarioStep parse_step(const Item& item, const std::string& path, const BoardNa
 // Counts a scenario can expect: at most 2^53 so a double holds them exactly.
 constexpr std::int64_t kMaxCount = std::int64_t{1} << 53;
 
+// isr: {vector, max_cycles, max_latency_cycles, min_runs}, stack:
+// {min_headroom_bytes}, interrupts_off: {max_cycles}; each with an optional mcu.
+ExpectAction parse_timing_expectation(const Item& item, const BoardNames& names) {
+    const std::string& k = item.kind;
+    if (!item.value.IsMap()) throw BadInput(item.location + ": '" + k + "' takes a map (docs/SCENARIOS.md)");
+    auto mcu = [&]() -> std::string {
+        if (!item.has("mcu")) return "";
+        names.check_mcu(item.get("mcu"), item.at("mcu"));
+        return item.get("mcu");
+    };
+    auto count = [&](const char* key) {
+        return static_cast<std::uint64_t>(parse_integer(item.get(key), item.at(key) + ": " + key, 0, kMaxCount));
+    };
+    if (k == "isr") {
+        item.expect_keys({"vector"}, {"mcu", "max_cycles", "max_latency_cycles", "min_runs"});
+        ExpectIsr e;
+        e.mcu = mcu();
+        e.vector = static_cast<int>(parse_integer(item.get("vector"), item.at("vector") + ": vector", 1, 127));
+        if (item.has("max_cycles")) e.max_cycles = count("max_cycles");
+        if (item.has("max_latency_cycles")) e.max_latency_cycles = count("max_latency_cycles");
+        if (item.has("min_runs")) e.min_runs = count("min_runs");
+        if (!e.max_cycles && !e.max_latency_cycles && !e.min_runs) {
+            throw BadInput(item.location + ": 'isr' needs max_cycles, max_latency_cycles or min_runs");
+        }
+        return e;
+    }
+    if (k == "stack") {
+        item.expect_keys({"min_headroom_bytes"}, {"mcu"});
+        return ExpectStack{mcu(), parse_integer(item.get("min_headroom_bytes"), item.at("min_headroom_bytes") +
+                                                                                    ": min_headroom_bytes", 0, 65536)};
+    }
+    item.expect_keys({"max_cycles"}, {"mcu"});
+    return ExpectInterruptsOff{mcu(), count("max_cycles")};
+}
+
 ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names) {
     ScenarioExpectation e;
     e.kind = item.kind;
@@ -231,6 +273,8 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
     } else if (k == "text") {
         names.check_serial(k, item.location);
         e.action = ExpectText{item.scalar_value()};
+    } else if (k == "isr" || k == "stack" || k == "interrupts_off") {
+        e.action = parse_timing_expectation(item, names);
     } else if (k == "findings") {
         if (item.value.IsSequence()) {
             ExpectFindingKinds kinds;
@@ -375,7 +419,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
     if (const YAML::Node steps = sequence("steps")) {
         for (const auto& node : steps) spec.steps.push_back(parse_step(read_item(node, path, kSteps, "step"), path, names));
     }
-    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "findings"};
+    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "findings", "isr", "stack", "interrupts_off"};
     if (const YAML::Node expect = sequence("expect")) {
         for (const auto& node : expect) spec.expectations.push_back(parse_expectation(read_item(node, path, kExpect, "expectation"), names));
     }

@@ -46,7 +46,17 @@ struct ExpectText { std::string text; };
 struct ExpectFindingCount { std::uint64_t count = 0; };
 struct ExpectFindingKinds { std::vector<std::string> kinds; };  // as a multiset
 
-using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectFindingCount, ExpectFindingKinds>;
+// Timing profile bounds (core/TimingProfile.hpp); `mcu` "" = the board's first.
+// A scenario with any of them profiles that MCU.
+struct ExpectIsr {
+    std::string mcu;
+    int vector = 0;
+    std::optional<std::uint64_t> max_cycles, max_latency_cycles, min_runs;  // inclusive execution time
+};
+struct ExpectStack { std::string mcu; std::int64_t min_headroom_bytes = 0; };
+struct ExpectInterruptsOff { std::string mcu; std::uint64_t max_cycles = 0; };
+using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectFindingCount, ExpectFindingKinds,
+                                  ExpectIsr, ExpectStack, ExpectInterruptsOff>;
 
 struct ScenarioExpectation {
     ExpectAction action;

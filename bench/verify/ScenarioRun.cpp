@@ -12,6 +12,7 @@
 #include "core/InputFile.hpp"
 #include "core/FileHash.hpp"
 #include "core/UserStop.hpp"
+#include "core/TimingProfile.hpp"
 #include "trace/WaveformFiles.hpp"
 #include "trace/HtmlReport.hpp"
 #include "core/OutputFile.hpp"
@@ -206,6 +207,44 @@ private:
         if (bench_.host().received_text().find(e.text) != std::string::npos) return "";
         return "the firmware never sent '" + e.text + "'";
     }
+    const TimingProfiler& profile(const std::string& mcu) {
+        return *(mcu.empty() ? bench_.mcu() : bench_.mcu(mcu)).profile();
+    }
+    std::string operator()(const ExpectIsr& e) {
+        const auto& vectors = profile(e.mcu).vectors();
+        const auto it = vectors.find(e.vector);
+        const std::string name = "vector " + std::to_string(e.vector);
+        if (it == vectors.end() || it->second.runs == 0) {
+            return e.min_runs && *e.min_runs == 0 ? "" : name + " never ran";
+        }
+        const VectorProfile& v = it->second;
+        if (e.min_runs && v.runs < *e.min_runs) {
+            return name + " ran " + std::to_string(v.runs) + " times, expected at least " + std::to_string(*e.min_runs);
+        }
+        if (e.max_cycles && v.inclusive_cycles.max() > *e.max_cycles) {
+            return name + " took up to " + std::to_string(v.inclusive_cycles.max()) + " cycles (median " +
+                   std::to_string(v.inclusive_cycles.median()) + "), expected at most " + std::to_string(*e.max_cycles);
+        }
+        if (e.max_latency_cycles && v.latency_cycles.max() > *e.max_latency_cycles) {
+            return name + " started up to " + std::to_string(v.latency_cycles.max()) +
+                   " cycles after its flag, expected at most " + std::to_string(*e.max_latency_cycles);
+        }
+        return "";
+    }
+    std::string operator()(const ExpectStack& e) {
+        const Mcu& m = e.mcu.empty() ? bench_.mcu() : bench_.mcu(e.mcu);
+        const std::int64_t headroom = static_cast<std::int64_t>(profile(e.mcu).lowest_sp()) + 1 -
+                                      static_cast<std::int64_t>(m.elf().ram_end_of_static_data());
+        if (headroom >= e.min_headroom_bytes) return "";
+        return "the stack came within " + std::to_string(headroom) + " bytes of .bss/.noinit, expected at least " +
+               std::to_string(e.min_headroom_bytes);
+    }
+    std::string operator()(const ExpectInterruptsOff& e) {
+        const TimingProfiler& p = profile(e.mcu);
+        if (p.longest_interrupts_off() <= e.max_cycles) return "";
+        return "interrupts were off for " + std::to_string(p.longest_interrupts_off()) + " cycles, expected at most " +
+               std::to_string(e.max_cycles);
+    }
     std::string operator()(const ExpectFindingCount& e) {
         if (findings_.size() == e.count) return "";
         std::string list;
@@ -383,6 +422,14 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         bench.host("", o);
     }
     bench.trace_board();
+    // Timing bounds need the profile of the MCUs they name.
+    for (const auto& e : spec.expectations) {
+        std::visit(
+            [&](const auto& a) {
+                if constexpr (requires { a.mcu; }) (a.mcu.empty() ? bench.mcu() : bench.mcu(a.mcu)).enable_profile();
+            },
+            e.action);
+    }
     auto fail = [&](const std::string& message) {
         result.failures.push_back(message);
         result.expectation_failures.push_back(message);

@@ -9,6 +9,7 @@
 
 #include "support/Paths.hpp"
 #include "trace/TimelineText.hpp"
+#include "core/Errors.hpp"
 #include "verify/Scenario.hpp"
 
 #include <cmath>
@@ -154,6 +155,48 @@ TEST(Scenarios, WaitPinEndsAtTheEdgesCycle) {
     const auto end_cycle = static_cast<Cycle>(std::llround(r.simulated_s * 16e6));
     EXPECT_GE(end_cycle, edge);
     EXPECT_LE(end_cycle, edge + 8) << "the wait ended " << end_cycle - edge << " cycles after the edge";
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// A timing bound one cycle under blink_timer1's 28-cycle ISR fails, naming
+// the vector, what it took and the bound (tests/scenarios/blink_timer1_timing.yaml
+// holds the hand count).
+TEST(Scenarios, AnIsrOverItsCycleBoundFailsWithTheMeasuredTime) {
+    const auto dir = test::scratch_dir("scenario-isr-bound");
+    const fs::path path = dir / "isr.yaml";
+    std::ofstream(path) << "name: isr\n"
+                        << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
+                        << "firmware: {uno: blink_timer1}\n"
+                        << "steps:\n  - delay: 10ms\n"
+                        << "expect:\n  - isr: {vector: 11, max_cycles: 27}\n  - stack: {min_headroom_bytes: 2041}\n";
+    const ScenarioResult r = run_scenario(load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR), {});
+    EXPECT_FALSE(r.passed);
+    ASSERT_EQ(r.expectation_failures.size(), 2u) << r.text();
+    EXPECT_NE(r.expectation_failures[0].find("vector 11 took up to 28 cycles (median 28), expected at most 27"),
+              std::string::npos)
+        << r.expectation_failures[0];
+    EXPECT_NE(r.expectation_failures[1].find("within 2040 bytes"), std::string::npos) << r.expectation_failures[1];
+}
+
+TEST(Scenarios, ATimingBoundForAnUnknownMcuIsAFileLineError) {
+    const auto dir = test::scratch_dir("scenario-isr-mcu");
+    const fs::path path = dir / "isr.yaml";
+    std::ofstream(path) << "name: isr\n"
+                        << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
+                        << "firmware: {uno: blink_timer1}\n"
+                        << "expect:\n  - isr: {vector: 11, mcu: mega, max_cycles: 27}\n";
+    try {
+        load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("isr.yaml:5"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("no MCU 'mega'"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
