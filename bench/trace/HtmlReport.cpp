@@ -153,6 +153,7 @@ std::string format_html_report(const RunReport& report) {
     if (report.timeline != nullptr && !report.axes.empty()) out += "<a href=\"#velocity-section\">motion</a>";
     if (report.timeline != nullptr && !report.temperatures.empty()) out += "<a href=\"#thermal-section\">temperatures</a>";
     if (report.timeline != nullptr && !report.servos.empty()) out += "<a href=\"#servo-section\">servos</a>";
+    if (!report.timing.empty()) out += "<a href=\"#timing-section\">timing</a>";
     out += "<a href=\"#transcript-section\">UART</a></nav>\n</div></header>\n<main>\n";
 
     append_findings(out, report);
@@ -160,6 +161,7 @@ std::string format_html_report(const RunReport& report) {
     append_motion(out, ctx);
     append_thermal(out, ctx);
     append_servos(out, ctx);
+    append_timing(out, report);
     append_transcript(out, report);
     out += "</main>\n<footer>avrbench " AVRBENCH_VERSION " \xc2\xb7 self-contained report, no network</footer>\n</body>\n</html>\n";
     return out;

@@ -29,6 +29,8 @@
 //     thermal     <svg id="temperatures"> (dashed target lines), and
 //                 <svg id="heater-duty"> (percent) when a duty signal is given
 //     servos      <svg id="servos">, degrees
+//     timing      only with profiled MCUs (run --profile): per MCU a <ul class="timing-facts">
+//                 and <table class="timing" id="timing-<mcu>"> of vectors (html/ReportTiming.cpp)
 //     transcript  <pre id="transcript">, lines class "from-host" / "from-firmware",
 //                 or "none"
 //   A plot section without data is left out. <signal> and <axis> in ids are

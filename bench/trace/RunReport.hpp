@@ -3,6 +3,7 @@
 // data: the report writer (HtmlReport) depends on nothing else.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -68,6 +69,19 @@ struct ComparisonView {
     std::vector<ChannelRow> channels;
 };
 
+// One MCU's timing profile (core/TimingProfile.hpp), as the report shows it.
+struct TimingTable {
+    std::string mcu;
+    std::vector<std::string> facts;  // CPU load, stack, interrupts off: one line each
+    struct Row {
+        int vector = 0;
+        std::uint64_t runs = 0;
+        int max_depth = 0;
+        std::array<Cycle, 4> inclusive{}, exclusive{}, latency{};  // min, median, p99, max
+    };
+    std::vector<Row> rows;
+};
+
 struct RunReport {
     std::string title;               // "stepdir_test on arduino-uno-cnc-shield-v3"
     std::vector<std::string> facts;  // "firmware: build/firmware/x.elf (sha256 ...)", "simulated: 1.2 s", ...
@@ -81,6 +95,7 @@ struct RunReport {
     std::vector<FaultMarker> faults;
     std::vector<Finding> findings;
     std::optional<ComparisonView> comparison;
+    std::vector<TimingTable> timing;  // the profiled MCUs (run --profile); none: no section
 };
 
 }  // namespace avrbench

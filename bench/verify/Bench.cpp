@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 
+#include "core/TimingProfile.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
 #include "parts/AcceptedMoves.hpp"
@@ -400,6 +401,21 @@ RunReport Bench::make_report(const std::string& title) const {
             }
         }
         if (!line.empty()) r.transcript.push_back({line_start, hz, false, line});
+    }
+    for (Mcu* m : board_->mcus()) {
+        const TimingProfiler* p = m->profile();
+        if (p == nullptr) continue;
+        TimingTable t;
+        t.mcu = m->name();
+        t.facts = p->summary_lines();
+        for (const auto& [vector, v] : p->vectors()) {
+            auto stats = [](const CycleStats& s) { return std::array<Cycle, 4>{s.min(), s.median(), s.p99(), s.max()}; };
+            t.rows.push_back({vector, v.runs, v.max_depth, stats(v.inclusive_cycles), stats(v.exclusive_cycles),
+                              stats(v.latency_cycles)});
+        }
+        // The per-vector lines are the table; the facts are the rest.
+        t.facts.resize(t.facts.size() - std::min(t.facts.size(), p->vectors().size()));
+        r.timing.push_back(std::move(t));
     }
     r.findings = findings();
     return r;

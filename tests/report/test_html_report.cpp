@@ -575,3 +575,27 @@ TEST(HtmlReport, WriteThrowsNamingAnUnwritablePath) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(HtmlReport, ATimingProfileIsATablePerMcuAndNoProfileNoSection) {
+    RunReport r;
+    r.title = "t";
+    EXPECT_EQ(format_html_report(r).find("timing-section"), std::string::npos);
+    TimingTable t;
+    t.mcu = "uno";
+    t.facts = {"cpu 0.83% executing"};
+    t.rows.push_back({11, 99, 1, {28, 28, 28, 28}, {28, 28, 28, 28}, {5, 5, 5, 5}});
+    r.timing.push_back(t);
+    const std::string html = format_html_report(r);
+    EXPECT_NE(html.find("<a href=\"#timing-section\">timing</a>"), std::string::npos);
+    EXPECT_NE(html.find("<table class=\"timing\" id=\"timing-uno\">"), std::string::npos);
+    EXPECT_NE(html.find("<tr><td>11</td><td>99</td><td>28</td><td>28</td><td>28</td><td>28</td><td>28</td><td>28</td>"
+                        "<td>28</td><td>28</td><td>5</td><td>5</td><td>5</td><td>5</td><td>1</td></tr>"),
+              std::string::npos);
+    EXPECT_NE(html.find("<li>cpu 0.83% executing</li>"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace avrbench

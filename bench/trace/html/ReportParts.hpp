@@ -254,4 +254,8 @@ void append_transcript_line(std::string& out, const TranscriptLine& line);
 
 void append_transcript(std::string& out, const RunReport& report);
 
+// <section id="timing-section">: per profiled MCU its facts and a
+// <table class="timing" id="timing-<mcu>"> of vectors; left out when no MCU was profiled.
+void append_timing(std::string& out, const RunReport& report);
+
 }  // namespace avrbench::html_report
