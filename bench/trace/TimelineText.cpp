@@ -101,7 +101,147 @@ std::vector<std::vector<TimelineEvent>> changes_by_signal(const Timeline& timeli
     return per_signal;
 }
 
-std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header) {
+namespace {
+
+// The exact form: a block of 1 or 2 pairs repeated 3 or more times becomes one line.
+void append_exact(std::string& out, const std::vector<Pair>& pairs) {
+    std::size_t i = 0;
+    while (i < pairs.size()) {
+        bool emitted = false;
+        for (std::size_t block = 1; block <= 2 && !emitted; ++block) {
+            std::size_t repeats = 1;
+            while (i + (repeats + 1) * block <= pairs.size()) {
+                bool same = true;
+                for (std::size_t k = 0; k < block; ++k) same = same && pairs[i + repeats * block + k] == pairs[i + k];
+                if (!same) break;
+                ++repeats;
+            }
+            if (repeats >= 3) {
+                out += "*" + std::to_string(repeats);
+                for (std::size_t k = 0; k < block; ++k) {
+                    out += " +" + std::to_string(pairs[i + k].delta) + " " + pairs[i + k].value;
+                }
+                out += "\n";
+                i += repeats * block;
+                emitted = true;
+            }
+        }
+        if (!emitted) {
+            out += "+" + std::to_string(pairs[i].delta) + " " + pairs[i].value + "\n";
+            ++i;
+        }
+    }
+}
+
+// A run of `repeats` blocks of `block` events from changes[i] on, each event
+// within `jitter` of prev + k * period + offset[j]: its nominal form, or
+// nothing when no such run of 3 or more blocks starts there.
+struct NominalBlock {
+    std::size_t repeats = 0;
+    Cycle period = 0;
+    std::vector<Cycle> offsets;  // of each event in the block from the block's start, the last = period
+};
+
+NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::string>& values, std::size_t i,
+                       std::size_t block, Cycle prev, Cycle jitter) {
+    const std::size_t n = cycles.size();
+    std::size_t repeats = 0;
+    while (i + (repeats + 1) * block <= n) {
+        bool same = true;
+        for (std::size_t j = 0; j < block; ++j) same = same && values[i + repeats * block + j] == values[i + j];
+        if (!same) break;
+        ++repeats;
+    }
+    // Fit, check, shrink to the first block that does not fit, a bounded number of times.
+    for (int attempt = 0; attempt < 24 && repeats >= 3; ++attempt) {
+        NominalBlock fit;
+        fit.repeats = repeats;
+        const Cycle last = cycles[i + repeats * block - 1];
+        if (last <= prev) return {};
+        fit.period = (last - prev + repeats / 2) / repeats;
+        if (fit.period == 0) return {};
+        for (std::size_t j = 0; j < block; ++j) {
+            if (j + 1 == block) {
+                fit.offsets.push_back(fit.period);
+                break;
+            }
+            // The mean offset of event j from its block's nominal start.
+            long double sum = 0;
+            for (std::size_t k = 0; k < repeats; ++k) {
+                sum += static_cast<long double>(cycles[i + k * block + j]) - static_cast<long double>(prev + k * fit.period);
+            }
+            const long double mean = sum / static_cast<long double>(repeats);
+            if (mean < 1) return {};
+            fit.offsets.push_back(static_cast<Cycle>(mean + 0.5L));
+        }
+        bool increasing = true;
+        for (std::size_t j = 1; j < fit.offsets.size(); ++j) increasing = increasing && fit.offsets[j] > fit.offsets[j - 1];
+        if (!increasing) return {};
+        std::size_t fits = repeats;
+        for (std::size_t k = 0; k < repeats && fits == repeats; ++k) {
+            for (std::size_t j = 0; j < block; ++j) {
+                const Cycle nominal = prev + k * fit.period + fit.offsets[j];
+                const Cycle actual = cycles[i + k * block + j];
+                if ((actual > nominal ? actual - nominal : nominal - actual) > jitter) {
+                    fits = k;
+                    break;
+                }
+            }
+        }
+        // The next event must come after the block's nominal end (deltas are never negative).
+        const std::size_t after = i + repeats * block;
+        if (fits == repeats && after < n && cycles[after] < prev + repeats * fit.period) fits = repeats - 1;
+        if (fits == repeats) return fit;
+        repeats = fits;
+    }
+    return {};
+}
+
+void append_nominal(std::string& out, const std::vector<TimelineEvent>& changes, const SignalInfo& info, Cycle jitter) {
+    std::vector<Cycle> cycles;
+    std::vector<std::string> values;
+    for (const auto& e : changes) {
+        cycles.push_back(e.cycle);
+        values.push_back(format_value(info, e));
+    }
+    Cycle prev = cycles[0];
+    std::size_t i = 1;
+    std::vector<Pair> pending;  // exact pairs between blocks
+    while (i < cycles.size()) {
+        NominalBlock best;
+        std::size_t best_block = 0;
+        for (std::size_t block = 1; block <= 2; ++block) {
+            NominalBlock fit = fit_block(cycles, values, i, block, prev, jitter);
+            if (fit.repeats * block > best.repeats * best_block) {
+                best = std::move(fit);
+                best_block = block;
+            }
+        }
+        if (best.repeats < 3) {
+            pending.push_back({cycles[i] - prev, values[i]});
+            prev = cycles[i];
+            ++i;
+            continue;
+        }
+        append_exact(out, pending);
+        pending.clear();
+        out += "*" + std::to_string(best.repeats);
+        Cycle at = 0;
+        for (std::size_t j = 0; j < best_block; ++j) {
+            out += " +" + std::to_string(best.offsets[j] - at) + " " + values[i + j];
+            at = best.offsets[j];
+        }
+        out += "\n";
+        prev += best.repeats * best.period;
+        i += best.repeats * best_block;
+    }
+    append_exact(out, pending);
+}
+
+}  // namespace
+
+std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header,
+                                 const std::map<std::string, Cycle>& jitter_cycles) {
     std::string out = "avrbench-timeline 1\n";
     out += "bench " + header.bench_version + "\n";
     for (const auto& in : header.inputs) out += "input " + in.role + " " + in.sha256 + " " + in.path + "\n";
@@ -118,43 +258,23 @@ std::string format_timeline_text(const Timeline& timeline, const TimelineHeader&
         const auto& changes = all_changes[id];
         if (changes.empty()) continue;
         out += std::to_string(changes[0].cycle) + " " + format_value(info, changes[0]) + "\n";
+        const auto jitter = jitter_cycles.find(full_name(info));
+        if (jitter != jitter_cycles.end() && jitter->second > 0) {
+            append_nominal(out, changes, info, jitter->second);
+            continue;
+        }
         std::vector<Pair> pairs;
         for (std::size_t i = 1; i < changes.size(); ++i) {
             pairs.push_back({changes[i].cycle - changes[i - 1].cycle, format_value(info, changes[i])});
         }
-        std::size_t i = 0;
-        while (i < pairs.size()) {
-            // A block of 1 or 2 pairs repeated 3 or more times becomes one line.
-            bool emitted = false;
-            for (std::size_t block = 1; block <= 2 && !emitted; ++block) {
-                std::size_t repeats = 1;
-                while (i + (repeats + 1) * block <= pairs.size()) {
-                    bool same = true;
-                    for (std::size_t k = 0; k < block; ++k) same = same && pairs[i + repeats * block + k] == pairs[i + k];
-                    if (!same) break;
-                    ++repeats;
-                }
-                if (repeats >= 3) {
-                    out += "*" + std::to_string(repeats);
-                    for (std::size_t k = 0; k < block; ++k) {
-                        out += " +" + std::to_string(pairs[i + k].delta) + " " + pairs[i + k].value;
-                    }
-                    out += "\n";
-                    i += repeats * block;
-                    emitted = true;
-                }
-            }
-            if (!emitted) {
-                out += "+" + std::to_string(pairs[i].delta) + " " + pairs[i].value + "\n";
-                ++i;
-            }
-        }
+        append_exact(out, pairs);
     }
     return out;
 }
 
-void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path) {
-    write_output_file(path, format_timeline_text(timeline, header), "golden timeline");
+void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path,
+                         const std::map<std::string, Cycle>& jitter_cycles) {
+    write_output_file(path, format_timeline_text(timeline, header, jitter_cycles), "golden timeline");
 }
 
 // A bound on what one golden file may expand to (events after run-length

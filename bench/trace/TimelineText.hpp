@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -49,8 +50,16 @@ struct TimelineHeader {
     std::uint32_t end_clock_hz = 0;
 };
 
-std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header);
-void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path);
+// `jitter_cycles`: per signal ("scope.name") how far an edge may sit from its
+// nominal place. A constant-rate train whose edges all lie within that of a
+// fixed period is written as one `*n` block of nominal deltas (the intent)
+// instead of its jitter: the golden's edges are then the nominal ones, each
+// within the bound of what was recorded, and the rule that gave the bound
+// (a `steps` tolerance) accepts them. Signals not named are written exactly.
+std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header,
+                                 const std::map<std::string, Cycle>& jitter_cycles = {});
+void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path,
+                         const std::map<std::string, Cycle>& jitter_cycles = {});
 
 struct ParsedTimeline {
     TimelineHeader header;

@@ -348,7 +348,20 @@ std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, cons
             result.failures.push_back("golden: not updated, because the run failed its steps or expectations "
                                       "(use --force to write it anyway)");
         } else {
-            write_timeline_text(actual, header, spec.golden_path);
+            // A steps tolerance is the jitter a constant-rate train may be
+            // written with: the golden keeps its nominal period, not its jitter.
+            CompareOptions rules;
+            rules.rules = spec.tolerances;
+            rules.wires = wire_names(bench.board().spec());
+            std::map<std::string, Cycle> jitter;
+            for (const SignalInfo& s : actual.signals()) {
+                const std::string name = s.scope + "." + s.name;
+                const ChannelRule rule = rule_for_signal(name, rules);
+                if (rule.kind == RuleKind::Steps && rule.tolerance_cycles >= 1) {
+                    jitter[name] = static_cast<Cycle>(rule.tolerance_cycles);
+                }
+            }
+            write_timeline_text(actual, header, spec.golden_path, jitter);
         }
         return std::nullopt;
     }

@@ -348,6 +348,14 @@ ChannelRule rule_for(const std::string& signal, const CompareOptions& options,
 
 }  // namespace
 
+ChannelRule rule_for_signal(const std::string& signal, const CompareOptions& options) {
+    std::map<std::string, const std::vector<std::string>*> wire_of;
+    for (const auto& wire : options.wires) {
+        for (const auto& name : wire) wire_of[name] = &wire;
+    }
+    return rule_for(signal, options, wire_of);
+}
+
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options) {
     CompareResult result;
     std::map<std::string, const std::vector<std::string>*> wire_of;

@@ -77,5 +77,8 @@ struct CompareResult {
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options);
 
 bool glob_match(const std::string& pattern, const std::string& text);
+// The rule `options` apply to `signal`: the first whose pattern matches it
+// or another name of its wire (CompareOptions::wires); Exact when none does.
+ChannelRule rule_for_signal(const std::string& signal, const CompareOptions& options);
 
 }  // namespace avrbench

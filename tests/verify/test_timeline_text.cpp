@@ -2,6 +2,8 @@
 // encoding, readable diffs, strict parsing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/Errors.hpp"
 #include "trace/TimelineText.hpp"
 
@@ -127,6 +129,59 @@ TEST(TimelineText, ImpossibleValuesAreFileLineErrors) {
         } catch (const BadInput& e) {
             EXPECT_EQ(std::string(e.what()), message) << body;
         }
+    }
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// Issue 36's case: a Timer1-compare stepper, 500 steps whose periods are
+// 7965/7966/7967 cycles (interrupt latency) around the timer's exact 7966,
+// 180-cycle pulses. Exact, it takes a line per edge; with a 4-cycle steps
+// tolerance on the pin it is the nominal train in one `*n` line.
+Timeline jittery_steps() {
+    Timeline t;
+    const SignalId id = t.add_signal({"uno", "PD2", SignalKind::Wire, 1, 16000000});
+    t.record(id, 0, 0);
+    const int jitter[] = {0, 1, -1, 1, 0, -1};  // latency around the timer's edge
+    for (int i = 0; i < 500; ++i) {
+        const Cycle rise = static_cast<Cycle>(20000 + i * 7966 + jitter[i % 6]);
+        t.record(id, rise, 1);
+        t.record(id, rise + 180 + static_cast<Cycle>(jitter[(i + 2) % 6] + 1), 0);
+    }
+    return t;
+}
+
+TEST(TimelineText, AJitteryConstantRateTrainIsItsNominalPeriodInOneLine) {
+    const Timeline t = jittery_steps();
+    TimelineHeader h = header();
+    h.end_cycle = 5'000'000;  // past the 500th step (20000 + 500 x 7966 = 4 003 000)
+    h.end_clock_hz = 16000000;
+    const std::string exact = format_timeline_text(t, h);
+    const std::string nominal = format_timeline_text(t, h, {{"uno.PD2", 4}});
+    EXPECT_GT(std::count(exact.begin(), exact.end(), '\n'), 400);
+    // Header lines, the signal, its first event and the block (and at most
+    // one edge on each side of it).
+    const auto at = nominal.find("@uno.PD2\n");
+    ASSERT_NE(at, std::string::npos);
+    const std::string events = nominal.substr(at);
+    EXPECT_LE(std::count(events.begin(), events.end(), '\n'), 6) << events;
+    // The period, not its jitter: 7966 = a 181-cycle pulse (180 + the mean
+    // of the fall's extra cycle) and 7785 cycles low, 499 times after the
+    // first rise.
+    EXPECT_NE(events.find("*499 +181 0 +7785 1\n"), std::string::npos) << events;
+    // Read back: the same number of edges, each rise within 4 cycles of the recorded one.
+    const ParsedTimeline back = parse_timeline_text(nominal, "g.txt");
+    const auto recorded = changes_of(t, 0);
+    const auto golden = changes_of(back.timeline, 0);
+    ASSERT_EQ(golden.size(), recorded.size());
+    for (std::size_t i = 0; i < golden.size(); ++i) {
+        const Cycle a = golden[i].cycle, b = recorded[i].cycle;
+        EXPECT_LE(a > b ? a - b : b - a, 4u) << "edge " << i;
+        EXPECT_EQ(golden[i].value.bits, recorded[i].value.bits);
     }
 }
 
