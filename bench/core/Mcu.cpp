@@ -571,6 +571,8 @@ bool Mcu::sleeps_in_virtual_time() const { return avr_->sleep != &avr_callback_s
 
 avr_io_t* Mcu::io_module(const char* kind, char name) const { return find_io_module(avr_, kind, name); }
 
+bool Mcu::sp_half_written_by(std::uint32_t pc_before) const { return sp_half_written(avr_, pc_before); }
+
 std::uint16_t Mcu::pud_register() const { return part_facts(avr_).pud_register; }
 
 void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt) {

@@ -178,6 +178,9 @@ public:
     // The I/O register (data address) holding PUD, the pull-up disable bit
     // (MCUCR or SFIOR by family); 0 for a part without one.
     std::uint16_t pud_register() const;
+    // Whether the instruction at `pc_before` left SP half written (avr-gcc's
+    // `out SPH; out SREG; out SPL`: between them SP reads new-high/old-low).
+    bool sp_half_written_by(std::uint32_t pc_before) const;
     // The firmware's own failures, which the core's oracles find (errors: they fail every run).
     static const FindingKind kSimavrCrash;       // simavr stopped the core (e.g. a write outside RAM)
     static const FindingKind kInvalidOpcode;     // an opcode the AVR core does not decode

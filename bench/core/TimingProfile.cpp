@@ -10,6 +10,7 @@ extern "C" {
 }
 
 #include "core/Mcu.hpp"
+#include "core/VectorNames.hpp"
 
 namespace avrbench {
 
@@ -61,7 +62,7 @@ void TimingProfiler::on_pending(avr_irq_t*, std::uint32_t value, void* param) {
     // and again when it is enabled with the flag set: latency counts from
     // the raise that found it enabled.
     if (avr_regbit_get(self.avr_, hook->vector->enable) == 0) return;
-    self.pending_since_.try_emplace(vector, self.avr_->cycle);
+    self.pending_since_[vector] = self.avr_->cycle;
 }
 
 void TimingProfiler::on_running(avr_irq_t*, std::uint32_t value, void* param) {
@@ -125,7 +126,7 @@ void TimingProfiler::after_step(Cycle cycle_before, bool was_sleeping, std::uint
     reti_pending_ = 0;
 
     const auto sp = static_cast<std::uint16_t>(avr_->data[R_SPL] | (avr_->data[R_SPH] << 8));
-    if (sp < lowest_sp_) {
+    if (sp < lowest_sp_ && !mcu_.sp_half_written_by(pc_before)) {
         lowest_sp_ = sp;
         lowest_sp_pc_ = entered_vector_ >= 0 ? avr_->pc : pc_before;
         lowest_sp_cycle_ = now;
@@ -235,9 +236,10 @@ std::vector<std::string> TimingProfiler::summary_lines() const {
         out.push_back(line);
     }
     for (const auto& [vector, p] : vectors_) {
+        const std::string name = vector_name(mcu_.mcu_type(), vector);
         std::snprintf(line, sizeof line,
-                      "vector %d: %llu runs, cycles min/median/p99/max: inclusive %s, exclusive %s, latency %s; depth %d",
-                      vector, static_cast<unsigned long long>(p.runs), stats_text(p.inclusive_cycles).c_str(),
+                      "vector %d%s%s: %llu runs, cycles min/median/p99/max: inclusive %s, exclusive %s, latency %s; depth %d",
+                      vector, name.empty() ? "" : " ", name.c_str(), static_cast<unsigned long long>(p.runs), stats_text(p.inclusive_cycles).c_str(),
                       stats_text(p.exclusive_cycles).c_str(), stats_text(p.latency_cycles).c_str(), p.max_depth);
         out.push_back(line);
     }
@@ -259,7 +261,8 @@ std::string TimingProfiler::json() const {
                       ", \"symbol\": " + json_string(mcu_.describe_pc(longest_off_pc_)) + "}, \"vectors\": [";
     bool first = true;
     for (const auto& [vector, p] : vectors_) {
-        out += std::string(first ? "" : ", ") + "{\"vector\": " + std::to_string(vector) + ", \"runs\": " +
+        out += std::string(first ? "" : ", ") + "{\"vector\": " + std::to_string(vector) + ", \"name\": " +
+               json_string(vector_name(mcu_.mcu_type(), vector)) + ", \"runs\": " +
                std::to_string(p.runs) + ", \"max_depth\": " + std::to_string(p.max_depth) +
                ", \"inclusive_cycles\": " + stats_json(p.inclusive_cycles) +
                ", \"exclusive_cycles\": " + stats_json(p.exclusive_cycles) +

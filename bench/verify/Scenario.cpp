@@ -12,6 +12,7 @@
 #include "boards/BoardFile.hpp"
 #include "boards/YamlKeys.hpp"
 #include "core/Errors.hpp"
+#include "core/VectorNames.hpp"
 #include "core/Finding.hpp"
 #include "core/InputFile.hpp"
 #include "core/McuPins.hpp"
@@ -125,6 +126,12 @@ public:
         if (!ok) throw BadInput(location + ": " + decl->type + " has no pin '" + pin + "' (in '" + text + "')");
     }
 
+    // The type of MCU `name` ("" = the board's first).
+    std::string mcu_type(const std::string& name) const {
+        const McuDecl* decl = name.empty() ? &board_.mcus.front() : board_.find_mcu(name);
+        return decl == nullptr ? "" : decl->type;
+    }
+
     void check_mcu(const std::string& name, const std::string& location) const {
         if (board_.find_mcu(name) != nullptr) return;
         std::string list;
@@ -224,7 +231,18 @@ ExpectAction parse_timing_expectation(const Item& item, const BoardNames& names)
         item.expect_keys({"vector"}, {"mcu", "max_cycles", "max_latency_cycles", "min_runs"});
         ExpectIsr e;
         e.mcu = mcu();
-        e.vector = static_cast<int>(parse_integer(item.get("vector"), item.at("vector") + ": vector", 1, 127));
+        const std::string vector = item.get("vector");
+        if (!vector.empty() && std::isdigit(static_cast<unsigned char>(vector[0]))) {
+            e.vector = static_cast<int>(parse_integer(vector, item.at("vector") + ": vector", 1, 127));
+        } else {
+            const std::string type = names.mcu_type(e.mcu);
+            const auto number = vector_number(type, vector);
+            if (!number) {
+                throw BadInput(item.at("vector") + ": the " + type + " has no interrupt vector '" + vector +
+                               "' (avr-libc's names, e.g. TIMER1_COMPA, or its number)");
+            }
+            e.vector = *number;
+        }
         if (item.has("max_cycles")) e.max_cycles = count("max_cycles");
         if (item.has("max_latency_cycles")) e.max_latency_cycles = count("max_latency_cycles");
         if (item.has("min_runs")) e.min_runs = count("min_runs");
@@ -237,6 +255,13 @@ ExpectAction parse_timing_expectation(const Item& item, const BoardNames& names)
         item.expect_keys({"min_headroom_bytes"}, {"mcu"});
         return ExpectStack{mcu(), parse_integer(item.get("min_headroom_bytes"), item.at("min_headroom_bytes") +
                                                                                     ": min_headroom_bytes", 0, 65536)};
+    }
+    if (k == "cpu") {
+        item.expect_keys({"max_busy_percent"}, {"mcu"});
+        const double percent = parse_quantity(item.get("max_busy_percent"), Dimension::Dimensionless,
+                                              item.at("max_busy_percent") + ": max_busy_percent");
+        if (!(percent >= 0 && percent <= 100)) throw BadInput(item.at("max_busy_percent") + ": a percentage, 0 to 100");
+        return ExpectCpu{mcu(), percent};
     }
     item.expect_keys({"max_cycles"}, {"mcu"});
     return ExpectInterruptsOff{mcu(), count("max_cycles")};
@@ -273,7 +298,7 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
     } else if (k == "text") {
         names.check_serial(k, item.location);
         e.action = ExpectText{item.scalar_value()};
-    } else if (k == "isr" || k == "stack" || k == "interrupts_off") {
+    } else if (k == "isr" || k == "stack" || k == "interrupts_off" || k == "cpu") {
         e.action = parse_timing_expectation(item, names);
     } else if (k == "findings") {
         if (item.value.IsSequence()) {
@@ -419,7 +444,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
     if (const YAML::Node steps = sequence("steps")) {
         for (const auto& node : steps) spec.steps.push_back(parse_step(read_item(node, path, kSteps, "step"), path, names));
     }
-    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "findings", "isr", "stack", "interrupts_off"};
+    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "findings", "isr", "stack", "interrupts_off", "cpu"};
     if (const YAML::Node expect = sequence("expect")) {
         for (const auto& node : expect) spec.expectations.push_back(parse_expectation(read_item(node, path, kExpect, "expectation"), names));
     }

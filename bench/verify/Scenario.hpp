@@ -55,8 +55,9 @@ struct ExpectIsr {
 };
 struct ExpectStack { std::string mcu; std::int64_t min_headroom_bytes = 0; };
 struct ExpectInterruptsOff { std::string mcu; std::uint64_t max_cycles = 0; };
+struct ExpectCpu { std::string mcu; double max_busy_percent = 100; };  // executing / (executing + asleep + idle loop)
 using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectFindingCount, ExpectFindingKinds,
-                                  ExpectIsr, ExpectStack, ExpectInterruptsOff>;
+                                  ExpectIsr, ExpectStack, ExpectInterruptsOff, ExpectCpu>;
 
 struct ScenarioExpectation {
     ExpectAction action;

@@ -13,6 +13,7 @@
 #include "core/FileHash.hpp"
 #include "core/UserStop.hpp"
 #include "core/TimingProfile.hpp"
+#include "core/VectorNames.hpp"
 #include "trace/WaveformFiles.hpp"
 #include "trace/HtmlReport.hpp"
 #include "core/OutputFile.hpp"
@@ -213,7 +214,9 @@ private:
     std::string operator()(const ExpectIsr& e) {
         const auto& vectors = profile(e.mcu).vectors();
         const auto it = vectors.find(e.vector);
-        const std::string name = "vector " + std::to_string(e.vector);
+        const Mcu& m = e.mcu.empty() ? bench_.mcu() : bench_.mcu(e.mcu);
+        const std::string label = vector_name(m.mcu_type(), e.vector);
+        const std::string name = "vector " + std::to_string(e.vector) + (label.empty() ? "" : " (" + label + ")");
         if (it == vectors.end() || it->second.runs == 0) {
             return e.min_runs && *e.min_runs == 0 ? "" : name + " never ran";
         }
@@ -244,6 +247,16 @@ private:
         if (p.longest_interrupts_off() <= e.max_cycles) return "";
         return "interrupts were off for " + std::to_string(p.longest_interrupts_off()) + " cycles, expected at most " +
                std::to_string(e.max_cycles);
+    }
+    std::string operator()(const ExpectCpu& e) {
+        const Mcu& m = e.mcu.empty() ? bench_.mcu() : bench_.mcu(e.mcu);
+        const TimingProfiler& p = profile(e.mcu);
+        const double total = static_cast<double>(p.active_cycles() + p.sleeping_cycles() + m.idle_cycles_skipped());
+        const double busy = total > 0 ? 100.0 * static_cast<double>(p.active_cycles()) / total : 0.0;
+        if (busy <= e.max_busy_percent) return "";
+        char text[160];
+        std::snprintf(text, sizeof text, "the CPU executed %.2f%% of the time, expected at most %g%%", busy, e.max_busy_percent);
+        return text;
     }
     std::string operator()(const ExpectFindingCount& e) {
         if (findings_.size() == e.count) return "";

@@ -177,7 +177,7 @@ TEST(Scenarios, AnIsrOverItsCycleBoundFailsWithTheMeasuredTime) {
     const ScenarioResult r = run_scenario(load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR), {});
     EXPECT_FALSE(r.passed);
     ASSERT_EQ(r.expectation_failures.size(), 2u) << r.text();
-    EXPECT_NE(r.expectation_failures[0].find("vector 11 took up to 28 cycles (median 28), expected at most 27"),
+    EXPECT_NE(r.expectation_failures[0].find("vector 11 (TIMER1_COMPA) took up to 28 cycles (median 28), expected at most 27"),
               std::string::npos)
         << r.expectation_failures[0];
     EXPECT_NE(r.expectation_failures[1].find("within 2040 bytes"), std::string::npos) << r.expectation_failures[1];
