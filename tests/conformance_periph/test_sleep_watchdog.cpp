@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "conformance_periph/PeriphSupport.hpp"
+#include "core/TimingProfile.hpp"
 
 namespace avrbench {
 namespace {
@@ -52,6 +53,29 @@ TEST_P(SleepWake, IdleWakeUpAddsTheResponseTimeAgain) {
     // §7.7.1: sleep adds 4 cycles (2560: 5) to the response; Idle has no
     // start-up time (the clock runs); then the JMP; then the ISR's sbi.
     EXPECT_EQ(m.rise(2) - event, part.response + 0 + part.response + kJmp) << part.name;
+}
+
+// The timing profile sees the same wake-up: INT0 (vector 1) from the edge
+// to the vector's first instruction (its JMP) is the response time twice
+// (§7.7.1: 4 + 4 cycles; the 2560's 5 + 5).
+TEST_P(SleepWake, TheProfilesLatencyOfAWakeUpIsTheResponseTwice) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("sleep_wake", part);
+    mcu.enable_profile();
+    Markers m(mcu);
+    Pin& int0 = mcu.pin(part.int0_pin);
+    int0.drive(true);
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 1));
+    const Cycle event = mcu.cycle() + 1000;
+    mcu.scheduler().at(event, [&](Cycle) { int0.drive(false); });
+    ASSERT_TRUE(test::run_until_rise(mcu, m, 2));
+    const auto& vectors = mcu.profile()->vectors();
+    ASSERT_EQ(vectors.count(1), 1u) << part.name;
+    const VectorProfile& int0_vector = vectors.at(1);
+    ASSERT_EQ(int0_vector.latency_cycles.count(), 1u) << part.name;
+    EXPECT_EQ(int0_vector.latency_cycles.max(), static_cast<Cycle>(2 * part.response)) << part.name;
+    // The Idle sleep before it counts as asleep, not executing.
+    EXPECT_GE(mcu.profile()->sleeping_cycles(), 1000u - 50) << part.name;
 }
 
 TEST_P(SleepWake, PowerDownWakesOnLevelAfterTheStartUpTime) {
