@@ -21,6 +21,7 @@
 #include "tools/FirmwareArgs.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/WaveformFiles.hpp"
+#include "verify/McuRun.hpp"
 
 namespace avrbench {
 namespace {
@@ -136,20 +137,6 @@ VcdOptions vcd_layout(const RunArgs& args) {
     return layout;
 }
 
-void print_findings(const std::vector<Finding>& findings) {
-    std::printf("  findings   %zu\n", findings.size());
-    for (const auto& line : summarize_findings(findings)) std::printf("    %s\n", line.c_str());
-}
-
-// --trace: the recorder's error, named after the option that gave the list.
-void trace_pins_for_cli(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option = "--trace") {
-    try {
-        recorder.trace_pins(mcu, spec);
-    } catch (const BadInput& e) {
-        throw BadInput(std::string(option) + ": " + e.what());
-    }
-}
-
 // --dxf: the drawing through seed 002's CAM to binary records (docs/CNC.md).
 BoardRunOptions::RecordJob plot_job(const RunArgs& args) {
     if (args.records != "faithful" && args.records != "improved") {
@@ -242,13 +229,14 @@ int run_command(const RunArgs& args) {
     if (!args.dxf.empty()) throw BadInput("--dxf needs --board (the board file names the serial port)");
     if (!args.report.empty()) throw BadInput("--report needs --board");
     if (!args.realtime.empty()) throw BadInput("--realtime needs --board and --gcode");
-    const ElfImage elf = ElfImage::load(args.elf);
-    McuOptions options;
-    options.name = "mcu";
-    options.mcu_type = args.mcu;
-    options.skip_idle_loops = !args.no_idle_skip;
-    if (!args.freq.empty()) options.frequency_hz = parse_frequency_hz(args.freq, "--freq");
-    const Picoseconds duration_ps = parse_duration_ps(args.duration, "--for");
+    McuRunOptions o;
+    o.elf = args.elf;
+    o.mcu_type = args.mcu;
+    o.skip_idle_loops = !args.no_idle_skip;
+    if (!args.freq.empty()) o.frequency_hz = parse_frequency_hz(args.freq, "--freq");
+    o.duration_ps = parse_duration_ps(args.duration, "--for");
+    o.duration_text = args.duration;
+    o.until_sleep = args.until_sleep;
     // Without a board there is one port: USART0 ("0=FILE" is accepted too).
     const std::vector<PortFile> uart_in = port_files(args.uart_in, "--uart-in");
     const std::vector<PortFile> uart_out = port_files(args.uart_out, "--uart-out");
@@ -259,99 +247,21 @@ int run_command(const RunArgs& args) {
             }
         }
     }
-    RunFiles files;
-    files.input(args.elf, "the firmware ELF");
-    for (const auto& pf : uart_in) {
-        if (pf.path != "-") files.input(pf.path, "--uart-in");
-    }
-    if (!args.vcd.empty()) {
-        files.output(args.vcd, "--vcd");
-        files.output(with_extension(args.vcd, ".gtkw"), "--vcd's gtkwave save file");
-    }
-    for (const auto& pf : uart_out) files.output(pf.path, "--uart-out");
-    if (!args.profile.empty()) files.output(args.profile, "--profile");
-    files.check();
-    std::string uart_in_bytes;
-    if (!uart_in.empty()) uart_in_bytes = read_uart_input(uart_in.front().path);
-
-    Mcu mcu(elf, options);
-    if (!args.profile.empty()) mcu.enable_profile();
-    Timeline timeline;
-    Recorder recorder(timeline);
-    const bool tracing = !args.vcd.empty() || !args.trace.empty() || !args.trace_only.empty();
-    // The default on one MCU is every pin; --trace only checks its names then.
-    if (tracing && !args.trace.empty()) trace_pins_for_cli(recorder, mcu, args.trace);
-    if (tracing) trace_pins_for_cli(recorder, mcu, args.trace_only.empty() ? "all" : args.trace_only, "--trace-only");
-
-    Uart* uart0 = nullptr;
-    try {
-        uart0 = &mcu.uart(0);
-    } catch (const BadInput&) {
-        if (!args.uart_in.empty() || !args.uart_out.empty()) throw;
-    }
-    if (uart0 != nullptr && tracing && args.trace_only.empty()) {
-        recorder.trace_uart_tx(mcu, *uart0);
-        recorder.trace_uart_rx(mcu, *uart0);
-    }
-    if (!uart_in_bytes.empty()) uart0->send(uart_in_bytes);
-
-    const Cycle end_cycle = cycle_at_ps(mcu, duration_ps);
-    WaveformFiles waveforms(timeline, args.vcd, true, vcd_layout(args));
-    waveforms.start();
+    if (!uart_in.empty()) o.uart_in = uart_in.front().path;
+    if (!uart_out.empty()) o.uart_out = uart_out.front().path;
+    o.read_uart_input = read_uart_input;
+    o.vcd = args.vcd;
+    o.vcd_layout = vcd_layout(args);
+    o.trace = args.trace;
+    o.trace_only = args.trace_only;
+    o.profile = args.profile;
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
-    const auto wall_start = std::chrono::steady_clock::now();
-    bool slept = false;
-    if (args.until_sleep) {
-        slept = mcu.run_until_sleep(end_cycle);
-    } else {
-        mcu.run_sliced(end_cycle, [&] {
-            waveforms.drain(ps_at_cycle(mcu, mcu.cycle()));
-            progress.show(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
-        });
-    }
+    o.on_progress = [&progress](double fraction, double simulated_s) { progress.show(fraction, simulated_s); };
+    McuRun run(std::move(o));
+    run.run();
     progress.finish();
-    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-
-    if (!uart_out.empty()) write_output_file(uart_out.front().path, uart0->transmitted_text(), "--uart-out");
-    if (timeline.overflowed()) throw BadInput(timeline.overflow_message());
-    const std::string gtkw_path = waveforms.finish(mcu.cycle(), mcu.frequency_hz());
-
-    const double simulated_s = mcu.seconds();
-    std::printf("avrbench run: %s on %s at %.6g MHz\n", args.elf.c_str(), mcu.mcu_type().c_str(),
-                mcu.frequency_hz() / 1e6);
-    std::printf("  simulated  %.6f s (%llu cycles)\n", simulated_s, static_cast<unsigned long long>(mcu.cycle()));
-    std::printf("  wall       %.3f s, real-time factor %.1fx\n", wall_s, wall_s > 0 ? simulated_s / wall_s : 0.0);
-    if (mcu.idle_jumps() != 0) {
-        std::printf("  idle skip  %llu jumps over %.6f s of idle-loop passes\n",
-                    static_cast<unsigned long long>(mcu.idle_jumps()),
-                    static_cast<double>(mcu.idle_cycles_skipped()) / mcu.frequency_hz());
-    }
-    if (args.until_sleep) std::printf("  stopped    %s\n", slept ? "firmware executed SLEEP" : "time limit");
-    if (mcu.halted()) std::printf("  halted     %s\n", mcu.halt_reason().c_str());
-    if (uart0 != nullptr) {
-        std::printf("  uart0      %zu bytes from firmware, %llu bytes to firmware\n", uart0->transmitted().size(),
-                    static_cast<unsigned long long>(uart0->bytes_delivered()));
-    }
-    if (const TimingProfiler* profile = mcu.profile()) {
-        for (const std::string& line : profile->summary_lines()) std::printf("  profile    %s\n", line.c_str());
-        write_output_file(args.profile, "{\"mcus\": [" + profile->json() + "]}\n", "--profile");
-    }
-    print_findings(mcu.findings());
-    if (!args.vcd.empty()) {
-        std::printf("  vcd        %s (%zu signals, %llu events), gtkwave save file %s\n", args.vcd.c_str(),
-                    timeline.signals().size(), static_cast<unsigned long long>(timeline.recorded_count()),
-                    gtkw_path.c_str());
-    }
-    if (user_stop_requested()) {
-        std::fprintf(stderr, "avrbench: interrupted at %.6f s simulated; what was recorded is written\n", simulated_s);
-        return kExitInterrupted;
-    }
-    if (!mcu.findings().empty()) return kExitFinding;
-    if (args.until_sleep && !slept && !mcu.halted()) {
-        std::fprintf(stderr, "avrbench: timeout: the firmware did not execute SLEEP within %s\n", args.duration.c_str());
-        return kExitTimeout;
-    }
-    return kExitOk;
+    for (const std::string& text : run.summary()) std::printf("%s\n", text.c_str());
+    return exit_code(run.verdict());
 }
 
 }  // namespace
