@@ -270,12 +270,10 @@ BoardSpec parse_board_text(const std::string& text, const std::string& path) {
 
 namespace {
 
-BoardSpec parse_board(const std::string& text, const std::string& path, int depth) {
-    const YAML::Node root = load_yaml(text, path);
-    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a board file is a map with mcus, parts, nets");
+namespace {
 
-    BoardSpec spec;
-    spec.path = path;
+// The sections a board file may have, its name and description.
+void parse_header(const YAML::Node& root, const std::string& path, BoardSpec& spec) {
     static const std::set<std::string> kSections = {"board", "description", "extends", "mcus",
                                                     "parts", "nets",  "serial",      "labels"};
     for (const auto& kv : root) {
@@ -285,8 +283,6 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
                            "' (expected board, description, extends, mcus, parts, nets, serial, labels)");
         }
     }
-    std::optional<BoardSpec> base;
-    if (root["extends"]) base = load_base(root["extends"], path, depth);
     if (root["board"]) {
         // A name people type and the summary prints: letters, digits, '_', '-', '.'.
         spec.name = scalar(root["board"], path, "board");
@@ -301,9 +297,11 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
     }
     if (root["description"]) spec.description = scalar(root["description"], path, "description");
 
-    std::set<std::string> names;
+}
+
+void parse_mcus(const YAML::Node& root, const std::string& path, bool has_base, BoardSpec& spec, std::set<std::string>& names) {
     const YAML::Node mcus = root["mcus"];
-    if (!base && (!mcus || !mcus.IsMap() || mcus.size() == 0)) {
+    if (!has_base && (!mcus || !mcus.IsMap() || mcus.size() == 0)) {
         throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
     }
     if (mcus && !mcus.IsMap()) throw BadInput(where(path, mcus) + ": 'mcus' must be a map of MCU name to type and clock");
@@ -340,6 +338,9 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         spec.mcus.push_back(std::move(m));
     }
 
+}
+
+void parse_parts(const YAML::Node& root, const std::string& path, BoardSpec& spec, std::set<std::string>& names) {
     // An empty section (`parts:` with nothing under it) is a board without parts.
     if (const YAML::Node parts = root["parts"]; parts && !parts.IsNull()) {
         if (!parts.IsMap()) throw BadInput(where(path, parts) + ": 'parts' must be a map of part name to its settings");
@@ -362,6 +363,9 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
+}
+
+void parse_nets(const YAML::Node& root, const std::string& path, BoardSpec& spec) {
     if (const YAML::Node nets = root["nets"]; nets && !nets.IsNull()) {
         if (!nets.IsMap()) throw BadInput(where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
         std::set<std::string> net_names;
@@ -380,6 +384,9 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
+}
+
+void parse_serial(const YAML::Node& root, const std::string& path, BoardSpec& spec, std::set<std::string>& names) {
     if (const YAML::Node serial = root["serial"]; serial && !serial.IsNull()) {
         if (!serial.IsMap()) throw BadInput(where(path, serial) + ": 'serial' must be a map of port name to its settings");
         for (const auto& kv : serial) {
@@ -426,6 +433,9 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
+}
+
+void parse_labels(const YAML::Node& root, const std::string& path, BoardSpec& spec) {
     if (const YAML::Node labels = root["labels"]; labels && !labels.IsNull()) {
         if (!labels.IsMap()) throw BadInput(where(path, labels) + ": 'labels' must be a map of name to endpoint");
         std::set<std::string> label_names;
@@ -439,10 +449,13 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
         }
     }
 
-    if (base) {
-        // A variant: what it names replaces the base's declaration of that
-        // name, whole; what it adds is added (docs/BOARDS.md, "Variants").
-        BoardSpec merged = std::move(*base);
+}
+
+// A variant: what it names replaces the base's declaration of that name,
+// whole; what it adds is added (docs/BOARDS.md, "Variants").
+BoardSpec merge_with_base(BoardSpec base_spec, BoardSpec spec, const std::string& path) {
+    {
+        BoardSpec merged = std::move(base_spec);
         merged.path = path;
         if (!spec.name.empty()) merged.name = spec.name;
         if (!spec.description.empty()) merged.description = spec.description;
@@ -461,6 +474,11 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
                            " MCUs; a board holds at most " + std::to_string(kMaxMcusPerBoard));
         }
     }
+    return spec;
+}
+
+// Endpoints on one net each, and every reference within the (merged) board resolved.
+void check_references(const BoardSpec& spec) {
     std::set<std::string> used_endpoints;
     for (const auto& n : spec.nets) {
         for (const auto& ep : n.endpoints) {
@@ -485,6 +503,26 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
     for (const auto& s : spec.serial) {
         if (spec.find_mcu(s.mcu) == nullptr) throw BadInput(s.location + ": serial '" + s.name + "': unknown MCU '" + s.mcu + "'");
     }
+}
+
+}  // namespace
+
+BoardSpec parse_board(const std::string& text, const std::string& path, int depth) {
+    const YAML::Node root = load_yaml(text, path);
+    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a board file is a map with mcus, parts, nets");
+    BoardSpec spec;
+    spec.path = path;
+    parse_header(root, path, spec);
+    std::optional<BoardSpec> base;
+    if (root["extends"]) base = load_base(root["extends"], path, depth);
+    std::set<std::string> names;
+    parse_mcus(root, path, base.has_value(), spec, names);
+    parse_parts(root, path, spec, names);
+    parse_nets(root, path, spec);
+    parse_serial(root, path, spec, names);
+    parse_labels(root, path, spec);
+    if (base) spec = merge_with_base(std::move(*base), std::move(spec), path);
+    check_references(spec);
     return spec;
 }
 

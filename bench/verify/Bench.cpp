@@ -270,6 +270,21 @@ std::vector<Finding> Bench::findings() const {
 RunReport Bench::make_report(const std::string& title) const {
     RunReport r;
     r.title = title;
+    r.timeline = &timeline_;
+    report_facts(r);
+    Mcu& first = *board_->mcus().front();
+    r.end_cycle = first.cycle();
+    r.end_clock_hz = first.frequency_hz();
+    report_plots(r);
+    report_faults(r);
+    report_transcripts(r);
+    report_timing(r);
+    r.findings = findings();
+    return r;
+}
+
+// The MCUs, the board, the simulated time and each MCU's I2C traffic.
+void Bench::report_facts(RunReport& r) const {
     for (Mcu* m : board_->mcus()) {
         r.facts.push_back("MCU " + m->name() + ": " + m->mcu_type() + " at " +
                           std::to_string(m->frequency_hz() / 1000000.0).substr(0, 5) + " MHz, firmware " +
@@ -279,7 +294,6 @@ RunReport Bench::make_report(const std::string& title) const {
     char buf[64];
     std::snprintf(buf, sizeof buf, "simulated: %.6f s", now_seconds());
     r.facts.push_back(buf);
-    r.timeline = &timeline_;
     // The I2C traffic each MCU's TWI took part in (its `twi` byte signal).
     for (Mcu* m : board_->mcus()) {
         const long twi = timeline_.find(m->name(), "twi");
@@ -296,9 +310,9 @@ RunReport Bench::make_report(const std::string& title) const {
                       static_cast<double>(first_cycle) / m->frequency_hz());
         r.facts.push_back("I2C " + m->name() + ".twi: " + text);
     }
-    Mcu& first = *board_->mcus().front();
-    r.end_cycle = first.cycle();
-    r.end_clock_hz = first.frequency_hz();
+}
+
+void Bench::report_plots(RunReport& r) const {
     // The report's plots come from what the parts' signals declare they are
     // (PartSignalInfo::role), not from part types.
     struct Declared {
@@ -371,12 +385,19 @@ RunReport Bench::make_report(const std::string& title) const {
         series.target_steps = targets[plant];
         r.temperatures.push_back(series);
     }
+}
+
+void Bench::report_faults(RunReport& r) const {
     for (Part* p : board_->parts()) {
         for (const auto& f : p->fault_history()) {
             r.faults.push_back({static_cast<double>(f.cycle) / p->clock().frequency_hz(), f.cycle,
                                 p->name() + ": " + (f.fault == "none" ? std::string("repaired") : f.fault)});
         }
     }
+}
+
+// Each serial port's lines: the host's transcript, or the firmware's output.
+void Bench::report_transcripts(RunReport& r) const {
     for (const auto& decl : board_->spec().serial) {
         Mcu& m = board_->mcu(decl.mcu);
         const std::uint32_t hz = m.frequency_hz();
@@ -402,6 +423,10 @@ RunReport Bench::make_report(const std::string& title) const {
         }
         if (!line.empty()) r.transcript.push_back({line_start, hz, false, line});
     }
+}
+
+// The profiled MCUs' timing (core/TimingProfile.hpp).
+void Bench::report_timing(RunReport& r) const {
     for (Mcu* m : board_->mcus()) {
         const TimingProfiler* p = m->profile();
         if (p == nullptr) continue;
@@ -417,8 +442,6 @@ RunReport Bench::make_report(const std::string& title) const {
         t.facts.resize(t.facts.size() - std::min(t.facts.size(), p->vectors().size()));
         r.timing.push_back(std::move(t));
     }
-    r.findings = findings();
-    return r;
 }
 
 }  // namespace avrbench

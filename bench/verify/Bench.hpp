@@ -105,6 +105,12 @@ public:
     RunReport make_report(const std::string& title) const;
 
 private:
+    // make_report's parts.
+    void report_facts(RunReport& r) const;
+    void report_plots(RunReport& r) const;
+    void report_faults(RunReport& r) const;
+    void report_transcripts(RunReport& r) const;
+    void report_timing(RunReport& r) const;
     void watch_motion();
     // G0/G1 targets the firmware answers ok to, checked against the board's
     // machines that can judge them (parts/DeltaRobot: target-out-of-reach).
