@@ -75,6 +75,8 @@ bool is_out_to(const avr_t* avr, std::uint32_t pc_bytes, unsigned io_address) {
 // avr-gcc's prologues and epilogues set SP with `out SPH`, `out SREG`,
 // `out SPL`; between the SPH and SPL writes SP reads as new-high/old-low,
 // which can dip below its true value. The check runs again after the SPL write.
+constexpr unsigned kSleepOpcode = 0x9588;  // SLEEP (AVR Instruction Set Manual)
+
 bool sp_half_written(const avr_t* avr, std::uint32_t pc_before) {
     constexpr unsigned kSph = 0x3E, kSreg = 0x3F;
     if (is_out_to(avr, pc_before, kSph)) return true;
@@ -304,9 +306,21 @@ StopReason Mcu::run_sliced(Cycle end_cycle, const std::function<void()>& after_s
     return reason;
 }
 
-bool Mcu::run_until_sleep(Cycle end_cycle) {
-    while (cycle() < end_cycle && !sleeping() && !user_stop_requested() && step()) {
+bool Mcu::run_until_sleep(Cycle end_cycle, const std::function<void()>& after_slice) {
+    // The run loop's own slices (fast path included), each stopping where
+    // the core has executed SLEEP: no instruction-by-instruction stepping.
+    const Cycle slice = std::clamp<Cycle>(end_cycle / 100, 1, frequency_hz() / 100 + 1);
+    // The run loop stops in front of a SLEEP instruction; step() then
+    // executes it outside the run, so its sleep jump goes to the next real
+    // event (inside run_until it would stop at the slice's end).
+    stop_at_sleep_ = true;
+    while (cycle() < end_cycle && !sleeping() && !user_stop_requested()) {
+        const StopReason reason = run_until(std::min(end_cycle, cycle() + slice));
+        if (reason == StopReason::Halted) break;
+        if (cycle() < end_cycle && avr_->state == cpu_Running && opcode_at(avr_, avr_->pc) == kSleepOpcode && !step()) break;
+        if (after_slice) after_slice();
     }
+    stop_at_sleep_ = false;
     return sleeping();
 }
 
@@ -364,6 +378,8 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     };
     IdleLoopSkipper* const skipper = skipper_.get();
     while (avr->cycle < target_cycle) {
+        // run_until_sleep: stop in front of SLEEP (it executes it itself).
+        if (__builtin_expect(stop_at_sleep_, 0) && avr->state == cpu_Running && opcode_at(avr, avr->pc) == kSleepOpcode) break;
         if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
         const std::uint32_t pc_before = avr->pc;
         [[maybe_unused]] const Cycle cycle_before = avr->cycle;
@@ -374,8 +390,8 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         check(state, pc_before);
         if constexpr (kCover) edges->hit(avr->pc);
         if (__builtin_expect(stop_requested_, 0)) break;
-        // A profile sees every step: no fast path.
-        if (kProfile || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
+        // A profile sees every step, run_until_sleep looks at every opcode: no fast path.
+        if (kProfile || stop_at_sleep_ || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
         // Fast path: while the core runs, no interrupt is on its way and no
         // cycle timer is due, a step of SimavrStepper is avr_run_one and the

@@ -149,10 +149,11 @@ public:
     }
     // The command line's runs: to `end_cycle` in slices of at most 10 ms
     // simulated, calling `after_slice` after each (progress, streaming a VCD),
-    // until halted or SIGINT/SIGTERM (core/UserStop.hpp); or instruction by
-    // instruction until the firmware executes SLEEP (true) or the end comes.
+    // until halted or SIGINT/SIGTERM (core/UserStop.hpp); or the same slices
+    // until the firmware executes SLEEP (true: stopped right after it, before
+    // the sleep jump) or the end comes.
     StopReason run_sliced(Cycle end_cycle, const std::function<void()>& after_slice);
-    bool run_until_sleep(Cycle end_cycle);
+    bool run_until_sleep(Cycle end_cycle, const std::function<void()>& after_slice = {});
 
     // "PB5" (also "B5"). Throws BadInput for a port the MCU does not have.
     Pin& pin(std::string_view name);
@@ -274,6 +275,7 @@ private:
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
+    bool stop_at_sleep_ = false;  // run_until_sleep: the run loop ends when the core sleeps
     PcEdgeMap* run_coverage_ = nullptr;
     std::unique_ptr<TimingProfiler> profiler_;
     bool real_stop_ = false;  // stop_requested_ came from request_stop, not request_yield

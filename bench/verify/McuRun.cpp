@@ -88,15 +88,16 @@ void McuRun::run() {
     WaveformFiles waveforms(timeline_, options_.vcd, true, options_.vcd_layout);
     waveforms.start();
     const auto wall_start = std::chrono::steady_clock::now();
+    const auto after_slice = [&] {
+        waveforms.drain(ps_at_cycle(mcu, mcu.cycle()));
+        if (options_.on_progress) {
+            options_.on_progress(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
+        }
+    };
     if (options_.until_sleep) {
-        slept_ = mcu.run_until_sleep(end_cycle);
+        slept_ = mcu.run_until_sleep(end_cycle, after_slice);
     } else {
-        mcu.run_sliced(end_cycle, [&] {
-            waveforms.drain(ps_at_cycle(mcu, mcu.cycle()));
-            if (options_.on_progress) {
-                options_.on_progress(static_cast<double>(mcu.cycle()) / static_cast<double>(end_cycle), mcu.seconds());
-            }
-        });
+        mcu.run_sliced(end_cycle, after_slice);
     }
     wall_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     if (!options_.uart_out.empty()) write_output_file(options_.uart_out, uart0_->transmitted_text(), "--uart-out");
