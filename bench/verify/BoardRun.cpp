@@ -2,12 +2,12 @@
 
 #include <cctype>
 #include <chrono>
-#include <cstdarg>
 #include <cstdio>
 #include <sstream>
 #include <thread>
 
 #include "core/Errors.hpp"
+#include "core/Format.hpp"
 #include "core/InputFile.hpp"
 #include "core/TimingProfile.hpp"
 #include "core/Twi.hpp"
@@ -19,27 +19,6 @@
 
 namespace avrbench {
 namespace {
-
-std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char* fmt, ...) {
-    va_list args;
-    va_start(args, fmt);
-    char small[512];
-    va_list copy;
-    va_copy(copy, args);
-    const int n = std::vsnprintf(small, sizeof small, fmt, copy);
-    va_end(copy);
-    std::string out;
-    if (n >= 0 && static_cast<std::size_t>(n) < sizeof small) {
-        out.assign(small, static_cast<std::size_t>(n));
-    } else if (n >= 0) {
-        out.resize(static_cast<std::size_t>(n) + 1);
-        std::vsnprintf(out.data(), out.size(), fmt, args);
-        out.resize(static_cast<std::size_t>(n));
-    }
-    va_end(args);
-    return out;
-}
 
 // The last `max_lines` lines of a port's text, indented, escaped.
 void append_text_tail(std::vector<std::string>& out, const std::string& text, std::size_t max_lines) {
@@ -56,15 +35,6 @@ void append_text_tail(std::vector<std::string>& out, const std::string& text, st
     if (!line.empty()) lines.push_back(line);
     const std::size_t from = lines.size() > max_lines ? lines.size() - max_lines : 0;
     for (std::size_t i = from; i < lines.size(); ++i) out.push_back("    " + hex_escaped(lines[i]));
-}
-
-// The recorder's error, named after the option that gave the list.
-void trace_pins(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option) {
-    try {
-        recorder.trace_pins(mcu, spec);
-    } catch (const BadInput& e) {
-        throw BadInput(std::string(option) + ": " + e.what());
-    }
 }
 
 // PB5, PORTB or all name pins of every MCU; MCU.PB5, MCU.PORTB or MCU.all
@@ -87,12 +57,20 @@ void trace_board_pins(Recorder& recorder, Board& board, const std::string& spec,
         per_mcu[mcu] += item.substr(dot + 1) + ",";
     }
     for (Mcu* m : board.mcus()) {
-        if (!every_mcu.empty()) trace_pins(recorder, *m, every_mcu, option);
-        if (const auto it = per_mcu.find(m->name()); it != per_mcu.end()) trace_pins(recorder, *m, it->second, option);
+        if (!every_mcu.empty()) trace_pins_option(recorder, *m, every_mcu, option);
+        if (const auto it = per_mcu.find(m->name()); it != per_mcu.end()) trace_pins_option(recorder, *m, it->second, option);
     }
 }
 
 }  // namespace
+
+void trace_pins_option(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option) {
+    try {
+        recorder.trace_pins(mcu, spec);
+    } catch (const BadInput& e) {
+        throw BadInput(std::string(option) + ": " + e.what());
+    }
+}
 
 std::pair<Picoseconds, std::string> parse_realtime_bytes(const std::string& item, const char* option) {
     const auto eq = item.find('=');
@@ -335,7 +313,7 @@ RunVerdict BoardRun::verdict(bool strict) const {
     if (plot_ && plot_->failed()) return {O::Timeout, "timeout: " + plot_->failure()};
     if (outcome_ == IdleResult::Interrupted) {
         return {O::Interrupted,
-                format("interrupted at %.6f s simulated; what was recorded is written", bench_->now_seconds())};
+                format_text("interrupted at %.6f s simulated; what was recorded is written", bench_->now_seconds())};
     }
     if (host_ != nullptr && outcome_ == IdleResult::HostFailed) {
         // A host that got no answer is a timeout; error/ALARM/!! are findings.
@@ -346,7 +324,7 @@ RunVerdict BoardRun::verdict(bool strict) const {
         return {timed_out ? O::Timeout : O::Finding, host_->failure_message()};
     }
     if (host_ != nullptr && outcome_ == IdleResult::TimeLimit) {
-        return {O::Timeout, format("timeout: the job was not finished within %g s (%zu of %zu lines acknowledged)",
+        return {O::Timeout, format_text("timeout: the job was not finished within %g s (%zu of %zu lines acknowledged)",
                                    seconds_from_ps(options_.duration_ps), host_->lines_acknowledged(),
                                    host_->lines().size())};
     }
@@ -363,49 +341,49 @@ std::vector<std::string> BoardRun::summary() const {
     const Bench& bench = *bench_;
     Board& board = bench_->board();
     const double simulated_s = bench.now_seconds();
-    out.push_back(format("avrbench run: board %s (%s)", board.spec().name.c_str(), options_.board.c_str()));
+    out.push_back(format_text("avrbench run: board %s (%s)", board.spec().name.c_str(), options_.board.c_str()));
     for (Mcu* m : board.mcus()) {
-        out.push_back(format("  mcu        %s: %s at %.6g MHz, firmware %s%s", m->name().c_str(), m->mcu_type().c_str(),
+        out.push_back(format_text("  mcu        %s: %s at %.6g MHz, firmware %s%s", m->name().c_str(), m->mcu_type().c_str(),
                              m->frequency_hz() / 1e6, m->elf().path().c_str(), m->halted() ? " (halted)" : ""));
     }
     for (Mcu* m : board.mcus()) {
         if (!m->boot()) continue;
-        out.push_back(format(
+        out.push_back(format_text(
             "  boot       %s: %s at 0x%05X (%u bytes), started the application %u time%s; the application section %s",
             m->name().c_str(), m->bootloader_path().c_str(), m->boot()->start_bytes, m->boot()->size_bytes,
             m->application_starts(), m->application_starts() == 1 ? "" : "s",
             m->elf_matches_flash() ? "holds the ELF" : "now differs from the ELF (rewritten by the boot loader)"));
     }
-    out.push_back(format("  simulated  %.6f s", simulated_s));
-    out.push_back(format("  wall       %.3f s, real-time factor %.1fx", wall_s_, wall_s_ > 0 ? simulated_s / wall_s_ : 0.0));
+    out.push_back(format_text("  simulated  %.6f s", simulated_s));
+    out.push_back(format_text("  wall       %.3f s, real-time factor %.1fx", wall_s_, wall_s_ > 0 ? simulated_s / wall_s_ : 0.0));
     for (Mcu* m : board.mcus()) {
         if (m->idle_jumps() == 0) continue;
-        out.push_back(format("  idle skip  %s%llu jumps over %.6f s of idle-loop passes",
+        out.push_back(format_text("  idle skip  %s%llu jumps over %.6f s of idle-loop passes",
                              board.mcus().size() > 1 ? (m->name() + ": ").c_str() : "",
                              static_cast<unsigned long long>(m->idle_jumps()),
                              static_cast<double>(m->idle_cycles_skipped()) / m->frequency_hz()));
     }
     if (pty_) {
-        std::string line = format("  pty        %s: %llu bytes to the firmware, %llu from it%s", pty_->path().c_str(),
+        std::string line = format_text("  pty        %s: %llu bytes to the firmware, %llu from it%s", pty_->path().c_str(),
                                   static_cast<unsigned long long>(pty_->bytes_to_firmware()),
                                   static_cast<unsigned long long>(pty_->bytes_to_host()),
                                   pty_->bytes_dropped() != 0 ? " (the host did not read them all)" : "");
-        if (options_.pty->reset_on_open) line += format(", %u resets on open", resets_on_open_);
+        if (options_.pty->reset_on_open) line += format_text(", %u resets on open", resets_on_open_);
         out.push_back(line);
     }
     if (plot_) {
-        out.push_back(format("  plot       %s: %zu of %zu records acknowledged (%s)%s", plot_source_.c_str(),
+        out.push_back(format_text("  plot       %s: %zu of %zu records acknowledged (%s)%s", plot_source_.c_str(),
                              plot_->acknowledged(), plot_->messages(), plot_variant_.c_str(),
                              plot_->failed() ? ", failed" : ""));
     }
     if (host_ != nullptr) {
-        out.push_back(format("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s",
+        out.push_back(format_text("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s",
                              options_.gcode->path.c_str(), host_->lines_acknowledged(), host_->lines().size(),
                              host_->oks(), host_->errors(), to_string(outcome_)));
     }
     for (const auto& [mcu, count] : i2c_) {
         if (count->transfers == 0) continue;  // a master that never spoke is no master
-        out.push_back(format("  i2c        %s as master: %llu transfers, %llu data bytes, %llu NACKed by a slave",
+        out.push_back(format_text("  i2c        %s as master: %llu transfers, %llu data bytes, %llu NACKed by a slave",
                              mcu.c_str(), static_cast<unsigned long long>(count->transfers),
                              static_cast<unsigned long long>(count->bytes), static_cast<unsigned long long>(count->nacks)));
     }
@@ -416,7 +394,7 @@ std::vector<std::string> BoardRun::summary() const {
         if (m->profile() == nullptr) continue;
         for (const std::string& line : m->profile()->summary_lines()) out.push_back("  profile    " + m->name() + ": " + line);
     }
-    out.push_back(format("  findings   %zu", findings_.size()));
+    out.push_back(format_text("  findings   %zu", findings_.size()));
     for (const auto& line : summarize_findings(findings_)) out.push_back("    " + line);
     if (host_ != nullptr) {
         out.push_back("  transcript (last lines):");
@@ -425,14 +403,14 @@ std::vector<std::string> BoardRun::summary() const {
     for (const auto& decl : board.spec().serial) {
         if ((host_ != nullptr || plot_) && bench_->serial_decl(options_.job_port).name == decl.name) continue;
         const Uart& u = bench_->serial(decl.name);
-        out.push_back(format("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
+        out.push_back(format_text("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
                              u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
                              u.transmitted().empty() ? "" : "; last lines:"));
         append_text_tail(out, u.transmitted_text(), 10);
     }
     if (!options_.vcd.empty()) {
         const Timeline& timeline = bench_->timeline();
-        out.push_back(format("  vcd        %s (%zu signals, %llu events), gtkwave save file %s", options_.vcd.c_str(),
+        out.push_back(format_text("  vcd        %s (%zu signals, %llu events), gtkwave save file %s", options_.vcd.c_str(),
                              timeline.signals().size(), static_cast<unsigned long long>(timeline.recorded_count()),
                              gtkw_path_.c_str()));
     }

@@ -18,6 +18,7 @@
 
 #include "core/OutputFile.hpp"
 #include "core/Time.hpp"
+#include "trace/Recorder.hpp"
 #include "trace/VcdWriter.hpp"
 #include "verify/Bench.hpp"
 
@@ -150,6 +151,9 @@ private:
     std::string gtkw_path_;
     double wall_s_ = 0;
 };
+
+// Recorder::trace_pins, its error named after the option that gave the list.
+void trace_pins_option(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option);
 
 // "2.5s=!" / "1.5s=^X" / "3s=0x85": a time and the bytes to send then
 // (printable characters as they are, ^X a control character, 0xNN any byte).

@@ -1,10 +1,10 @@
 #include "verify/McuRun.hpp"
 
-#include <cstdarg>
 #include <cstdio>
 
 #include "core/ElfImage.hpp"
 #include "core/Errors.hpp"
+#include "core/Format.hpp"
 #include "core/InputFile.hpp"
 #include "core/OutputFile.hpp"
 #include "core/TimingProfile.hpp"
@@ -12,28 +12,6 @@
 #include "trace/WaveformFiles.hpp"
 
 namespace avrbench {
-namespace {
-
-// The recorder's error, named after the option that gave the list.
-void trace_pins(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option) {
-    try {
-        recorder.trace_pins(mcu, spec);
-    } catch (const BadInput& e) {
-        throw BadInput(std::string(option) + ": " + e.what());
-    }
-}
-
-std::string line(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string line(const char* fmt, ...) {
-    char text[512];
-    va_list args;
-    va_start(args, fmt);
-    std::vsnprintf(text, sizeof text, fmt, args);
-    va_end(args);
-    return text;
-}
-
-}  // namespace
 
 McuRun::McuRun(McuRunOptions options) : options_(std::move(options)) {
     const ElfImage elf = ElfImage::load(options_.elf);
@@ -64,9 +42,9 @@ McuRun::McuRun(McuRunOptions options) : options_(std::move(options)) {
     if (!options_.profile.empty()) mcu_->enable_profile();
     const bool tracing = !options_.vcd.empty() || !options_.trace.empty() || !options_.trace_only.empty();
     // The default on one MCU is every pin; --trace only checks its names then.
-    if (tracing && !options_.trace.empty()) trace_pins(recorder_, *mcu_, options_.trace, "--trace");
+    if (tracing && !options_.trace.empty()) trace_pins_option(recorder_, *mcu_, options_.trace, "--trace");
     if (tracing) {
-        trace_pins(recorder_, *mcu_, options_.trace_only.empty() ? "all" : options_.trace_only, "--trace-only");
+        trace_pins_option(recorder_, *mcu_, options_.trace_only.empty() ? "all" : options_.trace_only, "--trace-only");
     }
     try {
         uart0_ = &mcu_->uart(0);
@@ -112,28 +90,28 @@ std::vector<std::string> McuRun::summary() const {
     const Mcu& mcu = *mcu_;
     std::vector<std::string> out;
     const double simulated_s = mcu.seconds();
-    out.push_back(line("avrbench run: %s on %s at %.6g MHz", options_.elf.c_str(), mcu.mcu_type().c_str(),
+    out.push_back(format_text("avrbench run: %s on %s at %.6g MHz", options_.elf.c_str(), mcu.mcu_type().c_str(),
                        mcu.frequency_hz() / 1e6));
-    out.push_back(line("  simulated  %.6f s (%llu cycles)", simulated_s, static_cast<unsigned long long>(mcu.cycle())));
-    out.push_back(line("  wall       %.3f s, real-time factor %.1fx", wall_s_, wall_s_ > 0 ? simulated_s / wall_s_ : 0.0));
+    out.push_back(format_text("  simulated  %.6f s (%llu cycles)", simulated_s, static_cast<unsigned long long>(mcu.cycle())));
+    out.push_back(format_text("  wall       %.3f s, real-time factor %.1fx", wall_s_, wall_s_ > 0 ? simulated_s / wall_s_ : 0.0));
     if (mcu.idle_jumps() != 0) {
-        out.push_back(line("  idle skip  %llu jumps over %.6f s of idle-loop passes",
+        out.push_back(format_text("  idle skip  %llu jumps over %.6f s of idle-loop passes",
                            static_cast<unsigned long long>(mcu.idle_jumps()),
                            static_cast<double>(mcu.idle_cycles_skipped()) / mcu.frequency_hz()));
     }
-    if (options_.until_sleep) out.push_back(line("  stopped    %s", slept_ ? "firmware executed SLEEP" : "time limit"));
+    if (options_.until_sleep) out.push_back(format_text("  stopped    %s", slept_ ? "firmware executed SLEEP" : "time limit"));
     if (mcu.halted()) out.push_back("  halted     " + mcu.halt_reason());
     if (uart0_ != nullptr) {
-        out.push_back(line("  uart0      %zu bytes from firmware, %llu bytes to firmware", uart0_->transmitted().size(),
+        out.push_back(format_text("  uart0      %zu bytes from firmware, %llu bytes to firmware", uart0_->transmitted().size(),
                            static_cast<unsigned long long>(uart0_->bytes_delivered())));
     }
     if (const TimingProfiler* profile = mcu.profile()) {
         for (const std::string& text : profile->summary_lines()) out.push_back("  profile    " + text);
     }
-    out.push_back(line("  findings   %zu", mcu.findings().size()));
+    out.push_back(format_text("  findings   %zu", mcu.findings().size()));
     for (const auto& text : summarize_findings(mcu.findings())) out.push_back("    " + text);
     if (!options_.vcd.empty()) {
-        out.push_back(line("  vcd        %s (%zu signals, %llu events), gtkwave save file %s", options_.vcd.c_str(),
+        out.push_back(format_text("  vcd        %s (%zu signals, %llu events), gtkwave save file %s", options_.vcd.c_str(),
                            timeline_.signals().size(), static_cast<unsigned long long>(timeline_.recorded_count()),
                            gtkw_path_.c_str()));
     }
@@ -144,7 +122,7 @@ RunVerdict McuRun::verdict() const {
     using O = RunVerdict::Outcome;
     const Mcu& mcu = *mcu_;
     if (user_stop_requested()) {
-        return {O::Interrupted, line("interrupted at %.6f s simulated; what was recorded is written", mcu.seconds())};
+        return {O::Interrupted, format_text("interrupted at %.6f s simulated; what was recorded is written", mcu.seconds())};
     }
     if (!mcu.findings().empty()) return {O::Finding, ""};
     if (options_.until_sleep && !slept_ && !mcu.halted()) {
