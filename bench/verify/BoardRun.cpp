@@ -96,7 +96,8 @@ std::pair<Picoseconds, std::string> parse_realtime_bytes(const std::string& item
 
 BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
     BoardSpec spec = load_board_file(options_.board);
-    options_.firmware[spec.mcus.front().name] = options_.elf;
+    // The first MCU's ELF may come as `elf` (the CLI's positional argument) or in `firmware`.
+    if (!options_.elf.empty()) options_.firmware[spec.mcus.front().name] = options_.elf;
     check_files(spec);
     if (!options_.read_uart_input) {
         options_.read_uart_input = [](const std::string& path) {
@@ -140,7 +141,7 @@ BoardRun::~BoardRun() = default;
 
 void BoardRun::check_files(const BoardSpec& spec) {
     RunFiles files;
-    files.input(options_.elf, "the firmware ELF");
+    if (!options_.elf.empty()) files.input(options_.elf, "the firmware ELF");
     files.input(spec.path, "an input of the board");
     for (const auto& [mcu, elf] : options_.firmware) files.input(elf, "an input of the board");
     for (const auto& m : spec.mcus) files.input(m.bootloader, "an input of the board");
