@@ -89,4 +89,11 @@ std::vector<std::string> summarize_findings(const std::vector<Finding>& findings
     return lines;
 }
 
+namespace {
+thread_local std::uint64_t recorded_findings = 0;
+}  // namespace
+
+std::uint64_t findings_recorded() { return recorded_findings; }
+void count_finding_recorded() { ++recorded_findings; }
+
 }  // namespace avrbench

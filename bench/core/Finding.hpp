@@ -74,4 +74,11 @@ struct Finding {
 // step-high-too-short (x_driver) x4990"), so a flood stays readable.
 std::vector<std::string> summarize_findings(const std::vector<Finding>& findings, std::size_t first_n = 10);
 
+// Findings recorded so far by this thread, whoever recorded them (an MCU, a
+// net, a part, a host): a debugger's --break-at-finding compares it after
+// every instruction instead of asking each of them.
+std::uint64_t findings_recorded();
+// Called by whoever records a finding.
+void count_finding_recorded();
+
 }  // namespace avrbench

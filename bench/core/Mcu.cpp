@@ -21,6 +21,7 @@ extern "C" {
 #include "core/Adc.hpp"
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
+#include "core/DebugHook.hpp"
 #include "core/IdleLoopSkip.hpp"
 #include "core/IntelHex.hpp"
 #include "core/TimingProfile.hpp"
@@ -264,6 +265,12 @@ Cycle Mcu::next_event_cycle() const {
     const avr_cycle_timer_slot_p head = avr_->cycle_timers.timer;
     return head == nullptr ? ~Cycle{0} : head->when;
 }
+void Mcu::set_debug_hook(DebugHook* hook) {
+    if (hook != nullptr && debug_ == nullptr) skip_idle_before_debug_ = options_.skip_idle_loops;
+    debug_ = hook;
+    set_skip_idle_loops(hook == nullptr && skip_idle_before_debug_);
+}
+
 void Mcu::set_skip_idle_loops(bool on) {
     options_.skip_idle_loops = on;
     if (!on || options_.reference_run_loop) {
@@ -378,6 +385,10 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     };
     IdleLoopSkipper* const skipper = skipper_.get();
     while (avr->cycle < target_cycle) {
+        if (__builtin_expect(debug_ != nullptr, 0)) {
+            debug_->before_step(*this);
+            if (stop_requested_ || halted_) break;
+        }
         // run_until_sleep: stop in front of SLEEP (it executes it itself).
         if (__builtin_expect(stop_at_sleep_, 0) && avr->state == cpu_Running && opcode_at(avr, avr->pc) == kSleepOpcode) break;
         if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
@@ -390,8 +401,9 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         check(state, pc_before);
         if constexpr (kCover) edges->hit(avr->pc);
         if (__builtin_expect(stop_requested_, 0)) break;
-        // A profile sees every step, run_until_sleep looks at every opcode: no fast path.
-        if (kProfile || stop_at_sleep_ || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
+        // A profile sees every step, run_until_sleep looks at every opcode, a
+        // debugger may stop in front of any instruction: no fast path.
+        if (kProfile || stop_at_sleep_ || debug_ != nullptr || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
         // Fast path: while the core runs, no interrupt is on its way and no
         // cycle timer is due, a step of SimavrStepper is avr_run_one and the
@@ -444,6 +456,7 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     avr_cycle_timer_cancel(avr, &horizon_timer, this);
     run_target_ = 0;
     in_run_ = false;
+    if (halted_ && debug_ != nullptr) debug_->halted(*this);
     if (halted_) return StopReason::Halted;
     if (stop_requested_) {
         stop_requested_ = false;
@@ -601,6 +614,7 @@ void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string deta
     f.symbol = describe_pc(pc_bytes);
     f.detail = std::move(detail);
     findings_.push_back(std::move(f));
+    count_finding_recorded();
     if (halt) {
         halted_ = true;
         halt_reason_ = findings_.back().describe();

@@ -29,6 +29,7 @@ struct avr_io_t;
 namespace avrbench {
 
 class Adc;
+class DebugHook;
 class IdleLoopSkipper;
 class TimingProfiler;
 class Mcu;
@@ -128,6 +129,10 @@ public:
     void enable_profile();
     // nullptr until enable_profile().
     const TimingProfiler* profile() const { return profiler_.get(); }
+    // A debugger (core/DebugHook.hpp); nullptr detaches. Idle loops are not
+    // skipped while one is attached: it may stop in front of any instruction.
+    void set_debug_hook(DebugHook* hook);
+    DebugHook* debug_hook() const { return debug_; }
     // Executes one instruction (or one sleep fast-forward). Returns false once halted.
     bool step();
     void request_stop();
@@ -275,6 +280,8 @@ private:
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
+    DebugHook* debug_ = nullptr;
+    bool skip_idle_before_debug_ = false;
     bool stop_at_sleep_ = false;  // run_until_sleep: the run loop ends when the core sleeps
     PcEdgeMap* run_coverage_ = nullptr;
     std::unique_ptr<TimingProfiler> profiler_;

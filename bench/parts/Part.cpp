@@ -128,6 +128,7 @@ void Part::report(FindingKind kind, std::string detail) {
     f.has_pc = false;
     f.detail = std::move(detail);
     findings_.push_back(std::move(f));
+    count_finding_recorded();
 }
 
 }  // namespace avrbench

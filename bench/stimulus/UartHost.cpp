@@ -652,7 +652,10 @@ void UartHost::on_line_timeout() {
     fail(std::move(e));
 }
 
-void UartHost::record(HostEvent event) { events_.push_back(std::move(event)); }
+void UartHost::record(HostEvent event) {
+    events_.push_back(std::move(event));
+    count_finding_recorded();
+}
 
 void UartHost::fail(HostEvent event) {
     if (failed_) {

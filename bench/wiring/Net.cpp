@@ -51,6 +51,8 @@ void Net::update() {
             f.has_pc = false;
             f.detail = "net '" + name_ + "': outputs drive opposite levels (" + drivers_text() + ")";
             findings_.push_back(std::move(f));
+    count_finding_recorded();
+            count_finding_recorded();
         }
         update_pending_ = false;
         deliver();
@@ -102,6 +104,7 @@ void Net::floating_read(Mcu& reader, const std::string& pin_label) {
     }
     f.detail = "the firmware read " + pin_label + " while net '" + name_ + "' floats (" + why + "); the bench reads 0";
     findings_.push_back(std::move(f));
+    count_finding_recorded();
 }
 
 }  // namespace avrbench
