@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <memory>
+#include <optional>
 
 #include "cam/Chain.hpp"
 #include "cam/DxfReader.hpp"
@@ -17,6 +19,8 @@
 #include "core/TimingProfile.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
+#include "debug/Debugger.hpp"
+#include "debug/RunViews.hpp"
 #include "tools/Commands.hpp"
 #include "tools/FirmwareArgs.hpp"
 #include "trace/Recorder.hpp"
@@ -64,7 +68,52 @@ struct RunArgs {
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
     bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
     bool no_periodic_waves = false;     // --no-periodic-waves: every PWM edge through the nets
+    std::vector<std::string> gdb;       // --gdb [MCU=]PORT (repeatable)
+    bool break_at_finding = false;
+    std::string break_at;               // --break-at TIME
+    std::string break_at_cycle;         // --break-at-cycle N
 };
+
+// --gdb and the --break-at options as the debugger's options; nullopt without --gdb.
+std::optional<DebugOptions> debug_options(const RunArgs& args) {
+    if (args.gdb.empty()) {
+        if (args.break_at_finding || !args.break_at.empty() || !args.break_at_cycle.empty()) {
+            throw BadInput("--break-at-finding, --break-at and --break-at-cycle need --gdb [MCU=]PORT");
+        }
+        return std::nullopt;
+    }
+    if (!args.pty.empty() && args.pace == "realtime") {
+        throw BadInput("--gdb with --pace realtime: a stopped MCU would hold wall time back; debug at --pace free");
+    }
+    DebugOptions o;
+    o.ports = parse_gdb_ports(args.gdb);
+    o.break_at_finding = args.break_at_finding;
+    if (!args.break_at.empty()) o.break_at_ps = parse_duration_ps(args.break_at, "--break-at");
+    if (!args.break_at_cycle.empty()) {
+        std::size_t used = 0;
+        unsigned long long cycle = 0;
+        try {
+            cycle = std::stoull(args.break_at_cycle, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != args.break_at_cycle.size()) {
+            throw BadInput("--break-at-cycle '" + args.break_at_cycle + "': not a cycle number");
+        }
+        o.break_at_cycle = cycle;
+    }
+    o.announce = [](const std::string& line) {
+        std::fprintf(stderr, "%s\n", line.c_str());
+        std::fflush(stderr);
+    };
+    return o;
+}
+
+// The verdict of a debugged run: a debugger that killed the program interrupted it.
+RunVerdict debugged_verdict(const Debugger& debugger, RunVerdict verdict) {
+    if (debugger.killed()) return {RunVerdict::Outcome::Interrupted, "the debugger killed the program"};
+    return verdict;
+}
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
 struct PortFile {
@@ -216,6 +265,23 @@ int run_board_command(const RunArgs& args) {
     BoardRunOptions options = board_run_options(args, progress);
     // The drawing is read once the board is built, as the library asks.
     if (!args.dxf.empty()) options.records = [&args] { return plot_job(args); };
+    if (auto debug = debug_options(args)) {
+        Debugger debugger(*debug);
+        debugger.listen();
+        std::unique_ptr<BoardRun> run;
+        // Each replay (reverse execution) is a new run of the same options.
+        debugger.run_replays([&] {
+            run.reset();
+            run = std::make_unique<BoardRun>(options);
+            debugger.attach(run->bench().board().mcus(), board_debug_view(*run, !options.pty.has_value()));
+            run->run();
+        });
+        debugger.detach();
+        debugger.run_ended();
+        progress.finish();
+        for (const std::string& line : run->summary()) std::printf("%s\n", line.c_str());
+        return exit_code(debugged_verdict(debugger, run->verdict(args.strict)));
+    }
     BoardRun run(std::move(options));
     run.run();
     progress.finish();
@@ -257,6 +323,23 @@ int run_command(const RunArgs& args) {
     o.profile = args.profile;
     ProgressBar progress(!args.quiet && isatty(STDERR_FILENO) != 0);
     o.on_progress = [&progress](double fraction, double simulated_s) { progress.show(fraction, simulated_s); };
+    if (auto debug = debug_options(args)) {
+        if (args.until_sleep) throw BadInput("--until-sleep and --gdb: break where you want to stop instead");
+        Debugger debugger(*debug);
+        debugger.listen();
+        std::unique_ptr<McuRun> run;
+        debugger.run_replays([&] {
+            run.reset();
+            run = std::make_unique<McuRun>(o);
+            debugger.attach({&run->mcu()}, mcu_debug_view(*run));
+            run->run();
+        });
+        debugger.detach();
+        debugger.run_ended();
+        progress.finish();
+        for (const std::string& text : run->summary()) std::printf("%s\n", text.c_str());
+        return exit_code(debugged_verdict(debugger, run->verdict()));
+    }
     McuRun run(std::move(o));
     run.run();
     progress.finish();
@@ -325,6 +408,13 @@ Command add_run_command(CLI::App& app) {
     run_cmd->add_option("--uart-out", run.uart_out,
                         "FILE or PORT=FILE: write what the firmware sent on a serial port (repeatable)");
     run_cmd->add_flag("-q,--quiet", run.quiet, "no progress bar");
+    run_cmd->add_option("--gdb", run.gdb,
+                        "[MCU=]PORT: wait for avr-gdb on 127.0.0.1:PORT (0: any free port, printed) and debug that MCU "
+                        "(default the first); repeat for other MCUs of a board (docs/DEBUGGING.md)");
+    run_cmd->add_flag("--break-at-finding", run.break_at_finding,
+                      "--gdb: stop at each finding, at the instruction it came after (monitor findings says why)");
+    run_cmd->add_option("--break-at", run.break_at, "--gdb: stop at the first instruction at or after this simulated time, e.g. 1.234s");
+    run_cmd->add_option("--break-at-cycle", run.break_at_cycle, "--gdb: stop at the first instruction at or after this cycle");
     run_cmd->add_flag("--no-idle-skip", run.no_idle_skip,
                       "run every pass of the firmware's idle loops instead of jumping over them (same results, slower)");
     run_cmd->add_flag("--no-periodic-waves", run.no_periodic_waves,

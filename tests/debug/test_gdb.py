@@ -1,0 +1,277 @@
+#!/usr/bin/env python3
+"""avr-gdb (Debian gdb-avr) in batch mode against `avrbench run --gdb`.
+
+Every expected value comes from the firmware's source or from the ELF read
+with binutils (avr-nm, avr-objdump), never from avrbench's own output:
+firmware/gdb_target/main.c says ticks holds 3 * (n - 1) on the n-th entry of
+tick(), eeprom_word is 0xBEEF; avr-nm gives the addresses of tick, ticks and
+bad_opcode_here; avr-objdump gives the stores and loads of ticks.
+
+Run by ctest, one test per case:
+  test_gdb.py --cli build/avrbench --firmware build/firmware GdbTests.test_x
+Each avrbench and avr-gdb process runs under a wall-clock guard (a stuck
+session fails the test instead of hanging it).
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+import unittest
+
+CLI = None
+FIRMWARE = None
+BOARDS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtures", "boards")
+GUARD_S = 120  # wall-clock guard per process: generous, never a speed check
+
+
+def elf(name):
+    return os.path.join(FIRMWARE, name + ".elf")
+
+
+def symbol_address(elf_path, name):
+    out = subprocess.run(["avr-nm", elf_path], capture_output=True, text=True, check=True).stdout
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[2] == name:
+            return int(parts[0], 16)
+    raise AssertionError(f"{name} not in {elf_path}")
+
+
+def disassembly_of(elf_path, function):
+    """(address, mnemonic, operands) of each instruction of `function`."""
+    out = subprocess.run(["avr-objdump", "-d", elf_path], capture_output=True, text=True, check=True).stdout
+    rows, inside = [], False
+    for line in out.splitlines():
+        if re.match(r"^[0-9a-f]+ <" + re.escape(function) + r">:", line):
+            inside = True
+            continue
+        if inside and re.match(r"^[0-9a-f]+ <", line):
+            break
+        m = re.match(r"^\s+([0-9a-f]+):\s+(?:[0-9a-f]{2} )+\s*(\w+)\s*([^;]*)", line)
+        if inside and m:
+            rows.append((int(m.group(1), 16), m.group(2), m.group(3).strip()))
+    return rows
+
+
+class Session:
+    """avrbench run ... --gdb [MCU=]0 for each MCU; the ports it announces."""
+
+    def __init__(self, run_args, mcus=("",)):
+        gdb_args = []
+        for mcu in mcus:
+            gdb_args += ["--gdb", (mcu + "=0") if mcu else "0"]
+        self.proc = subprocess.Popen([CLI, "run", "-q"] + run_args + gdb_args, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+        self.ports = {}
+        deadline = time.monotonic() + GUARD_S
+        while len(self.ports) < len(mcus):
+            line = self.proc.stderr.readline()
+            if not line or time.monotonic() > deadline:
+                self.proc.kill()
+                raise AssertionError("avrbench announced no gdb port: " + line + self.proc.stderr.read())
+            m = re.search(r"gdb: MCU (\S+) waits for avr-gdb on 127\.0\.0\.1:(\d+)", line)
+            if m:
+                self.ports[m.group(1)] = int(m.group(2))
+
+    def port(self, mcu="(first)"):
+        return self.ports[mcu]
+
+    def finish(self):
+        out, err = self.proc.communicate(timeout=GUARD_S)
+        return self.proc.returncode, out, err
+
+
+def gdb_command(port, elf_path, commands):
+    args = ["avr-gdb", "-nx", "-batch", "-ex", "set confirm off", "-ex", f"target remote :{port}"]
+    for c in commands:
+        args += ["-ex", c]
+    return args + [elf_path]
+
+
+def gdb(port, elf_path, commands):
+    # One stream, in order: avr-gdb writes monitor output to stderr.
+    r = subprocess.run(gdb_command(port, elf_path, commands), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                       text=True, timeout=GUARD_S)
+    return r.stdout
+
+
+def pcs(output):
+    """Every `print $pc`: avr-gdb prints a code pointer as "(void (*)()) 0xa2 <tick+18>" (byte address)."""
+    return [int(v, 16) for v in re.findall(r"^\$\d+ = \(void \(\*\)\(\)\) (0x[0-9a-f]+)", output, re.M)]
+
+
+def values(output, name):
+    """Every `$N = value` gdb printed, in order (`name` only for messages)."""
+    found = re.findall(r"^\$\d+ = (.*)$", output, re.M)
+    if not found:
+        raise AssertionError(f"no value printed for {name}:\n{output}")
+    return found
+
+
+class GdbTests(unittest.TestCase):
+    def test_break_on_a_symbol_reads_and_writes_variables_and_eeprom(self):
+        target = elf("gdb_target")
+        s = Session([target, "--for", "10ms"])
+        out = gdb(s.port(), target, ["break tick"] + ["continue"] * 5 + [
+            "print ticks", "print $pc", "x/2xb 0x810000",
+            # A write by the debugger: the next entry sees it plus one increment.
+            "set var ticks = 1000", "continue", "print ticks", "detach"])
+        rc, _, err = s.finish()
+        printed = values(out, "ticks, $pc")
+        self.assertEqual(printed[0], "12", out)  # 5th entry: 3 * (5 - 1)
+        self.assertEqual(pcs(out), [symbol_address(target, "tick")], out)
+        self.assertRegex(out, r"<eeprom_word>:\s+0xef\s+0xbe", out)  # EEMEM 0xBEEF, little-endian
+        self.assertEqual(printed[2], "1003", out)
+        self.assertEqual(rc, 0, err)
+
+    def test_watchpoints_stop_after_the_instruction_that_accessed_the_variable(self):
+        target = elf("gdb_target")
+        ticks = symbol_address(target, "ticks") & 0xFFFF
+        stores = [a for a, op, args in disassembly_of(target, "tick")
+                  if op == "sts" and args.split(",")[0].strip().lower() == f"0x{ticks:04x}"]
+        loads = [a for a, op, args in disassembly_of(target, "main")
+                 if op == "lds" and args.split(",")[1].strip().lower() == f"0x{ticks:04x}"]
+        self.assertTrue(stores and loads)
+        s = Session([target, "--for", "10ms"])
+        out = gdb(s.port(), target, [
+            "watch ticks", "continue", "print $pc", "delete",
+            "rwatch ticks", "continue", "print $pc", "detach"])
+        rc, _, err = s.finish()
+        printed = pcs(out)
+        # The write that changes ticks from 0 to 3 is the store of its low
+        # byte (avr-gcc stores a volatile word high byte first): 4-byte STS.
+        self.assertRegex(out, r"Old value = 0\s+New value = 3", out)
+        self.assertEqual(printed[0], stores[-1] + 4, out)
+        # The next read of ticks after that store is main's copy into
+        # last_seen (the low byte's LDS comes first: 4 bytes too).
+        self.assertEqual(printed[1], loads[0] + 4, out)
+        self.assertEqual(rc, 0, err)
+
+    def test_break_at_finding_stops_at_the_crashing_instruction(self):
+        target = elf("crash_bad_opcode")
+        s = Session([target, "--for", "10ms", "--break-at-finding"])
+        out = gdb(s.port(), target, ["continue", "print $pc", "monitor findings", "kill"])
+        rc, summary, err = s.finish()
+        self.assertIn("SIGSEGV", out)
+        self.assertEqual(pcs(out), [symbol_address(target, "bad_opcode_here")], out)
+        stop = re.search(r"invalid-opcode at [0-9.]+ s \(cycle (\d+)\), PC 0x0086", out)
+        reported = re.search(r"invalid-opcode at [0-9.]+ s \(cycle (\d+)\)", summary)
+        self.assertTrue(stop and reported, out + summary)
+        self.assertEqual(stop.group(1), reported.group(1))
+        self.assertEqual(rc, 130, err)  # killed by the debugger: interrupted (docs/CLI.md)
+
+    def test_reverse_stepi_100_then_stepi_100_returns_to_the_identical_state(self):
+        target = elf("gdb_target")
+        s = Session([target, "--for", "10ms"])
+        state = ["info registers", "x/16xb 0x800100", "monitor time"]
+        # Past the 5th entry of tick() (about 150 instructions from power-on: more than 100 to go back).
+        out = gdb(s.port(), target, ["break tick"] + ["continue"] * 5 + ["delete", "stepi 37"] + state +
+                  ["reverse-stepi 100", "monitor time", "stepi 100"] + state + ["detach"])
+        rc, _, err = s.finish()
+        times = re.findall(r"MCU \S+: cycle (\d+), [0-9.]+ s, (\d+) instructions", out)
+        self.assertEqual(len(times), 3, out)
+        before, back, again = [(int(c), int(n)) for c, n in times]
+        self.assertEqual(back[1], before[1] - 100, out)
+        self.assertEqual(again, before, out)
+        blocks = re.split(r"MCU \S+: cycle", out)
+        regs_before = re.findall(r"^(?:r\d+|SREG|SP|PC2|pc)\s.*$", blocks[0], re.M)
+        regs_after = re.findall(r"^(?:r\d+|SREG|SP|PC2|pc)\s.*$", blocks[2], re.M)
+        ram_before = re.findall(r"^0x8001[0-9a-f]{2}.*$", blocks[0], re.M)
+        ram_after = re.findall(r"^0x8001[0-9a-f]{2}.*$", blocks[2], re.M)
+        self.assertEqual(len(regs_before), 36, out)
+        self.assertEqual(regs_before, regs_after)
+        self.assertTrue(ram_before)
+        self.assertEqual(ram_before, ram_after)
+        self.assertEqual(rc, 0, err)
+
+    def test_reverse_continue_goes_back_to_the_previous_breakpoint_hit(self):
+        target = elf("gdb_target")
+        s = Session([target, "--for", "10ms"])
+        out = gdb(s.port(), target, ["break tick", "continue", "continue", "continue", "continue", "print ticks",
+                                     "reverse-continue", "print ticks", "reverse-continue", "print ticks", "detach"])
+        rc, _, err = s.finish()
+        self.assertEqual(values(out, "ticks"), ["9", "6", "3"], out)  # entries 4, 3, 2
+        self.assertEqual(rc, 0, err)
+
+    def test_two_mcus_of_a_board_debugged_on_two_ports(self):
+        target = elf("gdb_target")
+        board = os.path.join(BOARDS, "two-mcus.yaml")
+        s = Session(["--board", board, target, "--firmware", "right=" + target, "--for", "10ms"], mcus=("left", "right"))
+        left = subprocess.Popen(gdb_command(s.port("left"), target, ["break tick"] + ["continue"] * 3 +
+                                            ["print ticks", "monitor time", "detach"]),
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        right = subprocess.Popen(gdb_command(s.port("right"), target, ["break tick"] + ["continue"] * 7 +
+                                             ["print ticks", "monitor time", "detach"]),
+                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        out_left = left.communicate(timeout=GUARD_S)[0]
+        out_right = right.communicate(timeout=GUARD_S)[0]
+        rc, summary, err = s.finish()
+        self.assertEqual(values(out_left, "ticks"), ["6"], out_left)    # 3rd entry
+        self.assertEqual(values(out_right, "ticks"), ["18"], out_right)  # 7th entry
+        self.assertIn("MCU left:", out_left)
+        self.assertIn("MCU right:", out_right)
+        self.assertEqual(rc, 0, err + summary)
+
+    def test_malformed_packets_get_answers_and_the_run_goes_on(self):
+        """A client that is not avr-gdb: every packet gets a reply (an error
+        or the empty "unsupported" one), nothing ends the run, and after a
+        detach it finishes with exit code 0."""
+        import random
+        import socket
+        target = elf("gdb_target")
+        s = Session([target, "--for", "1ms"])
+        conn = socket.create_connection(("127.0.0.1", s.port()), timeout=GUARD_S)
+        stream = conn.makefile("rwb", buffering=0)
+
+        def receive(payload):
+            reply = b""
+            while not reply.endswith(b"#"):  # '+' acknowledgements, then $...#
+                c = stream.read(1)
+                self.assertTrue(c, "connection closed after " + repr(payload))
+                if reply or c == b"$":
+                    reply += c
+            stream.read(2)  # checksum
+            stream.write(b"+")
+            return reply[1:-1]
+
+        def exchange(payload):
+            stream.write(b"$" + payload + b"#" + b"%02x" % (sum(payload) & 0xFF))
+            reply = receive(payload)
+            while reply.startswith(b"O") and reply != b"OK":  # console output comes before the answer
+                reply = receive(payload)
+            return reply
+
+        rng = random.Random(39)  # seeded: the same packets every run
+        packets = [b"", b"m", b"m,", b"mffffffff,ffffffff", b"M0,4:zz", b"X800100,3:ab", b"P", b"P1", b"Pff=00",
+                   b"p", b"pff", b"G", b"G00", b"Z", b"Z2", b"Z2,800100", b"z9,0,0", b"qRcmd,", b"qRcmd,zz",
+                   b"qRcmd," + b"help".hex().encode(), b"vCont;q", b"qXfer:features:read:target.xml:0,fff", b"!", b"\xff" * 3]
+        for _ in range(200):
+            packets.append(bytes(rng.choice(b"mMXpPgGZzqv0123456789abcdef,:=;#$}*") for _ in range(rng.randint(1, 24))))
+        for packet in packets:
+            packet = bytes(c for c in packet if c not in b"#$}*")  # framing characters go escaped on the wire
+            if packet[:1] in (b"c", b"s", b"b", b"k", b"D") or packet.startswith(b"vKill"):
+                continue  # run control: it would run, step, replay or end the program, not malformed
+            exchange(packet)
+        self.assertEqual(exchange(b"m800102,2"), b"0000")  # ticks before the first instruction: 0
+        self.assertEqual(exchange(b"D"), b"OK")
+        conn.close()
+        rc, _, err = s.finish()
+        self.assertEqual(rc, 0, err)
+
+    def test_bad_gdb_option_is_one_line_with_the_bad_input_exit_code(self):
+        r = subprocess.run([CLI, "run", elf("gdb_target"), "--gdb", "x=notaport"], capture_output=True, text=True,
+                           timeout=GUARD_S)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        self.assertIn("--gdb 'x=notaport'", r.stderr)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--cli", required=True)
+    parser.add_argument("--firmware", required=True)
+    args, rest = parser.parse_known_args()
+    CLI, FIRMWARE = os.path.abspath(args.cli), os.path.abspath(args.firmware)
+    unittest.main(argv=[sys.argv[0]] + rest, verbosity=2)
