@@ -162,10 +162,9 @@ void Debugger::attach(const std::vector<Mcu*>& mcus, DebugRunView view) {
 }
 
 void Debugger::detach() {
-    for (auto& t : targets_) {
-        if (t->mcu != nullptr) t->mcu->set_debug_hook(nullptr);
-        t->mcu = nullptr;
-    }
+    // The run's MCUs may be gone already (a scenario's Bench ends inside
+    // run_scenario, a replay unwinds through it): only forget them.
+    for (auto& t : targets_) t->mcu = nullptr;
     mcus_.clear();
 }
 

@@ -73,7 +73,7 @@ public:
     // Each run (the first and every replay): its MCUs in board order. The
     // first waits for avr-gdb on every port (BadInput after the timeout).
     void attach(const std::vector<Mcu*>& mcus, DebugRunView view);
-    // The run's objects are about to go.
+    // The run's objects are gone or about to go (its MCUs are not touched).
     void detach();
     // The run ended (its time was up, the MCU halted or the user stopped it):
     // every debugger waiting for a stop hears that the program exited.

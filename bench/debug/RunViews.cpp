@@ -1,16 +1,18 @@
 #include "debug/RunViews.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <optional>
 
 #include "boards/Board.hpp"
 #include "core/Errors.hpp"
+#include "core/Units.hpp"
 #include "core/McuPins.hpp"
 #include "core/Mcu.hpp"
 #include "parts/Part.hpp"
 #include "stimulus/UartHost.hpp"
 #include "trace/Timeline.hpp"
-#include "verify/BoardRun.hpp"
+#include "verify/Bench.hpp"
 #include "verify/McuRun.hpp"
 #include "wiring/Net.hpp"
 
@@ -61,17 +63,16 @@ std::string timeline_text(const Timeline& timeline) {
 
 }  // namespace
 
-DebugRunView board_debug_view(BoardRun& run, bool replayable) {
+DebugRunView board_debug_view(Bench& bench, const UartHost* host, bool replayable) {
     DebugRunView v;
     v.replayable = replayable;
-    v.findings = [&run] { return run.bench().findings(); };
+    v.findings = [&bench] { return bench.findings(); };
     v.monitor_help = {"pins                 this MCU's pins (level, output or not)",
                       "nets                 every net of the board and its level",
                       "parts                every part's signals (positions, temperatures, ...)",
                       "uart                 the job's last lines either way",
                       "timeline             the last events recorded"};
-    v.monitor = [&run](const std::string& command, Mcu& mcu) -> std::optional<std::string> {
-        Bench& bench = run.bench();
+    v.monitor = [&bench, host](const std::string& command, Mcu& mcu) -> std::optional<std::string> {
         if (command == "pins") return pins_text(mcu);
         if (command == "nets") {
             std::string out;
@@ -93,8 +94,8 @@ DebugRunView board_debug_view(BoardRun& run, bool replayable) {
             return out;
         }
         if (command == "uart") {
-            if (run.host() == nullptr) return std::string("no job on a serial port\n");
-            const auto& lines = run.host()->transcript();
+            if (host == nullptr) return std::string("no job on a serial port\n");
+            const auto& lines = host->transcript();
             std::string out;
             const std::size_t first = lines.size() > kHostLinesShown ? lines.size() - kHostLinesShown : 0;
             for (std::size_t i = first; i < lines.size(); ++i) {
@@ -121,6 +122,9 @@ DebugRunView mcu_debug_view(McuRun& run) {
     return v;
 }
 
+namespace {
+
+// "--gdb [MCU=]PORT" items as ports (BadInput naming the item).
 std::vector<DebugOptions::Port> parse_gdb_ports(const std::vector<std::string>& items) {
     std::vector<DebugOptions::Port> out;
     for (const auto& item : items) {
@@ -145,6 +149,39 @@ std::vector<DebugOptions::Port> parse_gdb_ports(const std::vector<std::string>& 
         out.push_back(p);
     }
     return out;
+}
+
+}  // namespace
+
+std::optional<DebugOptions> debug_options(const DebugArgs& args) {
+    if (args.gdb.empty()) {
+        if (args.break_at_finding || !args.break_at.empty() || !args.break_at_cycle.empty()) {
+            throw BadInput("--break-at-finding, --break-at and --break-at-cycle need --gdb [MCU=]PORT");
+        }
+        return std::nullopt;
+    }
+    DebugOptions o;
+    o.ports = parse_gdb_ports(args.gdb);
+    o.break_at_finding = args.break_at_finding;
+    if (!args.break_at.empty()) o.break_at_ps = parse_duration_ps(args.break_at, "--break-at");
+    if (!args.break_at_cycle.empty()) {
+        std::size_t used = 0;
+        unsigned long long cycle = 0;
+        try {
+            cycle = std::stoull(args.break_at_cycle, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != args.break_at_cycle.size() || !std::isdigit(static_cast<unsigned char>(args.break_at_cycle[0]))) {
+            throw BadInput("--break-at-cycle '" + args.break_at_cycle + "': not a cycle number");
+        }
+        o.break_at_cycle = cycle;
+    }
+    o.announce = [](const std::string& line) {
+        std::fprintf(stderr, "%s\n", line.c_str());
+        std::fflush(stderr);
+    };
+    return o;
 }
 
 }  // namespace avrbench

@@ -4,6 +4,7 @@
 // events. One view per kind of run (verify/BoardRun, verify/McuRun).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,13 +12,22 @@
 
 namespace avrbench {
 
-class BoardRun;
+class Bench;
 class McuRun;
+class UartHost;
 
-DebugRunView board_debug_view(BoardRun& run, bool replayable);
+// `host`: the job's host for `monitor uart` (nullptr: none).
+DebugRunView board_debug_view(Bench& bench, const UartHost* host, bool replayable);
 DebugRunView mcu_debug_view(McuRun& run);
 
-// "--gdb [MCU=]PORT" items as ports (BadInput naming the item).
-std::vector<DebugOptions::Port> parse_gdb_ports(const std::vector<std::string>& items);
+// A front end's --gdb [MCU=]PORT items and --break-at-finding, --break-at
+// TIME and --break-at-cycle N as the debugger's options; nullopt without
+// --gdb (BadInput for a --break-at option without it, or a bad item).
+struct DebugArgs {
+    std::vector<std::string> gdb;
+    bool break_at_finding = false;
+    std::string break_at, break_at_cycle;
+};
+std::optional<DebugOptions> debug_options(const DebugArgs& args);
 
 }  // namespace avrbench

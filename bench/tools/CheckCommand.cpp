@@ -1,5 +1,6 @@
 // `avrbench check` and `avrbench golden update`: scenario files through
 // verify/ScenarioRun, JUnit for CI.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -10,6 +11,9 @@
 #include "core/UserStop.hpp"
 #include "tools/Commands.hpp"
 #include "trace/Junit.hpp"
+#include "debug/Debugger.hpp"
+#include "debug/RunViews.hpp"
+#include "verify/Bench.hpp"
 #include "verify/Scenario.hpp"
 
 namespace avrbench {
@@ -30,7 +34,47 @@ struct CheckArgs {
     std::string report_dir;
     std::string vcd_dir;
     std::string firmware_dir;
+    DebugArgs debug;                 // --gdb, --break-at...: one scenario under avr-gdb
+    bool break_at_divergence = false;
 };
+
+// `check --gdb`: one scenario run with avr-gdb attached (docs/DEBUGGING.md);
+// with --break-at-divergence it first runs undebugged to find where its
+// timeline leaves the golden, then stops there.
+int check_debugged(const CheckArgs& args, DebugOptions debug, const std::string& firmware_dir) {
+    if (args.scenarios.size() != 1) throw BadInput("--gdb: give one scenario (it runs under the debugger)");
+    const ScenarioSpec spec = load_scenario(args.scenarios.front(), firmware_dir);
+    ScenarioRunOptions options;
+    options.report_dir = args.report_dir;
+    options.vcd_dir = args.vcd_dir;
+    if (args.break_at_divergence) {
+        const ScenarioResult first = run_scenario(spec, ScenarioRunOptions{});
+        const ChannelResult* divergence = first.comparison ? first.comparison->first_divergence() : nullptr;
+        if (divergence == nullptr) {
+            std::fprintf(stderr, "avrbench: %s: the timeline does not leave its golden; no --break-at-divergence stop\n",
+                         spec.name.c_str());
+        } else {
+            debug.break_at_ps = static_cast<Picoseconds>(std::ceil(static_cast<long double>(divergence->divergence_cycle) *
+                                                                   static_cast<long double>(kPsPerSecond) /
+                                                                   divergence->clock_hz));
+            std::fprintf(stderr, "avrbench: %s: %s leaves the golden at %.9f s: stopping there\n", spec.name.c_str(),
+                         divergence->signal.c_str(), divergence->seconds());
+        }
+    }
+    Debugger debugger(debug);
+    debugger.listen();
+    options.prepared = [&debugger](Bench& bench) { debugger.attach(bench.board().mcus(), board_debug_view(bench, nullptr, true)); };
+    ScenarioResult result;
+    debugger.run_replays([&] { result = run_scenario(spec, options); });
+    debugger.detach();
+    debugger.run_ended();
+    std::fputs(result.text().c_str(), stdout);
+    if (debugger.killed()) {
+        std::fprintf(stderr, "avrbench: the debugger killed the program\n");
+        return kExitInterrupted;
+    }
+    return result.passed ? kExitOk : kExitFinding;
+}
 
 // GoogleTest's sharding variables, so a CI matrix splits scenario lists the
 // way it splits gtest binaries.
@@ -63,6 +107,8 @@ JunitCase junit_case(const ScenarioResult& r) {
 // failed (or, updating goldens, was refused), else 0.
 int check_command(const CheckArgs& args, bool update_golden) {
     const std::string firmware_dir = args.firmware_dir.empty() ? default_firmware_dir() : args.firmware_dir;
+    if (args.break_at_divergence && args.debug.gdb.empty()) throw BadInput("--break-at-divergence needs --gdb [MCU=]PORT");
+    if (auto debug = debug_options(args.debug)) return check_debugged(args, *debug, firmware_dir);
     // The report folder first: it is ours to create, and --junit may point into it.
     if (!args.report_dir.empty()) {
         std::error_code ec;
@@ -140,6 +186,13 @@ std::vector<Command> add_check_commands(CLI::App& app) {
     check_cmd->add_option("--vcd-dir", check.vcd_dir,
                           "write each scenario's waveforms here: <name>.vcd (sigrok-readable) and <name>.gtkw");
     check_cmd->add_option("--firmware-dir", check.firmware_dir, "where bare firmware names resolve (default: beside avrbench)");
+    check_cmd->add_option("--gdb", check.debug.gdb,
+                          "[MCU=]PORT: run the one scenario given with avr-gdb attached (as run --gdb; docs/DEBUGGING.md)");
+    check_cmd->add_flag("--break-at-finding", check.debug.break_at_finding, "--gdb: stop at each finding");
+    check_cmd->add_option("--break-at", check.debug.break_at, "--gdb: stop at the first instruction at or after this time");
+    check_cmd->add_option("--break-at-cycle", check.debug.break_at_cycle, "--gdb: stop at the first instruction at or after this cycle");
+    check_cmd->add_flag("--break-at-divergence", check.break_at_divergence,
+                        "--gdb: run the scenario once to find where it leaves its golden timeline, then debug it stopping there");
     CLI::App* golden_cmd = app.add_subcommand("golden", "manage golden timelines");
     golden_cmd->require_subcommand(1);
     CLI::App* update_cmd = golden_cmd->add_subcommand("update", "rerun scenarios and rewrite their golden timelines (never done implicitly)");

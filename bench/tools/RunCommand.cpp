@@ -76,37 +76,10 @@ struct RunArgs {
 
 // --gdb and the --break-at options as the debugger's options; nullopt without --gdb.
 std::optional<DebugOptions> debug_options(const RunArgs& args) {
-    if (args.gdb.empty()) {
-        if (args.break_at_finding || !args.break_at.empty() || !args.break_at_cycle.empty()) {
-            throw BadInput("--break-at-finding, --break-at and --break-at-cycle need --gdb [MCU=]PORT");
-        }
-        return std::nullopt;
-    }
-    if (!args.pty.empty() && args.pace == "realtime") {
+    if (!args.gdb.empty() && !args.pty.empty() && args.pace == "realtime") {
         throw BadInput("--gdb with --pace realtime: a stopped MCU would hold wall time back; debug at --pace free");
     }
-    DebugOptions o;
-    o.ports = parse_gdb_ports(args.gdb);
-    o.break_at_finding = args.break_at_finding;
-    if (!args.break_at.empty()) o.break_at_ps = parse_duration_ps(args.break_at, "--break-at");
-    if (!args.break_at_cycle.empty()) {
-        std::size_t used = 0;
-        unsigned long long cycle = 0;
-        try {
-            cycle = std::stoull(args.break_at_cycle, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used == 0 || used != args.break_at_cycle.size()) {
-            throw BadInput("--break-at-cycle '" + args.break_at_cycle + "': not a cycle number");
-        }
-        o.break_at_cycle = cycle;
-    }
-    o.announce = [](const std::string& line) {
-        std::fprintf(stderr, "%s\n", line.c_str());
-        std::fflush(stderr);
-    };
-    return o;
+    return debug_options(DebugArgs{args.gdb, args.break_at_finding, args.break_at, args.break_at_cycle});
 }
 
 // The verdict of a debugged run: a debugger that killed the program interrupted it.
@@ -273,7 +246,7 @@ int run_board_command(const RunArgs& args) {
         debugger.run_replays([&] {
             run.reset();
             run = std::make_unique<BoardRun>(options);
-            debugger.attach(run->bench().board().mcus(), board_debug_view(*run, !options.pty.has_value()));
+            debugger.attach(run->bench().board().mcus(), board_debug_view(run->bench(), run->host(), !options.pty.has_value()));
             run->run();
         });
         debugger.detach();

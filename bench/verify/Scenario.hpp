@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -29,6 +30,10 @@
 #include "core/Time.hpp"
 #include "stimulus/BenchSteps.hpp"
 #include "verify/TimelineCompare.hpp"
+
+namespace avrbench {
+class Bench;
+}
 
 namespace avrbench {
 
@@ -117,6 +122,9 @@ struct ScenarioRunOptions {
     std::string vcd_dir;         // write <vcd_dir>/<name>.vcd and .gtkw when set
     bool update_golden = false;  // write the golden timeline instead of comparing
     bool force = false;          // update_golden: also when steps or expectations failed
+    // Called once the board is built and traced, before the first step (a
+    // debugger attaches to its MCUs here; `avrbench check --gdb`).
+    std::function<void(Bench&)> prepared;
 };
 
 // Runs the scenario. Throws BadInput only for problems that show when the

@@ -456,6 +456,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
             },
             e.action);
     }
+    if (options.prepared) options.prepared(bench);
     auto fail = [&](const std::string& message) {
         result.failures.push_back(message);
         result.expectation_failures.push_back(message);

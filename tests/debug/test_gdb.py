@@ -214,6 +214,44 @@ class GdbTests(unittest.TestCase):
         self.assertIn("MCU right:", out_right)
         self.assertEqual(rc, 0, err + summary)
 
+    def test_check_stops_where_a_scenario_leaves_its_golden(self):
+        """blink_timer1's scenario against its golden with PB5's first rise
+        moved 10 cycles later: check --gdb --break-at-divergence stops in
+        front of the instruction that makes that edge: the ISR's write of PINB
+        (I/O 0x03), found with avr-objdump."""
+        import tempfile
+        root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+        target = elf("blink_timer1")
+        toggle = [a for a, op, args in disassembly_of(target, "__vector_11") if op == "out" and args.startswith("0x03,")]
+        self.assertEqual(len(toggle), 1)
+        with tempfile.TemporaryDirectory() as folder:
+            with open(os.path.join(root, "tests", "scenarios", "blink_timer1.yaml")) as f:
+                scenario = f.read()
+            scenario = scenario.replace("board: ../../bench/boards/arduino-uno.yaml",
+                                        "board: " + os.path.join(root, "bench", "boards", "arduino-uno.yaml"))
+            scenario = scenario.replace("golden: ../../golden/blink_timer1.timeline", "golden: moved.timeline")
+            with open(os.path.join(root, "golden", "blink_timer1.timeline")) as f:
+                golden = f.read()
+            self.assertIn("\n+16051 1\n", golden)
+            with open(os.path.join(folder, "blink.yaml"), "w") as f:
+                f.write(scenario)
+            with open(os.path.join(folder, "moved.timeline"), "w") as f:
+                f.write(golden.replace("\n+16051 1\n", "\n+16061 1\n", 1))
+            proc = subprocess.Popen([CLI, "check", os.path.join(folder, "blink.yaml"), "--firmware-dir", FIRMWARE,
+                                     "--gdb", "0", "--break-at-divergence"], stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True)
+            port = None
+            while port is None:
+                line = proc.stderr.readline()
+                self.assertTrue(line, "no gdb port announced")
+                m = re.search(r"127\.0\.0\.1:(\d+)", line)
+                port = int(m.group(1)) if m else None
+            out = gdb(port, target, ["continue", "print $pc", "monitor time", "detach"])
+            summary, err = proc.communicate(timeout=GUARD_S)
+        self.assertEqual(pcs(out), toggle, out)
+        self.assertIn("cycle 16051,", out)  # the golden's edge was at 16051 before it was moved
+        self.assertEqual(proc.returncode, 1, summary + err)  # the scenario still fails its golden
+
     def test_malformed_packets_get_answers_and_the_run_goes_on(self):
         """A client that is not avr-gdb: every packet gets a reply (an error
         or the empty "unsupported" one), nothing ends the run, and after a
