@@ -55,6 +55,12 @@ set(CPACK_STRIP_FILES ON)
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_COMPONENTS_GROUPING ALL_COMPONENTS_IN_ONE)
 set(CPACK_COMPONENTS_ALL cli fuzz docs examples)
+if(TARGET _avrbench)
+  # The Python module in /usr/lib/python3/dist-packages: built for Debian's python3 (3.11).
+  list(APPEND CPACK_COMPONENTS_ALL python)
+  math(EXPR avrbench_python_next "${Python_VERSION_MINOR} + 1")
+  set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3 (>= ${Python_VERSION_MAJOR}.${Python_VERSION_MINOR}), python3 (<< ${Python_VERSION_MAJOR}.${avrbench_python_next})")
+endif()
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION electronics)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
@@ -64,7 +70,7 @@ set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
 # `avrbench fuzz --engine afl` runs afl-fuzz; the firmware a user tests is
 # built with Debian's AVR toolchain, which avrbench itself never calls.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "gcc-avr, avr-libc, binutils-avr")
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "gcc-avr, avr-libc, binutils-avr, python3-numpy, python3-pytest")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "afl++, gtkwave, sigrok-cli, gdb-avr")
 include(CPack)
 
@@ -74,6 +80,9 @@ add_custom_target(deb
   COMMENT "cpack -G DEB: the CLI, the fuzz targets, docs and examples"
   USES_TERMINAL)
 add_dependencies(deb avrbench)
+if(TARGET _avrbench)
+  add_dependencies(deb _avrbench)
+endif()
 if(TARGET avrbench_fuzzers)
   add_dependencies(deb avrbench_fuzzers)
 endif()
