@@ -481,163 +481,164 @@ std::string Debugger::monitor(Target& t, const std::string& command) {
     return "unknown monitor command '" + command + "' (monitor help lists them)\n";
 }
 
-bool Debugger::handle(Target& t, const std::string& p) {
+// Registers: g, G, p, P. Returns the reply.
+std::string Debugger::handle_registers(Target& t, const std::string& p) {
+    if (p[0] == 'g') return to_hex(read_registers(t));
+    if (p[0] == 'G') {
+        const std::string bytes = from_hex(p.substr(1));
+        if (bytes.size() < 35) return "E01";
+        for (unsigned n = 0; n < 32; ++n) write_register(t, n, bytes.substr(n, 1), true);
+        write_register(t, kSregNumber, bytes.substr(32, 1), true);
+        write_register(t, kSpNumber, bytes.substr(33, 2), true);
+        if (bytes.size() >= 39) write_register(t, kPcNumber, bytes.substr(35, 4), true);
+        return "OK";
+    }
+    std::size_t at = 1;
+    const unsigned n = parse_hex(p, at);
+    if (n > kPcNumber) return "E01";
+    if (p[0] == 'p') {
+        const std::string regs = read_registers(t);
+        const std::size_t offset = n < 33 ? n : n == kSpNumber ? 33 : 35;
+        const std::size_t size = n < 33 ? 1 : n == kSpNumber ? 2 : 4;
+        return to_hex(regs.substr(offset, size));
+    }
+    write_register(t, n, from_hex(p.substr(std::min(p.size(), at + 1))), true);
+    return "OK";
+}
+
+// Memory: m, M, X. Returns the reply.
+std::string Debugger::handle_memory(Target& t, const std::string& p) {
+    std::size_t at = 1;
+    const std::uint32_t address = parse_hex(p, at);
+    ++at;
+    if (p[0] == 'm') {
+        const std::uint32_t length = std::min<std::uint32_t>(parse_hex(p, at), 2048);
+        const std::string bytes = read_memory(t, address, length);
+        return bytes.empty() && length > 0 ? "E01" : to_hex(bytes);
+    }
+    const std::uint32_t length = parse_hex(p, at);
+    const std::string data = p.substr(std::min(p.size(), at + 1));
+    const std::string bytes = p[0] == 'M' ? from_hex(data) : data;
+    return bytes.size() == length && write_memory(t, address, bytes, true) ? "OK" : "E01";
+}
+
+// Breakpoints and watchpoints: Z and z. Returns the reply ("" unsupported).
+std::string Debugger::handle_breakpoints(Target& t, const std::string& p) {
+    std::size_t at = 3;
+    const char type = p.size() > 1 ? p[1] : '?';
+    const std::uint32_t address = parse_hex(p, at);
+    ++at;
+    const std::uint32_t length = parse_hex(p, at);
+    const bool insert = p[0] == 'Z';
+    if (type == '0' || type == '1') {
+        if (insert) {
+            t.breakpoints.insert(address);
+        } else {
+            t.breakpoints.erase(address);
+        }
+        return "OK";
+    }
+    if (type < '2' || type > '4' || address < kDataBase || address >= kDataBase + kSpaceSize) return "";
+    const Target::Watch w{address - kDataBase, std::max<std::uint32_t>(length, 1), type};
+    if (insert) {
+        t.watches.push_back(w);
+    } else {
+        std::erase_if(t.watches, [&w](const Target::Watch& x) {
+            return x.address == w.address && x.length == w.length && x.type == w.type;
+        });
+    }
+    return "OK";
+}
+
+// Queries and settings (q..., Q..., v...): the reply ("" unsupported).
+std::string Debugger::handle_query(Target& t, const std::string& p) {
+    GdbConnection& c = *t.conn;
+    if (p.rfind("qSupported", 0) == 0) return "PacketSize=1000;QStartNoAckMode+;ReverseStep+;ReverseContinue+";
+    if (p == "QStartNoAckMode") {
+        c.send_packet("OK");
+        c.set_no_ack();
+        return {};  // answered before the mode changed
+    }
+    if (p == "qAttached") return "1";
+    if (p == "qC") return "QC1";
+    if (p == "qfThreadInfo") return "m1";
+    if (p == "qsThreadInfo") return "l";
+    if (p.rfind("qSymbol", 0) == 0) return "OK";
+    if (p.rfind("qRcmd,", 0) == 0) {
+        c.send_packet("O" + to_hex(monitor(t, from_hex(p.substr(6)))));
+        return "OK";
+    }
+    return "";
+}
+
+// Run control: c, s, bs, bc, D, k, vKill. False: the target runs again.
+bool Debugger::handle_run_control(Target& t, const std::string& p) {
     GdbConnection& c = *t.conn;
     const auto resume = [&t] {
         t.waiting = true;
         t.finding.reset();
         t.resumed_at = t.executed;
     };
+    if (p[0] == 'c') {
+        if (p.size() > 1) {  // continue at an address: a write of PC, made again by replays
+            std::size_t at = 1;
+            const std::uint32_t pc = parse_hex(p, at);
+            write_register(t, kPcNumber, std::string{static_cast<char>(pc & 0xFF), static_cast<char>((pc >> 8) & 0xFF),
+                                                     static_cast<char>((pc >> 16) & 0xFF)},
+                           true);
+        }
+        resume();
+        return false;
+    }
+    if (p[0] == 's') {
+        resume();
+        t.stop_at = t.executed + 1;
+        return false;
+    }
+    if (p == "bs" || p == "bc") {
+        if (t.executed == 0) {
+            c.send_packet("T05replaylog:begin;");
+            return true;
+        }
+        replay_to(t, p == "bs" ? t.executed - 1 : t.executed, p == "bc");
+        return true;  // not replayable: it said so and stays stopped
+    }
+    if (p[0] == 'D') {
+        c.send_packet("OK");
+        t.detached = true;
+        t.breakpoints.clear();
+        t.watches.clear();
+        c.close();
+        return false;
+    }
+    // k, vKill: the program ends (the run stops as at a Ctrl-C).
+    if (p[0] == 'v') c.send_packet("OK");
+    killed_ = true;
+    for (auto& other : targets_) other->detached = true;
+    request_user_stop();
+    t.mcu->request_stop();
+    c.close();
+    return false;
+}
+
+bool Debugger::handle(Target& t, const std::string& p) {
+    GdbConnection& c = *t.conn;
     if (p == "\x03") return true;  // already stopped
     switch (p[0]) {
         case '?': c.send_packet(t.last_reply); return true;
-        case 'g': c.send_packet(to_hex(read_registers(t))); return true;
-        case 'G': {
-            const std::string bytes = from_hex(p.substr(1));
-            if (bytes.size() < 35) {
-                c.send_packet("E01");
-                return true;
-            }
-            for (unsigned n = 0; n < 32; ++n) write_register(t, n, bytes.substr(n, 1), true);
-            write_register(t, kSregNumber, bytes.substr(32, 1), true);
-            write_register(t, kSpNumber, bytes.substr(33, 2), true);
-            if (bytes.size() >= 39) write_register(t, kPcNumber, bytes.substr(35, 4), true);
-            c.send_packet("OK");
-            return true;
-        }
-        case 'p': {
-            std::size_t at = 1;
-            const unsigned n = parse_hex(p, at);
-            const std::string regs = read_registers(t);
-            const std::size_t offset = n < 33 ? n : n == kSpNumber ? 33 : 35;
-            const std::size_t size = n < 33 ? 1 : n == kSpNumber ? 2 : 4;
-            c.send_packet(n <= kPcNumber ? to_hex(regs.substr(offset, size)) : "E01");
-            return true;
-        }
-        case 'P': {
-            std::size_t at = 1;
-            const unsigned n = parse_hex(p, at);
-            write_register(t, n, from_hex(p.substr(std::min(p.size(), at + 1))), true);
-            c.send_packet(n <= kPcNumber ? "OK" : "E01");
-            return true;
-        }
-        case 'm': {
-            std::size_t at = 1;
-            const std::uint32_t address = parse_hex(p, at);
-            ++at;
-            const std::uint32_t length = std::min<std::uint32_t>(parse_hex(p, at), 2048);
-            const std::string bytes = read_memory(t, address, length);
-            c.send_packet(bytes.empty() && length > 0 ? "E01" : to_hex(bytes));
-            return true;
-        }
-        case 'M':
-        case 'X': {
-            std::size_t at = 1;
-            const std::uint32_t address = parse_hex(p, at);
-            ++at;
-            const std::uint32_t length = parse_hex(p, at);
-            const std::string data = p.substr(std::min(p.size(), at + 1));
-            const std::string bytes = p[0] == 'M' ? from_hex(data) : data;
-            c.send_packet(bytes.size() == length && write_memory(t, address, bytes, true) ? "OK" : "E01");
-            return true;
-        }
-        case 'Z':
-        case 'z': {
-            std::size_t at = 3;
-            const char type = p.size() > 1 ? p[1] : '?';
-            const std::uint32_t address = parse_hex(p, at);
-            ++at;
-            const std::uint32_t length = parse_hex(p, at);
-            const bool insert = p[0] == 'Z';
-            if (type == '0' || type == '1') {
-                if (insert) {
-                    t.breakpoints.insert(address);
-                } else {
-                    t.breakpoints.erase(address);
-                }
-            } else if (type >= '2' && type <= '4' && address >= kDataBase && address < kDataBase + kSpaceSize) {
-                const Target::Watch w{address - kDataBase, std::max<std::uint32_t>(length, 1), type};
-                if (insert) {
-                    t.watches.push_back(w);
-                } else {
-                    std::erase_if(t.watches, [&w](const Target::Watch& x) {
-                        return x.address == w.address && x.length == w.length && x.type == w.type;
-                    });
-                }
-            } else {
-                c.send_packet("");  // not supported: gdb falls back (or says so)
-                return true;
-            }
-            c.send_packet("OK");
-            return true;
-        }
-        case 'c':
-            if (p.size() > 1) {  // continue at an address: a write of PC, made again by replays
-                std::size_t at = 1;
-                const std::uint32_t pc = parse_hex(p, at);
-                write_register(t, kPcNumber, std::string{static_cast<char>(pc & 0xFF), static_cast<char>((pc >> 8) & 0xFF),
-                                                         static_cast<char>((pc >> 16) & 0xFF)},
-                               true);
-            }
-            resume();
-            return false;
-        case 's':
-            resume();
-            t.stop_at = t.executed + 1;
-            return false;
+        case 'g': case 'G': case 'p': case 'P': c.send_packet(handle_registers(t, p)); return true;
+        case 'm': case 'M': case 'X': c.send_packet(handle_memory(t, p)); return true;
+        case 'Z': case 'z': c.send_packet(handle_breakpoints(t, p)); return true;
+        case 'c': case 's': case 'D': case 'k': return handle_run_control(t, p);
         case 'b':
-            if (p == "bs" || p == "bc") {
-                if (t.executed == 0) {
-                    c.send_packet("T05replaylog:begin;");
-                    return true;
-                }
-                replay_to(t, p == "bs" ? t.executed - 1 : t.executed, p == "bc");
-                return true;  // not replayable: it said so and stays stopped
-            }
+            if (p == "bs" || p == "bc") return handle_run_control(t, p);
             break;
-        case 'D':
-            c.send_packet("OK");
-            t.detached = true;
-            t.breakpoints.clear();
-            t.watches.clear();
-            c.close();
-            return false;
-        case 'k':
-            killed_ = true;
-            for (auto& other : targets_) other->detached = true;
-            request_user_stop();
-            t.mcu->request_stop();
-            c.close();
-            return false;
-        case 'H': c.send_packet("OK"); return true;
-        case 'T': c.send_packet("OK"); return true;
+        case 'H': case 'T': c.send_packet("OK"); return true;
         default: break;
     }
-    if (p.rfind("qSupported", 0) == 0) {
-        c.send_packet("PacketSize=1000;QStartNoAckMode+;ReverseStep+;ReverseContinue+");
-    } else if (p == "QStartNoAckMode") {
-        c.send_packet("OK");
-        c.set_no_ack();
-    } else if (p == "qAttached") {
-        c.send_packet("1");
-    } else if (p == "qC") {
-        c.send_packet("QC1");
-    } else if (p == "qfThreadInfo") {
-        c.send_packet("m1");
-    } else if (p == "qsThreadInfo") {
-        c.send_packet("l");
-    } else if (p.rfind("qSymbol", 0) == 0) {
-        c.send_packet("OK");
-    } else if (p.rfind("qRcmd,", 0) == 0) {
-        const std::string out = monitor(t, from_hex(p.substr(6)));
-        c.send_packet("O" + to_hex(out));
-        c.send_packet("OK");
-    } else if (p == "vKill;1" || p.rfind("vKill", 0) == 0) {
-        c.send_packet("OK");
-        return handle(t, "k");
-    } else {
-        c.send_packet("");  // unsupported, as the protocol says to answer
-    }
+    if (p.rfind("vKill", 0) == 0) return handle_run_control(t, p);
+    const std::string reply = handle_query(t, p);
+    if (p != "QStartNoAckMode") c.send_packet(reply);
     return true;
 }
 

@@ -94,6 +94,11 @@ private:
     Target* target_of(Mcu& mcu);
     void serve(Target& t, const std::string& stop_reply);
     bool handle(Target& t, const std::string& packet);  // false: the target runs again
+    std::string handle_registers(Target& t, const std::string& packet);
+    std::string handle_memory(Target& t, const std::string& packet);
+    std::string handle_breakpoints(Target& t, const std::string& packet);
+    std::string handle_query(Target& t, const std::string& packet);
+    bool handle_run_control(Target& t, const std::string& packet);
     std::string read_registers(Target& t) const;
     void write_register(Target& t, unsigned number, const std::string& bytes, bool record);
     std::string read_memory(Target& t, std::uint32_t address, std::uint32_t length) const;

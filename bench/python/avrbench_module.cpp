@@ -251,23 +251,9 @@ py::dict part_signals(Part& p) {
 }
 
 }  // namespace
-}  // namespace avrbench
 
-PYBIND11_MODULE(_avrbench, m) {
-    using namespace avrbench;
-    m.doc() = "avrbench's library for Python (docs/PYTHON.md); use the avrbench package, not this module";
-    static py::exception<BadInput> bad_input(m, "BadInput");
-    static py::exception<Timeout> timeout(m, "Timeout");
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const Timeout& e) {
-            PyErr_SetString(timeout.ptr(), e.what());
-        } catch (const BadInput& e) {
-            PyErr_SetString(bad_input.ptr(), e.what());
-        }
-    });
-
+// The Python classes, one function each.
+void bind_finding(py::module_& m) {
     py::class_<Finding>(m, "Finding")
         .def_property_readonly("kind", [](const Finding& f) { return f.kind.name(); })
         .def_property_readonly("severity", [](const Finding& f) { return std::string(to_string(f.kind.severity())); })
@@ -279,7 +265,9 @@ PYBIND11_MODULE(_avrbench, m) {
         .def_readonly("detail", &Finding::detail)
         .def("__str__", &Finding::describe)
         .def("__repr__", [](const Finding& f) { return "<avrbench.Finding " + f.describe() + ">"; });
+}
 
+void bind_mcu(py::module_& m) {
     py::class_<Mcu, std::unique_ptr<Mcu, py::nodelete>>(m, "Mcu")
         .def_property_readonly("name", &Mcu::name)
         .def_property_readonly("type", &Mcu::mcu_type)
@@ -309,7 +297,9 @@ PYBIND11_MODULE(_avrbench, m) {
                      mcu.poke(static_cast<std::uint32_t>(*at - 0x800000 + i), static_cast<std::uint8_t>(bytes[i]));
                  }
              }, py::arg("symbol"), py::arg("data"));
+}
 
+void bind_part(py::module_& m) {
     py::class_<Part, std::unique_ptr<Part, py::nodelete>>(m, "Part")
         .def_property_readonly("name", &Part::name)
         .def_property_readonly("signals", [](Part& p) { return part_signals(p); })
@@ -324,14 +314,18 @@ PYBIND11_MODULE(_avrbench, m) {
             for (const auto& s : p.signals()) names += (names.empty() ? "" : ", ") + s.name;
             throw BadInput("part " + p.name() + " has no signal '" + name + "' (it has " + (names.empty() ? "none" : names) + ")");
         });
+}
 
+void bind_serial(py::module_& m) {
     py::class_<PySerial>(m, "Serial")
         .def("write", &PySerial::write)
         .def("read_line", &PySerial::read_line, py::arg("timeout") = py::str("1s"))
         .def("expect", &PySerial::expect, py::arg("pattern"), py::arg("timeout") = py::str("1s"))
         .def("stream_gcode", &PySerial::stream_gcode, py::arg("path"), py::arg("family") = "", py::arg("flow") = "")
         .def_property_readonly("received", &PySerial::received);
+}
 
+void bind_bench(py::module_& m) {
     py::class_<PyBench>(m, "Bench")
         .def(py::init<const std::string&, std::map<std::string, std::string>, std::string, std::string, bool>(),
              py::arg("board"), py::arg("firmware"), py::arg("vcd") = "", py::arg("report") = "", py::arg("profile") = false)
@@ -368,4 +362,28 @@ PYBIND11_MODULE(_avrbench, m) {
         .def("timeline_text", &PyBench::timeline_text)
         .def("profile_json", &PyBench::profile_json)
         .def("close", &PyBench::close, py::arg("write") = true);
+}
+
+}  // namespace avrbench
+
+PYBIND11_MODULE(_avrbench, m) {
+    using namespace avrbench;
+    m.doc() = "avrbench's library for Python (docs/PYTHON.md); use the avrbench package, not this module";
+    static py::exception<BadInput> bad_input(m, "BadInput");
+    static py::exception<Timeout> timeout(m, "Timeout");
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Timeout& e) {
+            PyErr_SetString(timeout.ptr(), e.what());
+        } catch (const BadInput& e) {
+            PyErr_SetString(bad_input.ptr(), e.what());
+        }
+    });
+
+    avrbench::bind_finding(m);
+    avrbench::bind_mcu(m);
+    avrbench::bind_part(m);
+    avrbench::bind_serial(m);
+    avrbench::bind_bench(m);
 }
