@@ -282,180 +282,212 @@ void write_timeline_text(const Timeline& timeline, const TimelineHeader& header,
 // belongs in a golden of selected signals (golden_signals) or a window rule.
 constexpr std::uint64_t kMaxGoldenEvents = 50'000'000;
 
-ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source, double stop_after_s) {
-    ParsedTimeline parsed;
-    std::istringstream in(text);
-    std::string line;
-    int line_no = 0;
-    auto fail = [&](const std::string& what) { throw BadInput(escaped(source) + ":" + std::to_string(line_no) + ": " + escaped(what)); };
-    // Every word of a line is read or the line is refused: nothing is dropped.
-    auto no_more = [&](std::istringstream& words, const char* what) {
+namespace {
+
+// The golden-timeline text parser: one method per kind of line. Every word
+// of a line is read or the line is refused; errors name source:line.
+class TimelineTextParser {
+public:
+    TimelineTextParser(const std::string& text, const std::string& source, double stop_after_s)
+        : in_(text), source_(source), stop_after_s_(stop_after_s) {}
+
+    ParsedTimeline parse() {
+        if (!next_line() || line_ != "avrbench-timeline 1") fail("not an avrbench timeline (expected 'avrbench-timeline 1')");
+        while (next_line()) {
+            if (line_.empty()) continue;
+            std::istringstream ls(line_);
+            std::string word;
+            ls >> word;
+            if (word == "bench") {
+                if (!(ls >> parsed_.header.bench_version)) fail("'bench' needs the version that wrote the file");
+                no_more(ls, "the bench version");
+            } else if (word == "input") {
+                TimelineInput input;
+                if (!(ls >> input.role >> input.sha256)) fail("'input' needs a role, a SHA-256 and a path");
+                std::getline(ls >> std::ws, input.path);
+                parsed_.header.inputs.push_back(input);
+            } else if (word == "end") {
+                parse_end(ls);
+            } else if (word == "signal") {
+                parse_signal(ls);
+            } else if (word[0] == '@') {
+                begin_events(word.substr(1), ls);
+            } else if (current_ < 0) {
+                fail("unexpected '" + line_ + "'");
+            } else if (word[0] == '*') {
+                parse_repeat(word, ls);
+            } else {
+                std::string value;
+                if (!(ls >> value)) fail("'" + word + "' has no value");
+                no_more(ls, "a change");
+                record(word[0] == '+' ? last_cycle_ + parse_cycles(word.substr(1)) : parse_cycles(word), value);
+            }
+        }
+        return std::move(parsed_);
+    }
+
+private:
+    [[noreturn]] void fail(const std::string& what) const {
+        throw BadInput(escaped(source_) + ":" + std::to_string(line_no_) + ": " + escaped(what));
+    }
+    void no_more(std::istringstream& words, const char* what) const {
         std::string extra;
         if (words >> extra) fail("'" + extra + "' after " + what + " (one item per line)");
-    };
-    auto next_line = [&]() -> bool {
-        while (std::getline(in, line)) {
-            ++line_no;
-            if (!line.empty() && line.back() == '\r') line.pop_back();
-            return true;
-        }
-        return false;
-    };
-    if (!next_line() || line != "avrbench-timeline 1") fail("not an avrbench timeline (expected 'avrbench-timeline 1')");
-    long current = -1;
-    Cycle last_cycle = 0;
-    std::uint64_t events = 0;
-    auto parse_u64 = [&](const std::string& s) -> std::uint64_t {
+    }
+    bool next_line() {
+        if (!std::getline(in_, line_)) return false;
+        ++line_no_;
+        if (!line_.empty() && line_.back() == '\r') line_.pop_back();
+        return true;
+    }
+    std::uint64_t parse_u64(const std::string& s) const {
         std::uint64_t v = 0;
         auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
         if (ec != std::errc() || end != s.data() + s.size()) fail("'" + s + "' is not a whole number");
         return v;
-    };
+    }
     // A cycle count or a cycle delta: bounded so that sums never wrap.
-    auto parse_cycles = [&](const std::string& s) -> Cycle {
+    Cycle parse_cycles(const std::string& s) const {
         const std::uint64_t v = parse_u64(s);
         if (v > (std::uint64_t{1} << 53)) fail("cycle count " + s + " is past any run's end");
         return v;
-    };
-    // Where this signal's events stop being kept: its clock's cycle at the
-    // golden's own end (an event after it is malformed) and at stop_after_s
-    // (the run compared with it ended there: a later event is kept once, to
-    // show the difference, and the rest not even expanded).
-    Cycle end_bound = std::numeric_limits<Cycle>::max(), stop_bound = std::numeric_limits<Cycle>::max();
-    bool stopped = false;  // this signal passed stop_bound
-    auto record = [&](Cycle cycle, const std::string& value) {
-        // 10^6 s at 64 MHz is 6.4e13 cycles; 2^53 bounds the sums below too.
-        if (cycle > (std::uint64_t{1} << 53)) fail("cycle " + std::to_string(cycle) + " is past any run's end");
-        if (cycle > end_bound) fail("cycle " + std::to_string(cycle) + " is after the timeline's end");
-        if (stopped) {
-            last_cycle = cycle;
-            return;
+    }
+
+    void parse_end(std::istringstream& ls) {
+        std::string c, f;
+        if (!(ls >> c >> f)) fail("'end' needs a cycle and a clock in Hz");
+        no_more(ls, "the end cycle and clock");
+        parsed_.header.end_cycle = parse_cycles(c);
+        const std::uint64_t hz = parse_u64(f);
+        if (hz == 0 || hz > 64'000'000) fail("end clock " + f + " Hz is not 1 Hz .. 64 MHz");
+        if (parsed_.header.end_cycle > hz * 1'000'000ULL) fail("end " + c + " is past 10^6 s at " + f + " Hz");
+        parsed_.header.end_clock_hz = static_cast<std::uint32_t>(hz);
+    }
+
+    void parse_signal(std::istringstream& ls) {
+        std::string name, kind, width, clock;
+        if (!(ls >> name >> kind >> width >> clock)) fail("'signal' needs scope.name, kind, width and clock");
+        no_more(ls, "the signal's clock");
+        const auto dot = name.find('.');
+        if (dot == std::string::npos) fail("signal '" + name + "' has no scope");
+        SignalInfo info;
+        info.scope = name.substr(0, dot);
+        info.name = name.substr(dot + 1);
+        if (kind == "wire") info.kind = SignalKind::Wire;
+        else if (kind == "bus") info.kind = SignalKind::Bus;
+        else if (kind == "real") info.kind = SignalKind::Real;
+        else fail("unknown signal kind '" + kind + "'");
+        const std::uint64_t bits = info.kind == SignalKind::Real ? 1 : parse_u64(width);
+        if (info.kind == SignalKind::Wire && bits != 1) fail("a wire is 1 bit wide, not " + width);
+        if (bits < 1 || bits > 64) fail("bus width " + width + " is not 1..64");
+        info.width = static_cast<unsigned>(bits);
+        const std::uint64_t hz = parse_u64(clock);
+        if (hz == 0 || hz > 64'000'000) fail("clock " + clock + " Hz is not 1 Hz .. 64 MHz");
+        info.clock_hz = static_cast<std::uint32_t>(hz);
+        if (info.scope.empty() || info.name.empty()) fail("signal '" + name + "' has an empty scope or name");
+        if (parsed_.timeline.find(info.scope, info.name) >= 0) fail("signal '" + name + "' is declared twice");
+        try {
+            parsed_.timeline.add_signal(info);
+        } catch (const std::invalid_argument& e) {
+            fail(e.what());
         }
-        stopped = cycle > stop_bound;
-        if (++events > kMaxGoldenEvents) {
+    }
+
+    // "@scope.name": the events that follow are this signal's.
+    void begin_events(const std::string& name, std::istringstream& ls) {
+        const auto dot = name.find('.');
+        current_ = dot == std::string::npos ? -1 : parsed_.timeline.find(name.substr(0, dot), name.substr(dot + 1));
+        if (current_ < 0) fail("events for undeclared signal '" + name + "'");
+        no_more(ls, "the signal's name");
+        last_cycle_ = 0;
+        stopped_ = false;
+        // The bounds in this signal's clock (end cycle x clock / end clock, exact enough: whole cycles).
+        const double hz = parsed_.timeline.signals()[static_cast<std::size_t>(current_)].clock_hz;
+        end_bound_ = parsed_.header.end_clock_hz == 0
+                         ? std::numeric_limits<Cycle>::max()
+                         : static_cast<Cycle>(std::ceil(static_cast<double>(parsed_.header.end_cycle) * hz / parsed_.header.end_clock_hz));
+        stop_bound_ = stop_after_s_ > 0 ? static_cast<Cycle>(std::ceil(stop_after_s_ * hz)) : std::numeric_limits<Cycle>::max();
+    }
+
+    // "*n +d v +d v ...": the block of deltas and values n times.
+    void parse_repeat(const std::string& word, std::istringstream& ls) {
+        const std::uint64_t repeats = parse_u64(word.substr(1));
+        if (repeats > kMaxGoldenEvents) fail("repeat count " + word.substr(1) + " is more than the events a golden may hold");
+        std::vector<std::pair<Cycle, std::string>> block;
+        std::string delta, value;
+        while (ls >> delta) {
+            if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs, not '" + delta + "'");
+            if (!(ls >> value)) fail("repeat block: '" + delta + "' has no value");
+            block.emplace_back(parse_cycles(delta.substr(1)), value);
+        }
+        if (block.empty()) fail("empty repeat block");
+        // Checked before expanding, so an oversized block allocates nothing.
+        if (repeats > (kMaxGoldenEvents - events_) / block.size()) {
             fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
         }
-        const SignalInfo& info = parsed.timeline.signals()[static_cast<std::size_t>(current)];
+        Cycle block_cycles = 0;
+        for (const auto& [d, v] : block) block_cycles += d;
+        for (std::uint64_t r = 0; r < repeats; ++r) {
+            for (const auto& [d, v] : block) record(last_cycle_ + d, v);
+            if (stopped_) {
+                // Past the compared run's end: what is left only moves the
+                // clock on (and is checked against the timeline's end).
+                const std::uint64_t left = repeats - r - 1;
+                if (block_cycles != 0 && left > ((std::uint64_t{1} << 53) - last_cycle_) / block_cycles) {
+                    fail("the repeat runs past any run's end");
+                }
+                last_cycle_ += left * block_cycles;
+                if (last_cycle_ > end_bound_) fail("cycle " + std::to_string(last_cycle_) + " is after the timeline's end");
+                break;
+            }
+        }
+    }
+
+    void record(Cycle cycle, const std::string& value) {
+        // 10^6 s at 64 MHz is 6.4e13 cycles; 2^53 bounds the sums below too.
+        if (cycle > (std::uint64_t{1} << 53)) fail("cycle " + std::to_string(cycle) + " is past any run's end");
+        if (cycle > end_bound_) fail("cycle " + std::to_string(cycle) + " is after the timeline's end");
+        if (stopped_) {
+            last_cycle_ = cycle;
+            return;
+        }
+        stopped_ = cycle > stop_bound_;
+        if (++events_ > kMaxGoldenEvents) {
+            fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
+        }
+        const SignalInfo& info = parsed_.timeline.signals()[static_cast<std::size_t>(current_)];
         if (info.kind == SignalKind::Real) {
             double v = 0;
             auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
             if (ec != std::errc() || end != value.data() + value.size()) fail("'" + value + "' is not a number");
-            parsed.timeline.record_real(static_cast<SignalId>(current), cycle, v);
+            parsed_.timeline.record_real(static_cast<SignalId>(current_), cycle, v);
         } else {
-            parsed.timeline.record(static_cast<SignalId>(current), cycle, parse_u64(value));
+            parsed_.timeline.record(static_cast<SignalId>(current_), cycle, parse_u64(value));
         }
-        last_cycle = cycle;
-    };
-    while (next_line()) {
-        if (line.empty()) continue;
-        std::istringstream ls(line);
-        std::string word;
-        ls >> word;
-        if (word == "bench") {
-            if (!(ls >> parsed.header.bench_version)) fail("'bench' needs the version that wrote the file");
-            no_more(ls, "the bench version");
-        } else if (word == "input") {
-            TimelineInput input;
-            if (!(ls >> input.role >> input.sha256)) fail("'input' needs a role, a SHA-256 and a path");
-            std::getline(ls >> std::ws, input.path);
-            parsed.header.inputs.push_back(input);
-        } else if (word == "end") {
-            std::string c, f;
-            if (!(ls >> c >> f)) fail("'end' needs a cycle and a clock in Hz");
-            no_more(ls, "the end cycle and clock");
-            parsed.header.end_cycle = parse_cycles(c);
-            const std::uint64_t hz = parse_u64(f);
-            if (hz == 0 || hz > 64'000'000) fail("end clock " + f + " Hz is not 1 Hz .. 64 MHz");
-            if (parsed.header.end_cycle > hz * 1'000'000ULL) fail("end " + c + " is past 10^6 s at " + f + " Hz");
-            parsed.header.end_clock_hz = static_cast<std::uint32_t>(hz);
-        } else if (word == "signal") {
-            std::string name, kind, width, clock;
-            if (!(ls >> name >> kind >> width >> clock)) fail("'signal' needs scope.name, kind, width and clock");
-            no_more(ls, "the signal's clock");
-            const auto dot = name.find('.');
-            if (dot == std::string::npos) fail("signal '" + name + "' has no scope");
-            SignalInfo info;
-            info.scope = name.substr(0, dot);
-            info.name = name.substr(dot + 1);
-            if (kind == "wire") info.kind = SignalKind::Wire;
-            else if (kind == "bus") info.kind = SignalKind::Bus;
-            else if (kind == "real") info.kind = SignalKind::Real;
-            else fail("unknown signal kind '" + kind + "'");
-            const std::uint64_t bits = info.kind == SignalKind::Real ? 1 : parse_u64(width);
-            if (info.kind == SignalKind::Wire && bits != 1) fail("a wire is 1 bit wide, not " + width);
-            if (bits < 1 || bits > 64) fail("bus width " + width + " is not 1..64");
-            info.width = static_cast<unsigned>(bits);
-            const std::uint64_t hz = parse_u64(clock);
-            if (hz == 0 || hz > 64'000'000) fail("clock " + clock + " Hz is not 1 Hz .. 64 MHz");
-            info.clock_hz = static_cast<std::uint32_t>(hz);
-            if (info.scope.empty() || info.name.empty()) fail("signal '" + name + "' has an empty scope or name");
-            if (parsed.timeline.find(info.scope, info.name) >= 0) fail("signal '" + name + "' is declared twice");
-            try {
-                parsed.timeline.add_signal(info);
-            } catch (const std::invalid_argument& e) {
-                fail(e.what());
-            }
-        } else if (word[0] == '@') {
-            const std::string name = word.substr(1);
-            const auto dot = name.find('.');
-            current = dot == std::string::npos ? -1 : parsed.timeline.find(name.substr(0, dot), name.substr(dot + 1));
-            if (current < 0) fail("events for undeclared signal '" + name + "'");
-            no_more(ls, "the signal's name");
-            last_cycle = 0;
-            stopped = false;
-            // The bounds in this signal's clock (end cycle x clock / end clock, exact enough: whole cycles).
-            const double hz = parsed.timeline.signals()[static_cast<std::size_t>(current)].clock_hz;
-            end_bound = parsed.header.end_clock_hz == 0
-                            ? std::numeric_limits<Cycle>::max()
-                            : static_cast<Cycle>(std::ceil(static_cast<double>(parsed.header.end_cycle) * hz / parsed.header.end_clock_hz));
-            stop_bound = stop_after_s > 0 ? static_cast<Cycle>(std::ceil(stop_after_s * hz)) : std::numeric_limits<Cycle>::max();
-        } else if (current < 0) {
-            fail("unexpected '" + line + "'");
-        } else if (word[0] == '*') {
-            const std::uint64_t repeats = parse_u64(word.substr(1));
-
-            if (repeats > kMaxGoldenEvents) fail("repeat count " + word.substr(1) + " is more than the events a golden may hold");
-            std::vector<std::pair<Cycle, std::string>> block;
-            std::string delta, value;
-            while (ls >> delta) {
-                if (delta.empty() || delta[0] != '+') fail("repeat block needs +delta value pairs, not '" + delta + "'");
-                if (!(ls >> value)) fail("repeat block: '" + delta + "' has no value");
-                block.emplace_back(parse_cycles(delta.substr(1)), value);
-            }
-            if (block.empty()) fail("empty repeat block");
-            // Checked before expanding, so an oversized block allocates nothing.
-            if (repeats > (kMaxGoldenEvents - events) / block.size()) {
-                fail("more than " + std::to_string(kMaxGoldenEvents) + " events (the most a golden timeline may hold)");
-            }
-            Cycle block_cycles = 0;
-            for (const auto& [d, v] : block) block_cycles += d;
-            for (std::uint64_t r = 0; r < repeats; ++r) {
-                for (const auto& [d, v] : block) record(last_cycle + d, v);
-                if (stopped) {
-                    // Past the compared run's end: what is left only moves the
-                    // clock on (and is checked against the timeline's end).
-                    const std::uint64_t left = repeats - r - 1;
-                    if (block_cycles != 0 && left > ((std::uint64_t{1} << 53) - last_cycle) / block_cycles) {
-                        fail("the repeat runs past any run's end");
-                    }
-                    last_cycle += left * block_cycles;
-                    if (last_cycle > end_bound) fail("cycle " + std::to_string(last_cycle) + " is after the timeline's end");
-                    break;
-                }
-            }
-        } else if (word[0] == '+') {
-            std::string value;
-            if (!(ls >> value)) fail("'" + word + "' has no value");
-            no_more(ls, "a change");
-            record(last_cycle + parse_cycles(word.substr(1)), value);
-        } else {
-            std::string value;
-            if (!(ls >> value)) fail("'" + word + "' has no value");
-            no_more(ls, "a change");
-            record(parse_cycles(word), value);
-        }
+        last_cycle_ = cycle;
     }
-    return parsed;
+
+    std::istringstream in_;
+    const std::string& source_;
+    const double stop_after_s_;
+    ParsedTimeline parsed_;
+    std::string line_;
+    int line_no_ = 0;
+    long current_ = -1;  // the signal whose events these are
+    Cycle last_cycle_ = 0;
+    std::uint64_t events_ = 0;
+    // Where this signal's events stop being kept: its clock's cycle at the
+    // golden's own end (an event after it is malformed) and at stop_after_s
+    // (the run compared with it ended there: a later event is kept once, to
+    // show the difference, and the rest not even expanded).
+    Cycle end_bound_ = std::numeric_limits<Cycle>::max(), stop_bound_ = std::numeric_limits<Cycle>::max();
+    bool stopped_ = false;  // this signal passed stop_bound
+};
+
+}  // namespace
+
+ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source, double stop_after_s) {
+    return TimelineTextParser(text, source, stop_after_s).parse();
 }
 
 ParsedTimeline read_timeline_text(const std::string& path, double stop_after_s) {
