@@ -284,17 +284,8 @@ unsigned long afl_stat(const fs::path& stats, const std::string& key) {
     return 0;
 }
 
-Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env, const fs::path& out,
-                      const fs::path& corpus, double seconds, double bound_s, const std::string& family) {
-    Campaign campaign;
-    campaign.target = {find_target("avrbench-fuzz-firmware-afl", "AVRBENCH_FUZZ_AFL_TARGET"), false};
-    const std::string afl_fuzz = find_on_path("afl-fuzz", "afl++");
-    const std::string afl_showmap = find_on_path("afl-showmap", "afl++");
-    const fs::path sync = out / "afl";
-    fs::remove_all(sync);  // AFL++ refuses to resume into a finished directory without -i -
-    // Wall-clock limit per input, generous: an input may take bound_s of
-    // simulated time, and the slowest firmware here runs ~10x real time.
-    const long timeout_ms = 2000 + static_cast<long>(bound_s * 1000);
+// The target's environment plus AFL++'s own settings.
+std::vector<std::string> afl_environment(const FuzzArgs& args, const std::vector<std::string>& env) {
     std::vector<std::string> afl_env = env;
     afl_env.insert(afl_env.end(), {"AFL_SKIP_CPUFREQ=1", "AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1", "AFL_NO_UI=1",
                                    "AFL_NO_AFFINITY=1", "AFL_FORKSRV_INIT_TMOUT=60000",
@@ -307,6 +298,53 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
         const std::string mutator = find_helper("libavrbench-afl-gcode-mutator.so");
         if (!mutator.empty()) afl_env.push_back("AFL_CUSTOM_MUTATOR_LIBRARY=" + mutator);
     }
+    return afl_env;
+}
+
+// Why AFL++ gave up: its "PROGRAM ABORT" line, without the colour codes around it.
+std::string afl_abort_reason(const std::string& log_path) {
+    std::string why = "see the log";
+    std::istringstream lines(slurp(log_path));
+    for (std::string line; std::getline(lines, line);) {
+        if (line.find("PROGRAM ABORT") == std::string::npos) continue;
+        why.clear();
+        for (std::size_t i = 0; i < line.size(); ++i) {
+            if (line[i] == '\x1b') {
+                while (i < line.size() && !std::isalpha(static_cast<unsigned char>(line[i]))) ++i;
+                continue;
+            }
+            why += line[i];
+        }
+    }
+    return why;
+}
+
+// Executions, coverage, timeouts and crash inputs of every instance.
+void collect_afl_results(Campaign& campaign, const fs::path& sync) {
+    campaign.coverage_end = afl_stat(sync / "main" / "fuzzer_stats", "edges_found");  // main imports the others' finds
+    campaign.artifact_dir = (sync / "*" / "crashes").string();
+    for (const auto& instance : fs::directory_iterator(sync)) {
+        campaign.executions += afl_stat(instance.path() / "fuzzer_stats", "execs_done");
+        campaign.wall_timeouts += afl_stat(instance.path() / "fuzzer_stats", "saved_hangs");
+        if (!fs::is_directory(instance.path() / "crashes")) continue;
+        for (const auto& entry : fs::directory_iterator(instance.path() / "crashes")) {
+            if (entry.path().filename().string().rfind("id:", 0) == 0) campaign.artifacts.push_back(entry.path());
+        }
+    }
+}
+
+Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env, const fs::path& out,
+                      const fs::path& corpus, double seconds, double bound_s, const std::string& family) {
+    Campaign campaign;
+    campaign.target = {find_target("avrbench-fuzz-firmware-afl", "AVRBENCH_FUZZ_AFL_TARGET"), false};
+    const std::string afl_fuzz = find_on_path("afl-fuzz", "afl++");
+    const std::string afl_showmap = find_on_path("afl-showmap", "afl++");
+    const fs::path sync = out / "afl";
+    fs::remove_all(sync);  // AFL++ refuses to resume into a finished directory without -i -
+    // Wall-clock limit per input, generous: an input may take bound_s of
+    // simulated time, and the slowest firmware here runs ~10x real time.
+    const long timeout_ms = 2000 + static_cast<long>(bound_s * 1000);
+    const std::vector<std::string> afl_env = afl_environment(args, env);
     const int jobs = std::max(1, args.jobs);
     std::printf("avrbench fuzz: %s on %s (family %s) for %s, AFL++ with %d instance(s) on %s; logs %s/*.log\n",
                 args.elf.c_str(), args.board.c_str(), family.c_str(), budget_text(args, seconds).c_str(), jobs,
@@ -346,112 +384,61 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
         all_ran = all_ran && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     }
     if (!fs::exists(sync / "main" / "fuzzer_stats")) {
-        // AFL++ says why on a "PROGRAM ABORT" line, between colour codes.
-        std::string why = "see the log";
-        std::istringstream lines(slurp((out / "afl-main.log").string()));
-        for (std::string line; std::getline(lines, line);) {
-            if (line.find("PROGRAM ABORT") == std::string::npos) continue;
-            why.clear();
-            for (std::size_t i = 0; i < line.size(); ++i) {
-                if (line[i] == '\x1b') {
-                    while (i < line.size() && !std::isalpha(static_cast<unsigned char>(line[i]))) ++i;
-                    continue;
-                }
-                why += line[i];
-            }
-        }
-        throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (" + why + ")");
+        throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (" +
+                       afl_abort_reason((out / "afl-main.log").string()) + ")");
     }
     if (!all_ran) std::printf("  (an AFL++ instance ended with an error; see %s/afl-*.log)\n", out.string().c_str());
-    campaign.coverage_end = afl_stat(sync / "main" / "fuzzer_stats", "edges_found");  // main imports the others' finds
-    campaign.artifact_dir = (sync / "*" / "crashes").string();
-    for (const auto& instance : fs::directory_iterator(sync)) {
-        campaign.executions += afl_stat(instance.path() / "fuzzer_stats", "execs_done");
-        campaign.wall_timeouts += afl_stat(instance.path() / "fuzzer_stats", "saved_hangs");
-        if (!fs::is_directory(instance.path() / "crashes")) continue;
-        for (const auto& entry : fs::directory_iterator(instance.path() / "crashes")) {
-            if (entry.path().filename().string().rfind("id:", 0) == 0) campaign.artifacts.push_back(entry.path());
-        }
-    }
+    collect_afl_results(campaign, sync);
     return campaign;
 }
 
-}  // namespace
-
-int fuzz_command(const FuzzArgs& args) {
-    const double seconds = seconds_from_ps(parse_duration_ps(args.duration, "--for"));
-    const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
-    if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
+// Which ELF runs where: the fuzzed one on the MCU of the board's serial
+// port, the others from --firmware; and the port's firmware family.
+struct FuzzFirmware {
     std::string family;
-    std::string other_firmware;  // "mcu=elf;mcu=elf" for the target
-    // `run ELF --firmware ...` as the recorded runs give it: run's ELF goes
-    // to the board's first MCU, which need not be the serial port's.
-    std::vector<std::string> run_firmware;
-    {
-        // The fuzzed ELF runs on the MCU of the board's serial port; the
-        // others take --firmware. BadInput for a bad board or ELF, as `run` says it.
-        BoardSpec spec = load_board_file(args.board);
-        if (spec.serial.empty()) throw BadInput(args.board + ": has no serial port for the fuzz input");
-        std::map<std::string, std::string> firmware = firmware_assignments(args.firmware);
-        for (const auto& [mcu, elf] : firmware) other_firmware += (other_firmware.empty() ? "" : ";") + mcu + "=" + elf;
-        firmware[spec.serial.front().mcu] = args.elf;
-        const std::string first_mcu = spec.mcus.front().name;
-        run_firmware.push_back(firmware.count(first_mcu) != 0 ? firmware[first_mcu] : args.elf);
-        for (const auto& [mcu, elf] : firmware) {
-            if (mcu != first_mcu) run_firmware.insert(run_firmware.end(), {"--firmware", mcu + "=" + elf});
-        }
-        Bench bench(std::move(spec), firmware);
-        family = args.family.empty() ? bench.serial_decl().family : args.family;
-        (void)parse_firmware_family(family, "--family");
-    }
-    const fs::path out = args.out;
-    const fs::path corpus = out / "corpus", findings = out / "findings";
-    fs::create_directories(corpus);
-    fs::create_directories(findings);
-    // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
-    // coverage finds the rest.
-    const std::vector<std::string> seeds =
-        args.raw ? std::vector<std::string>{std::string("\x3b", 1), std::string("\x00\x00\x10\x00\x10\x40\x40\x05", 8)}
-                 : seed_lines(family);
-    for (std::size_t i = 0; i < seeds.size(); ++i) std::ofstream(corpus / ("seed-" + std::to_string(i))) << seeds[i];
-    if (!args.corpus.empty()) {
-        std::error_code ec;
-        if (!fs::is_directory(args.corpus, ec)) throw BadInput(args.corpus + ": --corpus is not a directory");
-        std::size_t copied = 0;
-        for (const auto& entry : fs::directory_iterator(args.corpus)) {
-            if (!entry.is_regular_file()) continue;
-            fs::copy_file(entry.path(), corpus / ("user-" + entry.path().filename().string()), fs::copy_options::overwrite_existing);
-            ++copied;
-        }
-        if (copied == 0) throw BadInput(args.corpus + ": --corpus holds no files");
-    }
-    {
-        std::ofstream dict(out / "gcode.dict");
-        for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";  // libFuzzer's and AFL's format
-    }
-    std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
-                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
-                                          std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
-                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
-                                          "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
-                                          std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
-    const auto started = std::chrono::steady_clock::now();
-    Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
-                                             : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
-    const double campaign_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const Target& target = campaign.target;
-    std::printf("  executions %lu in %.1f s (%.0f per second)\n", campaign.executions, campaign_s,
-                campaign_s > 0 ? static_cast<double>(campaign.executions) / campaign_s : 0.0);
-    std::printf("  coverage   firmware edge %s %lu at the start, %lu at the end\n",
-                campaign.target.libfuzzer ? "features" : "tuples (AFL++'s edges)", campaign.coverage_start,
-                campaign.coverage_end);
-    if (campaign.wall_timeouts != 0) {
-        std::printf("  timeouts   %lu inputs ran past AFL++'s wall-clock limit (out/afl/*/hangs; not findings: "
-                    "the simulated bound is the hang oracle)\n",
-                    campaign.wall_timeouts);
-    }
+    std::string other_firmware;             // "mcu=elf;mcu=elf" for the target
+    std::vector<std::string> run_firmware;  // `run ELF --firmware ...` as the recorded runs give it
+};
 
-    // Replay each reproducer once: the target prints the finding and aborts.
+FuzzFirmware fuzz_firmware(const FuzzArgs& args) {
+    FuzzFirmware fw;
+    // BadInput for a bad board or ELF, as `run` says it.
+    BoardSpec spec = load_board_file(args.board);
+    if (spec.serial.empty()) throw BadInput(args.board + ": has no serial port for the fuzz input");
+    std::map<std::string, std::string> firmware = firmware_assignments(args.firmware);
+    for (const auto& [mcu, elf] : firmware) fw.other_firmware += (fw.other_firmware.empty() ? "" : ";") + mcu + "=" + elf;
+    firmware[spec.serial.front().mcu] = args.elf;
+    // run's ELF goes to the board's first MCU, which need not be the serial port's.
+    const std::string first_mcu = spec.mcus.front().name;
+    fw.run_firmware.push_back(firmware.count(first_mcu) != 0 ? firmware[first_mcu] : args.elf);
+    for (const auto& [mcu, elf] : firmware) {
+        if (mcu != first_mcu) fw.run_firmware.insert(fw.run_firmware.end(), {"--firmware", mcu + "=" + elf});
+    }
+    Bench bench(std::move(spec), firmware);
+    fw.family = args.family.empty() ? bench.serial_decl().family : args.family;
+    (void)parse_firmware_family(fw.family, "--family");
+    return fw;
+}
+
+// What the reproducers' runs need besides the campaign.
+struct FindingsRun {
+    const FuzzArgs& args;
+    const std::vector<std::string>& run_firmware;
+    const std::string& family;
+    const fs::path& findings;
+    double bound_s;
+};
+
+// Replays each reproducer once (the target prints the finding and aborts),
+// groups them, minimizes the shortest of each group and records its run.
+// Exit code: 1 when something was found.
+int report_findings(Campaign& campaign, const std::vector<std::string>& env, const FindingsRun& how) {
+    const FuzzArgs& args = how.args;
+    const auto& run_firmware = how.run_firmware;
+    const std::string& family = how.family;
+    const fs::path& findings = how.findings;
+    const double bound_s = how.bound_s;
+    const Target& target = campaign.target;
     std::map<std::string, std::vector<fs::path>> by_finding;
     std::map<std::string, std::string> example;  // finding -> the first replay's whole line
     std::size_t not_reproduced = 0;
@@ -499,6 +486,65 @@ int fuzz_command(const FuzzArgs& args) {
                     static_cast<std::uintmax_t>(fs::file_size(shortest)), base.c_str(), base.c_str(), base.c_str());
     }
     return by_finding.empty() ? 0 : 1;
+}
+
+}  // namespace
+
+int fuzz_command(const FuzzArgs& args) {
+    const double seconds = seconds_from_ps(parse_duration_ps(args.duration, "--for"));
+    const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
+    if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");
+    const FuzzFirmware fw = fuzz_firmware(args);
+    const std::string& family = fw.family;
+    const std::vector<std::string>& run_firmware = fw.run_firmware;
+    const std::string& other_firmware = fw.other_firmware;
+    const fs::path out = args.out;
+    const fs::path corpus = out / "corpus", findings = out / "findings";
+    fs::create_directories(corpus);
+    fs::create_directories(findings);
+    // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
+    // coverage finds the rest.
+    const std::vector<std::string> seeds =
+        args.raw ? std::vector<std::string>{std::string("\x3b", 1), std::string("\x00\x00\x10\x00\x10\x40\x40\x05", 8)}
+                 : seed_lines(family);
+    for (std::size_t i = 0; i < seeds.size(); ++i) std::ofstream(corpus / ("seed-" + std::to_string(i))) << seeds[i];
+    if (!args.corpus.empty()) {
+        std::error_code ec;
+        if (!fs::is_directory(args.corpus, ec)) throw BadInput(args.corpus + ": --corpus is not a directory");
+        std::size_t copied = 0;
+        for (const auto& entry : fs::directory_iterator(args.corpus)) {
+            if (!entry.is_regular_file()) continue;
+            fs::copy_file(entry.path(), corpus / ("user-" + entry.path().filename().string()), fs::copy_options::overwrite_existing);
+            ++copied;
+        }
+        if (copied == 0) throw BadInput(args.corpus + ": --corpus holds no files");
+    }
+    {
+        std::ofstream dict(out / "gcode.dict");
+        for (const auto& word : gcode_dictionary()) dict << '"' << word << "\"\n";  // libFuzzer's and AFL's format
+    }
+    std::vector<std::string> env = {"AVRBENCH_FUZZ_BOARD=" + args.board, "AVRBENCH_FUZZ_ELF=" + args.elf,
+                                          "AVRBENCH_FUZZ_BOUND=" + std::to_string(bound_s), "AVRBENCH_FUZZ_FAMILY=" + family,
+                                          std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
+                                          "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
+                                          "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
+                                          std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
+    const auto started = std::chrono::steady_clock::now();
+    Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
+                                             : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
+    const double campaign_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::printf("  executions %lu in %.1f s (%.0f per second)\n", campaign.executions, campaign_s,
+                campaign_s > 0 ? static_cast<double>(campaign.executions) / campaign_s : 0.0);
+    std::printf("  coverage   firmware edge %s %lu at the start, %lu at the end\n",
+                campaign.target.libfuzzer ? "features" : "tuples (AFL++'s edges)", campaign.coverage_start,
+                campaign.coverage_end);
+    if (campaign.wall_timeouts != 0) {
+        std::printf("  timeouts   %lu inputs ran past AFL++'s wall-clock limit (out/afl/*/hangs; not findings: "
+                    "the simulated bound is the hang oracle)\n",
+                    campaign.wall_timeouts);
+    }
+
+    return report_findings(campaign, env, FindingsRun{args, run_firmware, family, findings, bound_s});
 }
 
 }  // namespace avrbench
