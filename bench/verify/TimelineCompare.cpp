@@ -132,151 +132,170 @@ private:
     bool level_ = false;
 };
 
+// Exact: every change at the same cycle with the same value.
+void compare_exact(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
+                   const std::vector<TimelineEvent>& a, std::size_t around) {
+    char buf[200];
+    for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
+        if (i < g.size() && i < a.size() && g[i].cycle == a[i].cycle && equal_value(info, g[i], a[i])) continue;
+        std::snprintf(buf, sizeof buf, "change #%zu differs (%zu golden vs %zu actual changes)", i + 1, g.size(), a.size());
+        diverge_at(r, info, g, a, i, around, buf);
+        return;
+    }
+}
+
+// Timing: the same values, each edge within the tolerance of its place or
+// its interval within the tolerance of its length.
+void compare_timing(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
+                   const std::vector<TimelineEvent>& a, std::size_t around) {
+    char buf[200];
+    double worst = 0;
+    for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
+        if (i >= g.size() || i >= a.size() || !equal_value(info, g[i], a[i])) {
+            std::snprintf(buf, sizeof buf, "change #%zu: value sequence differs (%zu golden vs %zu actual changes)",
+                          i + 1, g.size(), a.size());
+            diverge_at(r, info, g, a, i, around, buf);
+            return;
+        }
+        // Either the edge is where it was (absolute tolerance), or the
+        // interval that ends at it is as long as it was (relative
+        // tolerance): a jittered pulse moves its edges but keeps its width.
+        const double shift = std::fabs(static_cast<double>(a[i].cycle) - static_cast<double>(g[i].cycle));
+        const double g_interval = static_cast<double>(i == 0 ? g[0].cycle : g[i].cycle - g[i - 1].cycle);
+        const double a_interval = static_cast<double>(i == 0 ? a[0].cycle : a[i].cycle - a[i - 1].cycle);
+        const double interval_error = std::fabs(a_interval - g_interval);
+        const double interval_allowed = rule.tolerance_cycles + rule.tolerance_rel * g_interval;
+        worst = std::max(worst, shift);
+        if (shift > rule.tolerance_cycles && interval_error > interval_allowed) {
+            std::snprintf(buf, sizeof buf,
+                          "change #%zu moved by %.0f cycles (tolerance %.0f); its interval changed by %.0f "
+                          "(tolerance %.1f)",
+                          i + 1, shift, rule.tolerance_cycles, interval_error, interval_allowed);
+            diverge_at(r, info, g, a, i, around, buf);
+            return;
+        }
+    }
+    std::snprintf(buf, sizeof buf, "largest shift %.0f cycles", worst);
+    r.detail = buf;
+}
+
+// Steps: the rising edges, each within the tolerance, and as many.
+void compare_steps(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
+                   const std::vector<TimelineEvent>& a, std::size_t around) {
+    char buf[200];
+    const auto gs = rising(g), as = rising(a);
+    double worst = 0;
+    for (std::size_t i = 0; i < std::min(gs.size(), as.size()); ++i) {
+        const double shift = std::fabs(static_cast<double>(as[i].cycle) - static_cast<double>(gs[i].cycle));
+        worst = std::max(worst, shift);
+        if (shift > rule.tolerance_cycles) {
+            std::snprintf(buf, sizeof buf, "step #%zu moved by %.0f cycles, tolerance %.0f", i + 1, shift,
+                          rule.tolerance_cycles);
+            diverge_at(r, info, gs, as, i, around, buf);
+            return;
+        }
+    }
+    if (gs.size() != as.size()) {
+        std::snprintf(buf, sizeof buf, "%zu steps expected, %zu taken (%s)", gs.size(), as.size(),
+                      as.size() < gs.size() ? "lost steps" : "extra steps");
+        diverge_at(r, info, gs, as, std::min(gs.size(), as.size()), around, buf);
+        return;
+    }
+    std::snprintf(buf, sizeof buf, "%zu steps, largest shift %.0f cycles", gs.size(), worst);
+    r.detail = buf;
+}
+
+// Band: both signals' values at every change of either, within the band.
+void compare_band(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
+                  const std::vector<TimelineEvent>& a) {
+    char buf[200];
+    // Both signals at every time either changes, in time order (a merge of two sorted lists).
+    Cursor cg(g, info), ca(a, info);
+    double worst = 0;
+    std::size_t ig = 0, ia = 0;
+    while (ig < g.size() || ia < a.size()) {
+        const bool take_g = ia >= a.size() || (ig < g.size() && g[ig].cycle <= a[ia].cycle);
+        const Cycle t = take_g ? g[ig++].cycle : a[ia++].cycle;
+        const double vg = cg.value_at(t), va = ca.value_at(t);
+        const double d = std::fabs(va - vg);
+        worst = std::max(worst, d);
+        if (d > rule.band) {
+            std::snprintf(buf, sizeof buf, "at %.9f s actual %.6g vs golden %.6g (band %.6g)",
+                          static_cast<double>(t) / info.clock_hz, va, vg, rule.band);
+            r.passed = false;
+            r.verdict = "differs";
+            r.diverges = true;
+            r.divergence_cycle = t;
+            r.detail = buf;
+            std::snprintf(buf, sizeof buf, "%.6g", vg);
+            r.expected = buf;
+            std::snprintf(buf, sizeof buf, "%.6g", va);
+            r.actual = buf;
+            return;
+        }
+    }
+    std::snprintf(buf, sizeof buf, "largest difference %.6g", worst);
+    r.detail = buf;
+}
+
+// PwmDuty and StepRate: window by window up to the earlier run's end.
+void compare_windows(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
+                     const std::vector<TimelineEvent>& a, Cycle end) {
+    char buf[200];
+    const Cycle window = std::max<Cycle>(1, static_cast<Cycle>(std::llround(rule.window_s * info.clock_hz)));
+    const auto gs = rising(g), as = rising(a);
+    Cursor duty_g(g, info), duty_a(a, info), steps_g(gs, info), steps_a(as, info);
+    for (Cycle begin = 0; begin < end; begin += window) {
+        const Cycle stop = std::min(end, begin + window);
+        if (rule.kind == RuleKind::PwmDuty) {
+            const double dg = duty_g.duty(begin, stop), da = duty_a.duty(begin, stop);
+            if (std::fabs(dg - da) > rule.band) {
+                std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.6f s (band %.4f)", da,
+                              dg, static_cast<double>(begin) / info.clock_hz, rule.band);
+                r.passed = false;
+                r.verdict = "differs";
+                r.diverges = true;
+                r.divergence_cycle = begin;
+                r.detail = buf;
+                r.expected = std::to_string(dg);
+                r.actual = std::to_string(da);
+                return;
+            }
+        } else {
+            const auto cg = static_cast<double>(steps_g.count(begin, stop));
+            const auto ca = static_cast<double>(steps_a.count(begin, stop));
+            if (std::fabs(ca - cg) > rule.tolerance_rel * cg + 1) {
+                std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.6f s", ca, cg,
+                              static_cast<double>(begin) / info.clock_hz);
+                r.passed = false;
+                r.verdict = "differs";
+                r.diverges = true;
+                r.divergence_cycle = begin;
+                r.detail = buf;
+                r.expected = std::to_string(static_cast<long long>(cg));
+                r.actual = std::to_string(static_cast<long long>(ca));
+                return;
+            }
+        }
+    }
+    r.detail = "all windows within tolerance";
+}
+
 void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule,
                      const std::vector<TimelineEvent>& g, const std::vector<TimelineEvent>& a,
                      const CompareOptions& options) {
     const std::size_t around = options.context_events;
-    char buf[200];
     switch (rule.kind) {
-        case RuleKind::Ignore:
-            return;
-        case RuleKind::Exact: {
-            for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
-                if (i < g.size() && i < a.size() && g[i].cycle == a[i].cycle && equal_value(info, g[i], a[i])) continue;
-                std::snprintf(buf, sizeof buf, "change #%zu differs (%zu golden vs %zu actual changes)", i + 1, g.size(), a.size());
-                diverge_at(r, info, g, a, i, around, buf);
-                return;
-            }
-            return;
-        }
-        case RuleKind::Timing: {
-            double worst = 0;
-            for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
-                if (i >= g.size() || i >= a.size() || !equal_value(info, g[i], a[i])) {
-                    std::snprintf(buf, sizeof buf, "change #%zu: value sequence differs (%zu golden vs %zu actual changes)",
-                                  i + 1, g.size(), a.size());
-                    diverge_at(r, info, g, a, i, around, buf);
-                    return;
-                }
-                // Either the edge is where it was (absolute tolerance), or the
-                // interval that ends at it is as long as it was (relative
-                // tolerance): a jittered pulse moves its edges but keeps its width.
-                const double shift = std::fabs(static_cast<double>(a[i].cycle) - static_cast<double>(g[i].cycle));
-                const double g_interval = static_cast<double>(i == 0 ? g[0].cycle : g[i].cycle - g[i - 1].cycle);
-                const double a_interval = static_cast<double>(i == 0 ? a[0].cycle : a[i].cycle - a[i - 1].cycle);
-                const double interval_error = std::fabs(a_interval - g_interval);
-                const double interval_allowed = rule.tolerance_cycles + rule.tolerance_rel * g_interval;
-                worst = std::max(worst, shift);
-                if (shift > rule.tolerance_cycles && interval_error > interval_allowed) {
-                    std::snprintf(buf, sizeof buf,
-                                  "change #%zu moved by %.0f cycles (tolerance %.0f); its interval changed by %.0f "
-                                  "(tolerance %.1f)",
-                                  i + 1, shift, rule.tolerance_cycles, interval_error, interval_allowed);
-                    diverge_at(r, info, g, a, i, around, buf);
-                    return;
-                }
-            }
-            std::snprintf(buf, sizeof buf, "largest shift %.0f cycles", worst);
-            r.detail = buf;
-            return;
-        }
-        case RuleKind::Steps: {
-            const auto gs = rising(g), as = rising(a);
-            double worst = 0;
-            for (std::size_t i = 0; i < std::min(gs.size(), as.size()); ++i) {
-                const double shift = std::fabs(static_cast<double>(as[i].cycle) - static_cast<double>(gs[i].cycle));
-                worst = std::max(worst, shift);
-                if (shift > rule.tolerance_cycles) {
-                    std::snprintf(buf, sizeof buf, "step #%zu moved by %.0f cycles, tolerance %.0f", i + 1, shift,
-                                  rule.tolerance_cycles);
-                    diverge_at(r, info, gs, as, i, around, buf);
-                    return;
-                }
-            }
-            if (gs.size() != as.size()) {
-                std::snprintf(buf, sizeof buf, "%zu steps expected, %zu taken (%s)", gs.size(), as.size(),
-                              as.size() < gs.size() ? "lost steps" : "extra steps");
-                diverge_at(r, info, gs, as, std::min(gs.size(), as.size()), around, buf);
-                return;
-            }
-            std::snprintf(buf, sizeof buf, "%zu steps, largest shift %.0f cycles", gs.size(), worst);
-            r.detail = buf;
-            return;
-        }
+        case RuleKind::Ignore: return;
+        case RuleKind::Exact: return compare_exact(r, info, g, a, around);
+        case RuleKind::Timing: return compare_timing(r, info, rule, g, a, around);
+        case RuleKind::Steps: return compare_steps(r, info, rule, g, a, around);
+        case RuleKind::Band: return compare_band(r, info, rule, g, a);
         case RuleKind::StepRate:
-        case RuleKind::PwmDuty:
-        case RuleKind::Band: {
+        case RuleKind::PwmDuty: {
             const Cycle g_end = options.golden_end_cycle ? options.golden_end_cycle : (g.empty() ? 0 : g.back().cycle);
             const Cycle a_end = options.actual_end_cycle ? options.actual_end_cycle : (a.empty() ? 0 : a.back().cycle);
-            const Cycle end = std::min(g_end, a_end);
-            if (rule.kind == RuleKind::Band) {
-                // Both signals at every time either changes, in time order (a merge of two sorted lists).
-                Cursor cg(g, info), ca(a, info);
-                double worst = 0;
-                std::size_t ig = 0, ia = 0;
-                while (ig < g.size() || ia < a.size()) {
-                    const bool take_g = ia >= a.size() || (ig < g.size() && g[ig].cycle <= a[ia].cycle);
-                    const Cycle t = take_g ? g[ig++].cycle : a[ia++].cycle;
-                    const double vg = cg.value_at(t), va = ca.value_at(t);
-                    const double d = std::fabs(va - vg);
-                    worst = std::max(worst, d);
-                    if (d > rule.band) {
-                        std::snprintf(buf, sizeof buf, "at %.9f s actual %.6g vs golden %.6g (band %.6g)",
-                                      static_cast<double>(t) / info.clock_hz, va, vg, rule.band);
-                        r.passed = false;
-                        r.verdict = "differs";
-                        r.diverges = true;
-                        r.divergence_cycle = t;
-                        r.detail = buf;
-                        std::snprintf(buf, sizeof buf, "%.6g", vg);
-                        r.expected = buf;
-                        std::snprintf(buf, sizeof buf, "%.6g", va);
-                        r.actual = buf;
-                        return;
-                    }
-                }
-                std::snprintf(buf, sizeof buf, "largest difference %.6g", worst);
-                r.detail = buf;
-                return;
-            }
-            const Cycle window = std::max<Cycle>(1, static_cast<Cycle>(std::llround(rule.window_s * info.clock_hz)));
-            const auto gs = rising(g), as = rising(a);
-            Cursor duty_g(g, info), duty_a(a, info), steps_g(gs, info), steps_a(as, info);
-            for (Cycle begin = 0; begin < end; begin += window) {
-                const Cycle stop = std::min(end, begin + window);
-                if (rule.kind == RuleKind::PwmDuty) {
-                    const double dg = duty_g.duty(begin, stop), da = duty_a.duty(begin, stop);
-                    if (std::fabs(dg - da) > rule.band) {
-                        std::snprintf(buf, sizeof buf, "duty %.4f vs golden %.4f in the window at %.6f s (band %.4f)", da,
-                                      dg, static_cast<double>(begin) / info.clock_hz, rule.band);
-                        r.passed = false;
-                        r.verdict = "differs";
-                        r.diverges = true;
-                        r.divergence_cycle = begin;
-                        r.detail = buf;
-                        r.expected = std::to_string(dg);
-                        r.actual = std::to_string(da);
-                        return;
-                    }
-                } else {
-                    const auto cg = static_cast<double>(steps_g.count(begin, stop));
-                    const auto ca = static_cast<double>(steps_a.count(begin, stop));
-                    if (std::fabs(ca - cg) > rule.tolerance_rel * cg + 1) {
-                        std::snprintf(buf, sizeof buf, "%.0f steps vs golden %.0f in the window at %.6f s", ca, cg,
-                                      static_cast<double>(begin) / info.clock_hz);
-                        r.passed = false;
-                        r.verdict = "differs";
-                        r.diverges = true;
-                        r.divergence_cycle = begin;
-                        r.detail = buf;
-                        r.expected = std::to_string(static_cast<long long>(cg));
-                        r.actual = std::to_string(static_cast<long long>(ca));
-                        return;
-                    }
-                }
-            }
-            r.detail = "all windows within tolerance";
-            return;
+            return compare_windows(r, info, rule, g, a, std::min(g_end, a_end));
         }
     }
 }
