@@ -360,28 +360,11 @@ ScenarioSpec load_scenario(const std::string& path, const std::string& firmware_
     }
 }
 
-ScenarioSpec load_scenario_checked(const std::string& path, const std::string& firmware_dir) {
+// The scenario's board: a file beside the scenario (or a path relative to
+// it), else a standard board's bare name (`board: arduino-uno`), from
+// whatever folder avrbench runs in.
+BoardSpec scenario_board(ScenarioSpec& spec, const std::string& path, const std::string& board_value, const YAML::Node& node) {
     std::error_code ec;
-    const YAML::Node root = load_yaml(read_input_file(path, "scenario", kMaxScenarioFileBytes), path);
-    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a scenario is a map with board, firmware, steps, expect");
-    static const std::set<std::string> kKeys = {"name",   "description", "board",  "firmware",       "time_limit", "host",
-                                                "steps",  "expect",      "golden", "golden_signals", "tolerances"};
-    for (const auto& kv : root) {
-        if (kKeys.count(kv.first.Scalar()) == 0) {
-            throw BadInput(where(path, kv.first) + ": unknown key '" + kv.first.Scalar() +
-                           "' (expected name, description, board, firmware, time_limit, host, steps, expect, golden, "
-                           "golden_signals, tolerances)");
-        }
-    }
-    ScenarioSpec spec;
-    spec.path = path;
-    spec.name = root["name"] ? checked_name(scalar(root["name"], path, "name"), where(path, root["name"]))
-                             : checked_name(fs::path(path).stem().string(), path + ":1");
-    if (root["description"]) spec.description = scalar(root["description"], path, "description");
-    if (!root["board"]) throw BadInput(path + ":1: the scenario needs 'board'");
-    // A file beside the scenario (or a path relative to it), else a standard
-    // board's bare name (`board: arduino-uno`), from whatever folder avrbench runs in.
-    const std::string board_value = scalar(root["board"], path, "board");
     spec.board_path = resolve(path, board_value);
     const bool bare_board = board_value.find('/') == std::string::npos && fs::path(board_value).extension() != ".yaml";
     BoardSpec board;
@@ -390,11 +373,16 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
         board = load_board_file(spec.board_path);
     } catch (const BadInput& e) {
         // A missing board names the scenario line that points at it.
-        if (!fs::is_regular_file(spec.board_path, ec)) throw BadInput(where(path, root["board"]) + ": board " + e.what());
+        if (!fs::is_regular_file(spec.board_path, ec)) throw BadInput(where(path, node) + ": board " + e.what());
         throw;
     }
-    const BoardNames names(board);
+    return board;
+}
 
+// `firmware: {mcu: name-or-path}`: bare names from firmware_dir; every MCU of the board has one.
+void scenario_firmware(ScenarioSpec& spec, const BoardSpec& board, const YAML::Node& root, const std::string& path,
+                       const std::string& firmware_dir) {
+    std::error_code ec;
     if (!root["firmware"] || !root["firmware"].IsMap()) {
         throw BadInput(path + ":1: the scenario needs 'firmware: {mcu: name-or-path}'");
     }
@@ -412,28 +400,92 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
             throw BadInput(where(path, root["firmware"]) + ": MCU '" + m.name + "' of the board has no firmware");
         }
     }
+}
+
+// `host: {family, line_timeout}`.
+void scenario_host(ScenarioSpec& spec, const YAML::Node& host, const BoardNames& names, const std::string& path) {
+    if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout}");
+    names.check_serial("host", where(path, host));
+    for (const auto& kv : host) {
+        const std::string key = scalar(kv.first, path, "host key");
+        const std::string value = scalar(kv.second, path, key);
+        if (key == "family") {
+            if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
+                throw BadInput(where(path, kv.second) + ": family '" + value + "' is not grbl, marlin, teacup or generic");
+            }
+            spec.host_family = value;
+        } else if (key == "line_timeout") {
+            spec.host_line_timeout_ps = parse_duration_ps(value, where(path, kv.second) + ": line_timeout");
+            if (*spec.host_line_timeout_ps == 0) throw BadInput(where(path, kv.second) + ": line_timeout must be longer than 0");
+        } else {
+            throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout)");
+        }
+    }
+}
+
+// One entry of `tolerances:` {signals, rule, cycles, relative, window, band}.
+ChannelRule parse_tolerance(const YAML::Node& t, const std::string& path) {
+    const std::string loc = where(path, t);
+    if (!t.IsMap()) throw BadInput(loc + ": a tolerance is a map {signals, rule, ...}");
+    ChannelRule rule;
+    bool has_signals = false;
+    for (const auto& kv : t) {
+        const std::string key = kv.first.Scalar();
+        const std::string value = scalar(kv.second, path, key);
+        const std::string at = where(path, kv.second) + ": " + key;
+        auto non_negative = [&](double v) {
+            if (v < 0) throw BadInput(at + ": '" + value + "' must not be negative");
+            return v;
+        };
+        if (key == "signals") {
+            rule.pattern = value;
+            has_signals = true;
+        } else if (key == "rule") {
+            rule.kind = parse_rule(value, where(path, kv.second));
+        } else if (key == "cycles") {
+            rule.tolerance_cycles = static_cast<double>(parse_integer(value, at, 0, kMaxCount));
+        } else if (key == "relative") {
+            rule.tolerance_rel = non_negative(parse_quantity(value, Dimension::Dimensionless, at));
+        } else if (key == "window") {
+            rule.window_s = seconds_from_ps(parse_duration_ps(value, at));
+            if (rule.window_s <= 0) throw BadInput(at + ": the window must be longer than 0");
+        } else if (key == "band") {
+            rule.band = non_negative(parse_quantity(value, Dimension::Dimensionless, at));
+        } else {
+            throw BadInput(where(path, kv.first) + ": unknown tolerance key '" + key +
+                           "' (signals, rule, cycles, relative, window, band)");
+        }
+    }
+    if (!has_signals) throw BadInput(loc + ": a tolerance needs 'signals' (a glob such as \"uno.PD*\")");
+    return rule;
+}
+
+ScenarioSpec load_scenario_checked(const std::string& path, const std::string& firmware_dir) {
+    const YAML::Node root = load_yaml(read_input_file(path, "scenario", kMaxScenarioFileBytes), path);
+    if (!root.IsMap()) throw BadInput(escaped(path) + ":1: a scenario is a map with board, firmware, steps, expect");
+    static const std::set<std::string> kKeys = {"name",   "description", "board",  "firmware",       "time_limit", "host",
+                                                "steps",  "expect",      "golden", "golden_signals", "tolerances"};
+    for (const auto& kv : root) {
+        if (kKeys.count(kv.first.Scalar()) == 0) {
+            throw BadInput(where(path, kv.first) + ": unknown key '" + kv.first.Scalar() +
+                           "' (expected name, description, board, firmware, time_limit, host, steps, expect, golden, "
+                           "golden_signals, tolerances)");
+        }
+    }
+    ScenarioSpec spec;
+    spec.path = path;
+    spec.name = root["name"] ? checked_name(scalar(root["name"], path, "name"), where(path, root["name"]))
+                             : checked_name(fs::path(path).stem().string(), path + ":1");
+    if (root["description"]) spec.description = scalar(root["description"], path, "description");
+    if (!root["board"]) throw BadInput(path + ":1: the scenario needs 'board'");
+    const std::string board_value = scalar(root["board"], path, "board");
+    const BoardSpec board = scenario_board(spec, path, board_value, root["board"]);
+    const BoardNames names(board);
+    scenario_firmware(spec, board, root, path, firmware_dir);
     if (root["time_limit"]) {
         spec.time_limit_ps = parse_duration_ps(scalar(root["time_limit"], path, "time_limit"), where(path, root["time_limit"]) + ": time_limit");
     }
-    if (const YAML::Node host = root["host"]) {
-        if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout}");
-        names.check_serial("host", where(path, host));
-        for (const auto& kv : host) {
-            const std::string key = scalar(kv.first, path, "host key");
-            const std::string value = scalar(kv.second, path, key);
-            if (key == "family") {
-                if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
-                    throw BadInput(where(path, kv.second) + ": family '" + value + "' is not grbl, marlin, teacup or generic");
-                }
-                spec.host_family = value;
-            } else if (key == "line_timeout") {
-                spec.host_line_timeout_ps = parse_duration_ps(value, where(path, kv.second) + ": line_timeout");
-                if (*spec.host_line_timeout_ps == 0) throw BadInput(where(path, kv.second) + ": line_timeout must be longer than 0");
-            } else {
-                throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout)");
-            }
-        }
-    }
+    if (const YAML::Node host = root["host"]) scenario_host(spec, host, names, path);
     auto sequence = [&](const char* key) {
         const YAML::Node node = root[key];
         if (node && !node.IsSequence() && !node.IsNull()) throw BadInput(where(path, node) + ": '" + key + "' is a list");
@@ -453,41 +505,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
         for (const auto& g : globs) spec.golden_signals.push_back(scalar(g, path, "golden_signals entry"));
     }
     if (const YAML::Node tolerances = sequence("tolerances")) {
-        for (const auto& t : tolerances) {
-            const std::string loc = where(path, t);
-            if (!t.IsMap()) throw BadInput(loc + ": a tolerance is a map {signals, rule, ...}");
-            ChannelRule rule;
-            bool has_signals = false;
-            for (const auto& kv : t) {
-                const std::string key = kv.first.Scalar();
-                const std::string value = scalar(kv.second, path, key);
-                const std::string at = where(path, kv.second) + ": " + key;
-                auto non_negative = [&](double v) {
-                    if (v < 0) throw BadInput(at + ": '" + value + "' must not be negative");
-                    return v;
-                };
-                if (key == "signals") {
-                    rule.pattern = value;
-                    has_signals = true;
-                } else if (key == "rule") {
-                    rule.kind = parse_rule(value, where(path, kv.second));
-                } else if (key == "cycles") {
-                    rule.tolerance_cycles = static_cast<double>(parse_integer(value, at, 0, kMaxCount));
-                } else if (key == "relative") {
-                    rule.tolerance_rel = non_negative(parse_quantity(value, Dimension::Dimensionless, at));
-                } else if (key == "window") {
-                    rule.window_s = seconds_from_ps(parse_duration_ps(value, at));
-                    if (rule.window_s <= 0) throw BadInput(at + ": the window must be longer than 0");
-                } else if (key == "band") {
-                    rule.band = non_negative(parse_quantity(value, Dimension::Dimensionless, at));
-                } else {
-                    throw BadInput(where(path, kv.first) + ": unknown tolerance key '" + key +
-                                   "' (signals, rule, cycles, relative, window, band)");
-                }
-            }
-            if (!has_signals) throw BadInput(loc + ": a tolerance needs 'signals' (a glob such as \"uno.PD*\")");
-            spec.tolerances.push_back(rule);
-        }
+        for (const auto& t : tolerances) spec.tolerances.push_back(parse_tolerance(t, path));
     }
     return spec;
 }
