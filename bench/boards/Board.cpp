@@ -155,81 +155,85 @@ std::string pins_and_ports(Part& p) {
 }  // namespace
 
 void Board::build_nets() {
-    // A port that requires a kind, joined to the part that provides it.
-    struct PortLink {
+    std::vector<PortLink> links;
+    for (const auto& decl : spec_.nets) build_net(decl, links);
+    connect_ports(links);
+    set_net_clocks();
+    build_twi_buses();
+    for (auto& p : parts_) p->start();
+    for (auto& n : nets_) n->settle();
+}
+
+// One net of the board file: an electrical net of pins, an analog net, or
+// ports of one interface (their links go to `links`).
+void Board::build_net(const NetDecl& decl, std::vector<PortLink>& links) {
+    struct PortEnd {
         Part* part;
         std::size_t port;
-        Part* provider;
-        std::size_t provider_port;
+        const Endpoint* endpoint;
     };
-    std::vector<PortLink> links;
-    for (const auto& decl : spec_.nets) {
-        struct PortEnd {
-            Part* part;
-            std::size_t port;
-            const Endpoint* endpoint;
-        };
-        std::vector<PortEnd> ports;
-        std::vector<const Endpoint*> pins;
-        for (const auto& e : decl.endpoints) {
-            if (spec_.find_mcu(e.owner) != nullptr) {
-                pins.push_back(&e);
-                continue;
-            }
-            Part& p = part(e.owner);
-            std::size_t index = 0;
-            if (p.find_pin(e.pin) != nullptr) {
-                pins.push_back(&e);
-            } else if (p.find_port(e.pin, &index) != nullptr) {
-                ports.push_back({&p, index, &e});
-            } else {
-                throw BadInput(e.location + ": part '" + p.name() + "' (" + std::string(p.type()) + ") has no pin or port '" +
-                               e.pin + "' (" + pins_and_ports(p) + ")");
-            }
-        }
-        if (ports.empty()) {
-            build_electrical_net(decl);
+    std::vector<PortEnd> ports;
+    std::vector<const Endpoint*> pins;
+    for (const auto& e : decl.endpoints) {
+        if (spec_.find_mcu(e.owner) != nullptr) {
+            pins.push_back(&e);
             continue;
         }
-        // Ports of one kind, exactly one of them providing it.
-        const PortInfo& first = ports.front().part->port(ports.front().port);
-        const PortEnd* provider = nullptr;
-        for (const PortEnd& end : ports) {
-            const PortInfo& info = end.part->port(end.port);
-            if (info.kind != first.kind) {
-                throw BadInput(decl.location + ": net '" + decl.name + "' joins a " + std::string(first.kind->name) +
-                               " port (" + ports.front().endpoint->text() + ") and a " +
-                               std::string(info.kind->name) + " port (" + end.endpoint->text() + ")");
-            }
-            if (!info.provides) continue;
-            if (provider != nullptr) {
-                throw BadInput(decl.location + ": net '" + decl.name + "' has two " +
-                               std::string(info.kind->name) + " providers: " + provider->endpoint->text() +
-                               " and " + end.endpoint->text());
-            }
-            provider = &end;
-        }
-        if (provider == nullptr) {
-            throw BadInput(decl.location + ": net '" + decl.name + "' has no part providing its " +
-                           std::string(first.kind->name) + " port (" + ports.front().endpoint->text() +
-                           " needs one, e.g. " + std::string(first.kind->example) + ")");
-        }
-        if (first.kind == &kAnalogPort) {
-            build_analog_net(decl, *provider->part, provider->port, pins);
-            continue;
-        }
-        if (!pins.empty()) {
-            throw BadInput(pins.front()->location + ": net '" + decl.name + "' joins the pin " + pins.front()->text() +
-                           " and the " + std::string(first.kind->name) + " port " +
-                           provider->endpoint->text() + ": only analog outputs share a net with pins");
-        }
-        for (const PortEnd& end : ports) {
-            if (&end != provider) links.push_back({end.part, end.port, provider->part, provider->port});
+        Part& p = part(e.owner);
+        std::size_t index = 0;
+        if (p.find_pin(e.pin) != nullptr) {
+            pins.push_back(&e);
+        } else if (p.find_port(e.pin, &index) != nullptr) {
+            ports.push_back({&p, index, &e});
+        } else {
+            throw BadInput(e.location + ": part '" + p.name() + "' (" + std::string(p.type()) + ") has no pin or port '" +
+                           e.pin + "' (" + pins_and_ports(p) + ")");
         }
     }
+    if (ports.empty()) {
+        build_electrical_net(decl);
+        return;
+    }
+    // Ports of one kind, exactly one of them providing it.
+    const PortInfo& first = ports.front().part->port(ports.front().port);
+    const PortEnd* provider = nullptr;
+    for (const PortEnd& end : ports) {
+        const PortInfo& info = end.part->port(end.port);
+        if (info.kind != first.kind) {
+            throw BadInput(decl.location + ": net '" + decl.name + "' joins a " + std::string(first.kind->name) +
+                           " port (" + ports.front().endpoint->text() + ") and a " +
+                           std::string(info.kind->name) + " port (" + end.endpoint->text() + ")");
+        }
+        if (!info.provides) continue;
+        if (provider != nullptr) {
+            throw BadInput(decl.location + ": net '" + decl.name + "' has two " +
+                           std::string(info.kind->name) + " providers: " + provider->endpoint->text() +
+                           " and " + end.endpoint->text());
+        }
+        provider = &end;
+    }
+    if (provider == nullptr) {
+        throw BadInput(decl.location + ": net '" + decl.name + "' has no part providing its " +
+                       std::string(first.kind->name) + " port (" + ports.front().endpoint->text() +
+                       " needs one, e.g. " + std::string(first.kind->example) + ")");
+    }
+    if (first.kind == &kAnalogPort) {
+        build_analog_net(decl, *provider->part, provider->port, pins);
+        return;
+    }
+    if (!pins.empty()) {
+        throw BadInput(pins.front()->location + ": net '" + decl.name + "' joins the pin " + pins.front()->text() +
+                       " and the " + std::string(first.kind->name) + " port " +
+                       provider->endpoint->text() + ": only analog outputs share a net with pins");
+    }
+    for (const PortEnd& end : ports) {
+        if (&end != provider) links.push_back({end.part, end.port, provider->part, provider->port});
+    }
+}
 
-    // Ports are connected part by part in declaration order (the order
-    // listeners are called in), then every required one must be.
+// Ports are connected part by part in declaration order (the order
+// listeners are called in), then every required one must be.
+void Board::connect_ports(const std::vector<PortLink>& links) {
     for (auto& p : parts_) {
         for (std::size_t port = 0; port < p->port_count(); ++port) {
             const PortInfo& info = p->port(port);
@@ -253,8 +257,11 @@ void Board::build_nets() {
         }
     }
 
+}
+
+// Findings of a net carry the cycle of an MCU on it (else the board's first).
+void Board::set_net_clocks() {
     for (auto& n : nets_) {
-        // Findings of a net carry the cycle of an MCU on it (else the board's first).
         Mcu* clock = mcus_.front().get();
         for (const auto& t : mcu_terminals_) {
             if (t->net() == n.get()) {
@@ -264,9 +271,6 @@ void Board::build_nets() {
         }
         n->set_clock(*clock);
     }
-    build_twi_buses();
-    for (auto& p : parts_) p->start();
-    for (auto& n : nets_) n->settle();
 }
 
 void Board::build_electrical_net(const NetDecl& decl) {

@@ -87,6 +87,16 @@ private:
     void build_mcus(const std::map<std::string, std::string>& firmware);
     void build_parts();
     void build_nets();
+    // A port that requires an interface, joined to the part that provides it.
+    struct PortLink {
+        Part* part;
+        std::size_t port;
+        Part* provider;
+        std::size_t provider_port;
+    };
+    void build_net(const NetDecl& decl, std::vector<PortLink>& links);
+    void connect_ports(const std::vector<PortLink>& links);
+    void set_net_clocks();
     void build_electrical_net(const NetDecl& decl);
     void build_analog_net(const NetDecl& decl, Part& source, std::size_t port, const std::vector<const Endpoint*>& pins);
     void build_twi_buses();
