@@ -82,6 +82,70 @@ struct ElfHandle {
     }
 };
 
+// The header of an AVR executable (ELF32, EM_AVR, ET_EXEC, headers inside the file).
+void check_elf_header(Elf* elf, std::uint64_t file_size, const std::string& path) {
+    GElf_Ehdr ehdr;
+    if (gelf_getehdr(elf, &ehdr) == nullptr) throw BadInput(path + ": not an ELF file (unreadable header)");
+    if (ehdr.e_machine != EM_AVR) {
+        throw BadInput(path + ": not an AVR ELF (e_machine " + std::to_string(ehdr.e_machine) +
+                       ", expected " + std::to_string(EM_AVR) + ")");
+    }
+    if (gelf_getclass(elf) != ELFCLASS32) throw BadInput(path + ": not an AVR ELF (not ELF32)");
+    if (ehdr.e_shoff + static_cast<std::uint64_t>(ehdr.e_shnum) * ehdr.e_shentsize > file_size ||
+        ehdr.e_phoff + static_cast<std::uint64_t>(ehdr.e_phnum) * ehdr.e_phentsize > file_size) {
+        throw BadInput(path + ": malformed ELF: truncated (its headers reach past the end of the file)");
+    }
+    if (ehdr.e_type != ET_EXEC) throw BadInput(path + ": not an AVR executable (an object file or library? link it first)");
+}
+
+// The .mmcu section's bytes (simavr's tags), bounded.
+std::vector<std::uint8_t> mmcu_section(Elf_Scn* scn, const GElf_Shdr& shdr, const std::string& path) {
+    if (shdr.sh_size > 4096) throw BadInput(path + ": malformed .mmcu section (" + std::to_string(shdr.sh_size) + " bytes; simavr tags take a few hundred)");
+    Elf_Data* data = elf_getdata(scn, nullptr);
+    if (data == nullptr || data->d_buf == nullptr || data->d_size != shdr.sh_size) {
+        throw BadInput(path + ": malformed ELF: the .mmcu section's bytes lie outside the file");
+    }
+    const auto* bytes = static_cast<const std::uint8_t*>(data->d_buf);
+    return {bytes, bytes + data->d_size};
+}
+
+// Every named symbol, and the flash ones that can name a PC (functions and labels).
+void read_symbol_table(Elf* elf, Elf_Scn* scn, const GElf_Shdr& shdr, const std::string& path,
+                       std::map<std::string, std::uint32_t>& symbols, std::map<std::uint32_t, std::string>& functions) {
+    // A symbol table, and the string table it names, are read whole: bounded.
+    GElf_Shdr strings{};
+    Elf_Scn* string_section = elf_getscn(elf, shdr.sh_link);
+    if (shdr.sh_size > kMaxSymbolTableBytes || string_section == nullptr || gelf_getshdr(string_section, &strings) == nullptr ||
+        strings.sh_size > kMaxSymbolTableBytes) {
+        throw BadInput(path + ": malformed ELF: a symbol table or its names larger than " +
+                       std::to_string(kMaxSymbolTableBytes >> 20) + " MiB, or without its string table");
+    }
+    if (shdr.sh_entsize != sizeof(Elf32_Sym)) {
+        throw BadInput(path + ": malformed ELF: symbol table entries of " + std::to_string(shdr.sh_entsize) +
+                       " bytes (ELF32 symbols are " + std::to_string(sizeof(Elf32_Sym)) + ")");
+    }
+    Elf_Data* data = elf_getdata(scn, nullptr);
+    if (data == nullptr) throw BadInput(path + ": malformed ELF: the symbol table lies outside the file");
+    const auto count = data->d_size / sizeof(Elf32_Sym);
+    for (std::size_t i = 0; i < count && i < 1'000'000; ++i) {
+        GElf_Sym sym;
+        if (gelf_getsym(data, static_cast<int>(i), &sym) == nullptr) continue;
+        const char* sname = elf_strptr(elf, shdr.sh_link, sym.st_name);
+        if (sname == nullptr) {
+            throw BadInput(path + ": malformed ELF: symbol " + std::to_string(i) + " has its name outside the string table");
+        }
+        if (sname[0] == '\0' || sname[0] == '.') continue;
+        const auto value = static_cast<std::uint32_t>(sym.st_value);
+        symbols.emplace(sname, value);
+        const int type = GELF_ST_TYPE(sym.st_info);
+        const bool in_flash = value < kDataSpaceBase && sym.st_shndx != SHN_ABS && sym.st_shndx != SHN_UNDEF;
+        if (in_flash && (type == STT_FUNC || type == STT_NOTYPE)) {
+            auto [it, inserted] = functions.emplace(value, sname);
+            if (!inserted && name_rank(sname, type) > name_rank(it->second.c_str(), STT_NOTYPE)) it->second = sname;
+        }
+    }
+}
+
 }  // namespace
 
 ElfImage ElfImage::load(const std::string& path_given) {
@@ -102,19 +166,7 @@ ElfImage ElfImage::load(const std::string& path_given) {
     const auto file_size = static_cast<std::uint64_t>(st.st_size);
     h.elf = elf_begin(h.fd, ELF_C_READ, nullptr);
     if (h.elf == nullptr || elf_kind(h.elf) != ELF_K_ELF) throw BadInput(path + ": not an ELF file");
-    GElf_Ehdr ehdr;
-    if (gelf_getehdr(h.elf, &ehdr) == nullptr) throw BadInput(path + ": not an ELF file (unreadable header)");
-    if (ehdr.e_machine != EM_AVR) {
-        throw BadInput(path + ": not an AVR ELF (e_machine " + std::to_string(ehdr.e_machine) +
-                       ", expected " + std::to_string(EM_AVR) + ")");
-    }
-    if (gelf_getclass(h.elf) != ELFCLASS32) throw BadInput(path + ": not an AVR ELF (not ELF32)");
-
-    if (ehdr.e_shoff + static_cast<std::uint64_t>(ehdr.e_shnum) * ehdr.e_shentsize > file_size ||
-        ehdr.e_phoff + static_cast<std::uint64_t>(ehdr.e_phnum) * ehdr.e_phentsize > file_size) {
-        throw BadInput(path + ": malformed ELF: truncated (its headers reach past the end of the file)");
-    }
-    if (ehdr.e_type != ET_EXEC) throw BadInput(path + ": not an AVR executable (an object file or library? link it first)");
+    check_elf_header(h.elf, file_size, path);
 
     ElfImage image;
     image.path_ = path_given;
@@ -140,48 +192,10 @@ ElfImage ElfImage::load(const std::string& path_given) {
             image.text_end_ = static_cast<std::uint32_t>(shdr.sh_addr + shdr.sh_size);
         }
         if (std::strcmp(name, ".mmcu") == 0 && shdr.sh_type == SHT_PROGBITS) {
-            if (shdr.sh_size > 4096) throw BadInput(path + ": malformed .mmcu section (" + std::to_string(shdr.sh_size) + " bytes; simavr tags take a few hundred)");
-            Elf_Data* data = elf_getdata(scn, nullptr);
-            if (data == nullptr || data->d_buf == nullptr || data->d_size != shdr.sh_size) {
-                throw BadInput(path + ": malformed ELF: the .mmcu section's bytes lie outside the file");
-            }
-            const auto* bytes = static_cast<const std::uint8_t*>(data->d_buf);
-            mmcu_bytes.assign(bytes, bytes + data->d_size);
+            mmcu_bytes = mmcu_section(scn, shdr, path);
             mmcu = &mmcu_bytes;
         }
-        if (shdr.sh_type != SHT_SYMTAB) continue;
-        // A symbol table, and the string table it names, are read whole: bounded.
-        GElf_Shdr strings{};
-        Elf_Scn* string_section = elf_getscn(h.elf, shdr.sh_link);
-        if (shdr.sh_size > kMaxSymbolTableBytes || string_section == nullptr || gelf_getshdr(string_section, &strings) == nullptr ||
-            strings.sh_size > kMaxSymbolTableBytes) {
-            throw BadInput(path + ": malformed ELF: a symbol table or its names larger than " +
-                           std::to_string(kMaxSymbolTableBytes >> 20) + " MiB, or without its string table");
-        }
-        if (shdr.sh_entsize != sizeof(Elf32_Sym)) {
-            throw BadInput(path + ": malformed ELF: symbol table entries of " + std::to_string(shdr.sh_entsize) +
-                           " bytes (ELF32 symbols are " + std::to_string(sizeof(Elf32_Sym)) + ")");
-        }
-        Elf_Data* data = elf_getdata(scn, nullptr);
-        if (data == nullptr) throw BadInput(path + ": malformed ELF: the symbol table lies outside the file");
-        const auto count = data->d_size / sizeof(Elf32_Sym);
-        for (std::size_t i = 0; i < count && i < 1'000'000; ++i) {
-            GElf_Sym sym;
-            if (gelf_getsym(data, static_cast<int>(i), &sym) == nullptr) continue;
-            const char* sname = elf_strptr(h.elf, shdr.sh_link, sym.st_name);
-            if (sname == nullptr) {
-                throw BadInput(path + ": malformed ELF: symbol " + std::to_string(i) + " has its name outside the string table");
-            }
-            if (sname[0] == '\0' || sname[0] == '.') continue;
-            const auto value = static_cast<std::uint32_t>(sym.st_value);
-            image.symbols_.emplace(sname, value);
-            const int type = GELF_ST_TYPE(sym.st_info);
-            const bool in_flash = value < kDataSpaceBase && sym.st_shndx != SHN_ABS && sym.st_shndx != SHN_UNDEF;
-            if (in_flash && (type == STT_FUNC || type == STT_NOTYPE)) {
-                auto [it, inserted] = image.flash_functions_.emplace(value, sname);
-                if (!inserted && name_rank(sname, type) > name_rank(it->second.c_str(), STT_NOTYPE)) it->second = sname;
-            }
-        }
+        if (shdr.sh_type == SHT_SYMTAB) read_symbol_table(h.elf, scn, shdr, path, image.symbols_, image.flash_functions_);
     }
     if (!has_text) throw BadInput(path + ": AVR ELF without a .text section (nothing to run)");
 
