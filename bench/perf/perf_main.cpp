@@ -271,6 +271,120 @@ void run_motor_overhead(const std::string& firmware_dir, const std::string& sour
 void run_printer_lockstep(const std::string& firmware_dir, const std::string& source_dir, int repeats);
 void run_fast_forward(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 
+// The workloads of the side-by-side table: bare simavr and the bench on the same ELF.
+const Workload kWorkloads[] = {
+    {"busy_poll (CPU-bound, PORTD counter)", "busy_poll", 5.0},
+    {"busy_poll_step (step pins PD2/PD3 held low)", "busy_poll_step", 5.0},
+    {"blink_timer1 (timer ISR, idle loop)", "blink_timer1", 5.0},
+    {"toggle_1mhz (PB0 edge every us: 1 M events/s)", "toggle_1mhz", 2.0},
+    {"grbl_stepper (grbl-style step ISR, idle)", "grbl_stepper", 5.0},
+    {"ramps_teacup (Teacup-style RAMPS, 2560)", "ramps_teacup", 5.0},
+    {"sleep_idle (SLEEP between 10 ms wake-ups)", "sleep_idle", 600.0},
+};
+
+// --workload W --side S: one side once (callgrind counts its instructions).
+int run_one_side(const std::string& only_workload, const std::string& side, const std::string& firmware_dir, double scale,
+                 const std::string& vcd_path) {
+    for (const auto& w : kWorkloads) {
+        if (only_workload != w.elf) continue;
+        const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
+        const auto cycles = static_cast<avr_cycle_count_t>(w.simulated_s * scale * elf.embedded_frequency_hz());
+        std::uint64_t events = 0;
+        const double cpu = side == "bare" ? run_bare_simavr(elf, cycles) : run_avrbench(elf, cycles, vcd_path, &events);
+        std::printf("%s %s %.3f s CPU\n", w.elf, side.c_str(), cpu);
+        std::filesystem::remove(vcd_path);
+        return 0;
+    }
+    std::fprintf(stderr, "avrbench_perf: no workload '%s'\n", only_workload.c_str());
+    return 2;
+}
+
+// --elf: a firmware built outside this repository (grbl, Teacup, Marlin...),
+// idle on both sides: no host, no board, same simulated time.
+void run_external_elf(const std::string& external_elf, const std::string& external_mcu, double external_seconds, int repeats,
+                      const std::string& vcd_path) {
+    avrbench::McuOptions options;
+    options.mcu_type = external_mcu;
+    options.frequency_hz = 16'000'000;
+    const auto elf = avrbench::ElfImage::load(external_elf);
+    const auto cycles = static_cast<avr_cycle_count_t>(external_seconds * options.frequency_hz);
+    std::vector<double> bare, bench;
+    std::uint64_t events = 0;
+    for (int i = 0; i < repeats; ++i) {
+        bare.push_back(run_bare_simavr(elf, cycles, options));
+        bench.push_back(run_avrbench(elf, cycles, vcd_path, &events, options));
+    }
+    const double b = median(bare), a = median(bench);
+    std::printf("%s (%s, 16 MHz), %.1f s simulated: bare %.1fx real time (%.3f s CPU), bench %.1fx (%.3f s), "
+                "ratio %.3f, %llu trace events\n",
+                external_elf.c_str(), external_mcu.c_str(), external_seconds, external_seconds / b, b,
+                external_seconds / a, a, a / b, static_cast<unsigned long long>(events));
+    std::filesystem::remove(vcd_path);
+}
+
+// --rss: the CLI's peak memory streaming a VCD of 1 M events per simulated second.
+void run_rss_rows(const std::vector<double>& rss_seconds, const std::string& firmware_dir, const std::string& vcd_path) {
+    std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace-only PB0 --vcd", "sim s", "peak RSS MiB");
+    for (const double seconds : rss_seconds) {
+        const double mib = cli_peak_rss_mib(firmware_dir + "/toggle_1mhz.elf", seconds, vcd_path);
+        std::printf("%-44s %9.0f %14.1f\n", "", seconds, mib);
+        std::filesystem::remove(vcd_path);
+        std::filesystem::remove(vcd_path.substr(0, vcd_path.size() - 4) + ".gtkw");
+    }
+}
+
+// The side-by-side table: CPU seconds of alternating runs, median per side.
+void run_workload_table(const std::string& firmware_dir, int repeats, double scale, const std::string& vcd_path) {
+    std::printf("CPU seconds, median of %d alternating runs per side\n", repeats);
+    std::printf("%-48s %7s %11s %11s %9s %9s %7s\n", "workload", "sim s", "bare RTF", "bench RTF", "bare s",
+                "bench s", "ratio");
+    for (const auto& w : kWorkloads) {
+        const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
+        const double simulated_s = w.simulated_s * scale;
+        const auto cycles = static_cast<avr_cycle_count_t>(simulated_s * elf.embedded_frequency_hz());
+        std::vector<double> bare, bench;
+        std::uint64_t events = 0;
+        for (int i = 0; i < repeats; ++i) {
+            bare.push_back(run_bare_simavr(elf, cycles));
+            bench.push_back(run_avrbench(elf, cycles, vcd_path, &events));
+        }
+        const double b = median(bare), a = median(bench);
+        std::printf("%-48s %7.1f %10.1fx %10.1fx %9.3f %9.3f %7.3f  (%llu trace events)\n", w.name, simulated_s,
+                    simulated_s / b, simulated_s / a, b, a, a / b, static_cast<unsigned long long>(events));
+    }
+    std::filesystem::remove(vcd_path);
+
+}
+
+// The thermal plant's overhead on the same firmware and simulated time.
+void run_thermal_overhead(const std::string& firmware_dir, int repeats, double scale) {
+    const std::string pid_elf = firmware_dir + "/thermal_pid.elf";
+    const double thermal_s = 300.0 * scale;
+    AdcTape tape;
+    std::uint64_t steps_with = 0, steps_without = 0;
+    double cpu = 0, cpu_without = 1e300, cpu_with = 1e300;
+    run_board(kThermalMegaBoard, pid_elf, thermal_s, &tape, nullptr, &steps_with, &cpu);  // records the inputs
+    double best_without = 1e300, best_with = 1e300;
+    for (int i = 0; i < repeats; ++i) {
+        best_without = std::min(best_without,
+                                run_board(kBareMegaBoard, pid_elf, thermal_s, nullptr, &tape, &steps_without, &cpu));
+        cpu_without = std::min(cpu_without, cpu);
+        best_with = std::min(best_with, run_board(kThermalMegaBoard, pid_elf, thermal_s, nullptr, nullptr, &steps_with, &cpu));
+        cpu_with = std::min(cpu_with, cpu);
+    }
+    // The plant side takes a few more run-loop steps: its sample ticks split
+    // some SLEEP fast-forwards in two (about 20 per simulated second).
+    std::printf("\n(run-loop steps: %llu without the plant, %llu with it)",
+                static_cast<unsigned long long>(steps_without), static_cast<unsigned long long>(steps_with));
+    std::printf("\n%-44s %9s %12s %12s %9s %9s %7s\n", "thermal plant (thermal_pid, ATmega2560)", "sim s",
+                "no plant RTF", "plant RTF", "no pl. s", "plant s", "ratio");
+    std::printf("%-44s %9.1f %11.1fx %11.1fx %9.3f %9.3f %7.3f\n", "hot end + bed plants, heaters, NTCs, fan",
+                thermal_s, thermal_s / best_without, thermal_s / best_with, best_without, best_with,
+                best_with / best_without);
+    std::printf("%-44s %9s %12s %12s %9.3f %9.3f %7.3f\n", "  (thread CPU time, best of each)", "", "", "",
+                cpu_without, cpu_with, cpu_with / cpu_without);
+}
+
 int perf_main(int argc, char** argv) {
     CLI::App app{"avrbench_perf: bench vs bare simavr on the same ELFs"};
     int repeats = 3;
@@ -307,51 +421,10 @@ int perf_main(int argc, char** argv) {
         return 0;
     }
 
-    const Workload workloads[] = {
-        {"busy_poll (CPU-bound, PORTD counter)", "busy_poll", 5.0},
-        {"busy_poll_step (step pins PD2/PD3 held low)", "busy_poll_step", 5.0},
-        {"blink_timer1 (timer ISR, idle loop)", "blink_timer1", 5.0},
-        {"toggle_1mhz (PB0 edge every us: 1 M events/s)", "toggle_1mhz", 2.0},
-        {"grbl_stepper (grbl-style step ISR, idle)", "grbl_stepper", 5.0},
-        {"ramps_teacup (Teacup-style RAMPS, 2560)", "ramps_teacup", 5.0},
-        {"sleep_idle (SLEEP between 10 ms wake-ups)", "sleep_idle", 600.0},
-    };
     const auto vcd_path = (std::filesystem::temp_directory_path() / "avrbench_perf.vcd").string();
-    if (!only_workload.empty()) {
-        // One side once (for callgrind's instruction counts).
-        for (const auto& w : workloads) {
-            if (only_workload != w.elf) continue;
-            const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
-            const auto cycles = static_cast<avr_cycle_count_t>(w.simulated_s * scale * elf.embedded_frequency_hz());
-            std::uint64_t events = 0;
-            const double cpu = side == "bare" ? run_bare_simavr(elf, cycles) : run_avrbench(elf, cycles, vcd_path, &events);
-            std::printf("%s %s %.3f s CPU\n", w.elf, side.c_str(), cpu);
-            std::filesystem::remove(vcd_path);
-            return 0;
-        }
-        std::fprintf(stderr, "avrbench_perf: no workload '%s'\n", only_workload.c_str());
-        return 2;
-    }
+    if (!only_workload.empty()) return run_one_side(only_workload, side, firmware_dir, scale, vcd_path);
     if (!external_elf.empty()) {
-        // A firmware built outside this repository (grbl, Teacup, Marlin...),
-        // idle on both sides: no host, no board, same simulated time.
-        avrbench::McuOptions options;
-        options.mcu_type = external_mcu;
-        options.frequency_hz = 16'000'000;
-        const auto elf = avrbench::ElfImage::load(external_elf);
-        const auto cycles = static_cast<avr_cycle_count_t>(external_seconds * options.frequency_hz);
-        std::vector<double> bare, bench;
-        std::uint64_t events = 0;
-        for (int i = 0; i < repeats; ++i) {
-            bare.push_back(run_bare_simavr(elf, cycles, options));
-            bench.push_back(run_avrbench(elf, cycles, vcd_path, &events, options));
-        }
-        const double b = median(bare), a = median(bench);
-        std::printf("%s (%s, 16 MHz), %.1f s simulated: bare %.1fx real time (%.3f s CPU), bench %.1fx (%.3f s), "
-                    "ratio %.3f, %llu trace events\n",
-                    external_elf.c_str(), external_mcu.c_str(), external_seconds, external_seconds / b, b,
-                    external_seconds / a, a, a / b, static_cast<unsigned long long>(events));
-        std::filesystem::remove(vcd_path);
+        run_external_elf(external_elf, external_mcu, external_seconds, repeats, vcd_path);
         return 0;
     }
     if (compare_edges > 0) {
@@ -359,61 +432,11 @@ int perf_main(int argc, char** argv) {
         return 0;
     }
     if (!rss_seconds.empty()) {
-        std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace-only PB0 --vcd", "sim s", "peak RSS MiB");
-        for (const double seconds : rss_seconds) {
-            const double mib = cli_peak_rss_mib(firmware_dir + "/toggle_1mhz.elf", seconds, vcd_path);
-            std::printf("%-44s %9.0f %14.1f\n", "", seconds, mib);
-            std::filesystem::remove(vcd_path);
-            std::filesystem::remove(vcd_path.substr(0, vcd_path.size() - 4) + ".gtkw");
-        }
+        run_rss_rows(rss_seconds, firmware_dir, vcd_path);
         return 0;
     }
-    std::printf("CPU seconds, median of %d alternating runs per side\n", repeats);
-    std::printf("%-48s %7s %11s %11s %9s %9s %7s\n", "workload", "sim s", "bare RTF", "bench RTF", "bare s",
-                "bench s", "ratio");
-    for (const auto& w : workloads) {
-        if (only_thermal) break;
-        const auto elf = avrbench::ElfImage::load(firmware_dir + "/" + w.elf + ".elf");
-        const double simulated_s = w.simulated_s * scale;
-        const auto cycles = static_cast<avr_cycle_count_t>(simulated_s * elf.embedded_frequency_hz());
-        std::vector<double> bare, bench;
-        std::uint64_t events = 0;
-        for (int i = 0; i < repeats; ++i) {
-            bare.push_back(run_bare_simavr(elf, cycles));
-            bench.push_back(run_avrbench(elf, cycles, vcd_path, &events));
-        }
-        const double b = median(bare), a = median(bench);
-        std::printf("%-48s %7.1f %10.1fx %10.1fx %9.3f %9.3f %7.3f  (%llu trace events)\n", w.name, simulated_s,
-                    simulated_s / b, simulated_s / a, b, a, a / b, static_cast<unsigned long long>(events));
-    }
-    std::filesystem::remove(vcd_path);
-
-    // Thermal plant overhead on the same firmware and simulated time.
-    const std::string pid_elf = firmware_dir + "/thermal_pid.elf";
-    const double thermal_s = 300.0 * scale;
-    AdcTape tape;
-    std::uint64_t steps_with = 0, steps_without = 0;
-    double cpu = 0, cpu_without = 1e300, cpu_with = 1e300;
-    run_board(kThermalMegaBoard, pid_elf, thermal_s, &tape, nullptr, &steps_with, &cpu);  // records the inputs
-    double best_without = 1e300, best_with = 1e300;
-    for (int i = 0; i < repeats; ++i) {
-        best_without = std::min(best_without,
-                                run_board(kBareMegaBoard, pid_elf, thermal_s, nullptr, &tape, &steps_without, &cpu));
-        cpu_without = std::min(cpu_without, cpu);
-        best_with = std::min(best_with, run_board(kThermalMegaBoard, pid_elf, thermal_s, nullptr, nullptr, &steps_with, &cpu));
-        cpu_with = std::min(cpu_with, cpu);
-    }
-    // The plant side takes a few more run-loop steps: its sample ticks split
-    // some SLEEP fast-forwards in two (about 20 per simulated second).
-    std::printf("\n(run-loop steps: %llu without the plant, %llu with it)",
-                static_cast<unsigned long long>(steps_without), static_cast<unsigned long long>(steps_with));
-    std::printf("\n%-44s %9s %12s %12s %9s %9s %7s\n", "thermal plant (thermal_pid, ATmega2560)", "sim s",
-                "no plant RTF", "plant RTF", "no pl. s", "plant s", "ratio");
-    std::printf("%-44s %9.1f %11.1fx %11.1fx %9.3f %9.3f %7.3f\n", "hot end + bed plants, heaters, NTCs, fan",
-                thermal_s, thermal_s / best_without, thermal_s / best_with, best_without, best_with,
-                best_with / best_without);
-    std::printf("%-44s %9s %12s %12s %9.3f %9.3f %7.3f\n", "  (thread CPU time, best of each)", "", "", "",
-                cpu_without, cpu_with, cpu_with / cpu_without);
+    if (!only_thermal) run_workload_table(firmware_dir, repeats, scale, vcd_path);
+    run_thermal_overhead(firmware_dir, repeats, scale);
     if (!only_thermal) run_motor_overhead(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
     if (!only_thermal) run_printer_lockstep(firmware_dir, AVRBENCH_SOURCE_DIR, repeats);
     if (!only_thermal) run_fast_forward(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
