@@ -77,7 +77,13 @@ void LimitSwitch::connect_axis(Carriage& axis) {
     axis_->on_move([this](double position_m) { on_axis_move(position_m); });
 }
 
-bool LimitSwitch::contact_closed() const { return normally_open_ ? triggered_ : !triggered_; }
+bool LimitSwitch::contact_closed() const {
+    if (fault() == "stuck_closed") return true;
+    if (fault() == "stuck_open") return false;
+    return normally_open_ ? triggered_ : !triggered_;
+}
+
+void LimitSwitch::apply_fault(const std::string&) { set_contact(contact_closed()); }
 
 void LimitSwitch::start() {
     on_axis_move(axis_->position_mm() * 1e-3);

@@ -29,6 +29,11 @@ public:
     unsigned contact_transitions() const { return contact_transitions_; }
 
     void start() override;
+    // stuck_closed: the contact is closed wherever the carriage is (a
+    // shorted or jammed switch, or a finger on it); stuck_open: never closes
+    // (a broken wire); none: the carriage decides again.
+    std::vector<std::string> fault_names() const override { return {"stuck_closed", "stuck_open"}; }
+    void apply_fault(const std::string& fault) override;
 
 private:
     void connect_axis(Carriage& axis);

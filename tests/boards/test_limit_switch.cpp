@@ -125,5 +125,34 @@ TEST(LimitSwitch, PushPullSensorDrivesBothLevelsAgainstThePullUp) {
     EXPECT_TRUE(h.board.findings().empty());
 }
 
+// Faults, injected at power-on: limit_probe (firmware/boards/limit_probe)
+// steps towards the switch while PB1 reads 1 and back while it reads 0,
+// each loop capped at 60000 steps.
+TEST(LimitSwitch, StuckClosedReadsClosedWhereverTheCarriageIs) {
+    Board board(parse_board_text(board_text(""), "limit-test.yaml"), {{"uno", test::firmware("limit_probe")}});
+    board.part("x_limit").inject_fault("stuck_closed", 0);
+    board.run_for_seconds(2.0);
+    ASSERT_EQ(board.mcu().read_ram_u8("done"), 1);
+    // Closed before the first step (the carriage at 1 mm, the switch at 0.5 mm)...
+    EXPECT_EQ(board.mcus()[0]->read_ram_u16("steps_to_trip"), 0);
+    // ...and still closed after backing off 60000 steps (240 mm).
+    EXPECT_EQ(board.mcus()[0]->read_ram_u16("steps_to_release"), 60000);
+    EXPECT_TRUE(board.part_as<LimitSwitch>("x_limit").contact_closed());
+}
+
+TEST(LimitSwitch, StuckOpenNeverTripsAndNoneRepairs) {
+    Board board(parse_board_text(board_text(""), "limit-test.yaml"), {{"uno", test::firmware("limit_probe")}});
+    auto& sw = board.part_as<LimitSwitch>("x_limit");
+    sw.inject_fault("stuck_open", 0);
+    board.run_for_seconds(0.05);  // ~2000 steps: the carriage is past the switch (125 steps away)
+    EXPECT_TRUE(sw.triggered());   // where the carriage is...
+    EXPECT_FALSE(sw.contact_closed());  // ...but the contact stays open
+    EXPECT_EQ(board.pin("uno.PB1").level(), 1);  // the pull-up
+    sw.inject_fault("none", board.mcu().cycle());
+    board.run_for_seconds(0.001);
+    EXPECT_TRUE(sw.contact_closed());
+    EXPECT_EQ(board.pin("uno.PB1").level(), 0);
+}
+
 }  // namespace
 }  // namespace avrbench

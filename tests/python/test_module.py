@@ -88,6 +88,19 @@ def test_driving_a_pin_reaches_the_firmware(elf):
     assert bench.net("uno.PB1").level == 1
 
 
+def test_triggering_a_limit_switch_alarms_the_firmware(elf):
+    # The switch's first fault is stuck_closed (bench/parts/LimitSwitch.hpp):
+    # its input PB1 goes to ground and grbl_stepper's pin change vector sets `alarm`.
+    bench = avrbench.Bench("arduino-uno-cnc-shield-v3", elf("grbl_stepper"))
+    bench.serial().expect(r"^avrbench grbl_stepper", timeout="100ms")
+    x_limit = bench.part("x_limit")
+    assert x_limit.faults == ["stuck_closed", "stuck_open"]
+    x_limit.trigger()
+    bench.run_for("1ms")
+    assert x_limit.fault == "stuck_closed" and x_limit.closed == 1
+    assert bench.mcu().symbol("alarm") == 1
+
+
 def test_a_gcode_file_streams_through_the_boards_host(elf, tmp_path):
     # grbl_stepper answers "ok" per line (not grbl's banner): family generic.
     # 100 and 200 steps at 250 steps/mm from 100 mm: 100.4 and 100.8 mm.
