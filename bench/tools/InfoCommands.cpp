@@ -51,7 +51,7 @@ struct CamArgs {
     std::string dxf;
     std::string out;            // .nc file ("" = beside the DXF)
     std::string tolerance = "0.01mm";
-    std::string feed = "600";   // mm/min
+    std::string feed = "120";   // mm/min: as run --dxf, the plotter tests' 2 mm/s
 };
 
 // DXF -> aligned segments -> G-code (seed 002's CAD2G, docs/CNC.md).
@@ -90,7 +90,7 @@ std::vector<Command> add_info_commands(CLI::App& app) {
     cam_cmd->add_option("dxf", cam.dxf, "the drawing, machine millimetres from home")->required();
     cam_cmd->add_option("-o,--output", cam.out, "the .nc file to write (default: beside the DXF)");
     cam_cmd->add_option("--tolerance", cam.tolerance, "endpoints closer than this are one point (default 0.01mm)");
-    cam_cmd->add_option("--feed", cam.feed, "drawing feed in mm/min (default 600)");
+    cam_cmd->add_option("--feed", cam.feed, "drawing feed in mm/min (default 120, as run --dxf)");
 
     return {{boards_cmd, [] { return boards_command(); }},
             {findings_cmd, [] { return findings_command(); }},
