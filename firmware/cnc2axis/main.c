@@ -326,6 +326,19 @@ static void m30(void)
 {
     PORTB |= _BV(X_EN) | _BV(Y_EN);
     pen(PEN_UP_OCR);
+#ifndef IMPROVED
+    /* The thesis says only that M30 disables the drivers and sleeps; its
+     * acceptance check (digest §8 item 15) wants the pen up. Power-down stops
+     * Timer1, and the new width only starts at the next 20 ms frame: give the
+     * SG90 its 0.15 s to lift before the clock stops (the improved build's
+     * pen() already waits). Ours, not the thesis's: without it the pen stayed
+     * down (tests/cnc Cnc2Axis.M30DisablesSleepsAndLiftsThePen). */
+    _delay_ms(200);
+#endif
+    /* TXC0 is still set from the last byte sent (it clears only by writing
+     * 1 or by its ISR): clear it, or the wait below ends at once and the
+     * ACK is cut off by the sleep. */
+    UCSR0A |= _BV(TXC0);
     tx(ACK);
     while (!(UCSR0A & _BV(TXC0))) { /* let the ACK leave before the clock stops */
     }

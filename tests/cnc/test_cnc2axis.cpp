@@ -180,16 +180,24 @@ TEST(Cnc2Axis, ArcRecordsArePipelinedWithOneAckEach) {
 }
 
 TEST(Cnc2Axis, M30DisablesSleepsAndLiftsThePen) {
-    CncRun run;
-    run.send({0x7F, 0x3B});  // an unknown command byte, then M30
-    run.board.run_for_seconds(0.5);
-    const std::string nak_then_ack{static_cast<char>(kNak), static_cast<char>(kAck)};
-    EXPECT_EQ(run.received(), nak_then_ack);
-    EXPECT_TRUE(run.uno.halted());
-    EXPECT_NE(run.uno.halt_reason().find("SLEEP with interrupts disabled"), std::string::npos);
-    EXPECT_TRUE(run.uno.pin("PB2").level());
-    EXPECT_TRUE(run.uno.pin("PB4").level());
-    EXPECT_FALSE(run.board.part_as<PenLift>("pen").down());
+    for (const std::string firmware : {"cnc2axis", "cnc2axis_improved"}) {
+        SCOPED_TRACE(firmware);
+        CncRun run(firmware);
+        // A G01 first: the pen goes down (OCR1A = 2000), so lifting it is something M30 does.
+        run.send(run.g01(160, 0, 3, 3, kYOff));
+        run.run_until_acks(1, 5);
+        run.board.run_for_seconds(0.3);
+        EXPECT_TRUE(run.board.part_as<PenLift>("pen").down());
+        run.send({0x7F, 0x3B});  // an unknown command byte, then M30
+        run.board.run_for_seconds(0.5);
+        const std::string ack_nak_ack{static_cast<char>(kAck), static_cast<char>(kNak), static_cast<char>(kAck)};
+        EXPECT_EQ(run.received(), ack_nak_ack);
+        EXPECT_TRUE(run.uno.halted());
+        EXPECT_NE(run.uno.halt_reason().find("SLEEP with interrupts disabled"), std::string::npos);
+        EXPECT_TRUE(run.uno.pin("PB2").level());
+        EXPECT_TRUE(run.uno.pin("PB4").level());
+        EXPECT_FALSE(run.board.part_as<PenLift>("pen").down());
+    }
 }
 
 TEST(Cnc2Axis, PenServoIsPhaseCorrectPwmMode10) {
