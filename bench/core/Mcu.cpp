@@ -1,4 +1,6 @@
 #include "core/Mcu.hpp"
+
+#include <type_traits>
 #include "core/SimavrStep.hpp"
 
 #include <cctype>
@@ -118,6 +120,8 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     avr_ = avr_make_mcu_by_name(mcu_type_.c_str());
     if (avr_ == nullptr) throw BadInput("unknown MCU '" + mcu_type_ + "' (simavr has no core by that name)");
     avr_init(avr_);
+    cycle_ = &avr_->cycle;
+    state_ = &avr_->state;
     route_simavr_log(avr_, this);
     avr_->log = LOG_ERROR;
 
@@ -248,7 +252,8 @@ Mcu::~Mcu() {
     }
 }
 
-Cycle Mcu::cycle() const { return avr_->cycle; }
+static_assert(cpu_Sleeping == 3, "Mcu::kCpuSleeping");
+static_assert(std::is_same_v<avr_cycle_count_t, std::uint64_t>, "Mcu::cycle_");
 
 void Mcu::request_stop() {
     stop_requested_ = true;
@@ -260,7 +265,7 @@ void Mcu::request_yield() {
     stop_requested_ = true;
     avr_cycle_timer_register(avr_, 0, &stop_timer, this);
 }
-bool Mcu::dormant() const { return avr_->state == cpu_Sleeping && !avr_has_pending_interrupts(avr_); }
+bool Mcu::no_pending_interrupts() const { return !avr_has_pending_interrupts(avr_); }
 Cycle Mcu::next_event_cycle() const {
     const avr_cycle_timer_slot_p head = avr_->cycle_timers.timer;
     return head == nullptr ? ~Cycle{0} : head->when;

@@ -102,7 +102,9 @@ public:
     const ElfImage& elf() const { return elf_; }
     avr_t* avr() const { return avr_; }
 
-    Cycle cycle() const;
+    // Inline (the lockstep asks each MCU its cycle several times per turn):
+    // a pointer to simavr's own counter, set when the core is made.
+    Cycle cycle() const { return *cycle_; }
     std::uint32_t pc_bytes() const;
     std::uint16_t stack_pointer() const;
     double seconds() const { return static_cast<double>(cycle()) / frequency_hz_; }
@@ -142,7 +144,7 @@ public:
     bool in_run() const { return in_run_; }
     // Asleep with no interrupt on its way: nothing changes until its next
     // cycle timer, unless something outside wakes it.
-    bool dormant() const;
+    bool dormant() const { return *state_ == kCpuSleeping && no_pending_interrupts(); }
     // The first pending cycle timer (simavr's peripherals, the scheduler's
     // events), or the largest cycle when none is pending.
     Cycle next_event_cycle() const;
@@ -280,6 +282,12 @@ private:
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
+    // simavr's cycle counter and core state (avr_t::cycle, avr_t::state),
+    // for the inline getters; cpu_Sleeping is 3 in sim_avr.h (static_assert in Mcu.cpp).
+    const std::uint64_t* cycle_ = nullptr;
+    const int* state_ = nullptr;
+    static constexpr int kCpuSleeping = 3;
+    bool no_pending_interrupts() const;
     DebugHook* debug_ = nullptr;
     bool skip_idle_before_debug_ = false;
     bool stop_at_sleep_ = false;  // run_until_sleep: the run loop ends when the core sleeps
