@@ -147,8 +147,8 @@ std::string byte_comparison(const std::string& id, const std::vector<std::pair<d
     return out + "</tbody></table>\n";
 }
 
-void append_comparison(std::string& out, const Context& ctx) {
-    const ComparisonView& cmp = *ctx.report.comparison;
+// The verdict, the diff as the CLI prints it and the table of channels.
+void append_comparison_text(std::string& out, const ComparisonView& cmp, double div_t) {
     out += "<section id=\"comparison-section\"><h2>Comparison with the golden timeline</h2>\n";
     out += std::string("<p><span class=\"badge ") + (cmp.passed ? "good\">passed" : "bad\">FAILED") + "</span></p>\n";
     // The diff as the CLI prints it: one <pre>, its line breaks kept.
@@ -161,7 +161,6 @@ void append_comparison(std::string& out, const Context& ctx) {
         at = nl + 1;
     }
     out += "</pre>\n";
-    const double div_t = to_seconds(cmp.first_divergence_cycle, cmp.first_divergence_clock_hz);
     if (!cmp.first_divergence_signal.empty())
         out += "<p>First divergence: <b class=\"mono\">" + esc(cmp.first_divergence_signal) + "</b> at " +
                seconds_text(div_t) + " (cycle " + std::to_string(cmp.first_divergence_cycle) + ")</p>\n";
@@ -180,6 +179,89 @@ void append_comparison(std::string& out, const Context& ctx) {
         out += "</tbody></table>\n";
     }
 
+}
+
+// Golden and actual of one channel: zoomed on the first divergence (with a
+// close-up and the whole run) for its channel, the whole run for the others.
+// False when neither timeline has it (nothing drawn).
+bool append_channel_plot(std::string& out, const Context& ctx, const std::string& name, double div_t) {
+    const ComparisonView& cmp = *ctx.report.comparison;
+    const long g = find_signal(cmp.golden, name);
+    const long a = ctx.report.timeline != nullptr ? find_signal(*ctx.report.timeline, name) : -1;
+    if (g < 0 && a < 0) {
+        out += "<p class=\"note\">" + esc(name) + ": in neither timeline, nothing to draw.</p>\n";
+        return false;
+    }
+    const SignalInfo& any_info = g >= 0 ? cmp.golden.signals()[static_cast<std::size_t>(g)]
+                                        : ctx.report.timeline->signals()[static_cast<std::size_t>(a)];
+    if (any_info.kind == SignalKind::Bus && any_info.characters) {
+        out += plot_block(name + ": bytes, golden and actual", byte_comparison("comparison-" + id_fragment(name),
+                               g >= 0 ? byte_events(cmp.golden, static_cast<SignalId>(g)) : decltype(byte_events(cmp.golden, 0)){},
+                               a >= 0 ? byte_events(*ctx.report.timeline, static_cast<SignalId>(a))
+                                      : decltype(byte_events(cmp.golden, 0)){}));
+        return true;
+    }
+    Series golden, actual;
+    const SignalInfo* info = nullptr;
+    if (g >= 0) {
+        golden = extract(cmp.golden, {static_cast<SignalId>(g)})[0];
+        info = &cmp.golden.signals()[static_cast<std::size_t>(g)];
+    }
+    if (a >= 0) {
+        actual = extract(*ctx.report.timeline, {static_cast<SignalId>(a)})[0];
+        info = &ctx.report.timeline->signals()[static_cast<std::size_t>(a)];
+    }
+    const bool binary = info->kind == SignalKind::Wire;
+    const double end = std::max({ctx.end_s, last_time({golden, actual}), div_t, 1e-6});
+    const bool is_first = name == cmp.first_divergence_signal;
+
+    auto make_plot = [&](const std::string& id, double t0, double t1, bool zoomed) {
+        TimePlot plot;
+        plot.id = id;
+        plot.title = name + (zoomed ? ": golden and actual around the first divergence" : ": golden and actual");
+        plot.extra_attrs = " data-signal=\"" + esc(name) + "\"";
+        plot.t0 = t0, plot.t1 = t1;
+        plot.binary = binary;
+        plot.height = binary ? 90 : 150;
+        plot.y_label = binary ? "level" : info->kind == SignalKind::Bus ? "value" : name;
+        if (binary) plot.y = {-0.25, 1.25, 1};
+        else plot.y = value_range({&golden, &actual}, t0, t1, false);
+        if (g >= 0)
+            plot.series.push_back({"golden", kGoldenColor, step_points(golden, t0, t1, kTimePlotWidth), 6, 1, ""});
+        if (a >= 0)
+            plot.series.push_back({"actual", kActualColor, step_points(actual, t0, t1, kTimePlotWidth), 1.6, 1, ""});
+        if (is_first) {
+            plot.marker = VMarker{div_t, "first divergence " + seconds_text(div_t)};
+            plot.extra_legend.push_back({"first divergence", kDivergenceColor, 2, "5 3", ""});
+        }
+        return plot;
+    };
+
+    const std::string id = "comparison-" + id_fragment(name);
+    if (is_first) {
+        const std::vector<double> times = event_times(golden, actual);
+        const auto [z0, z1] = zoom_window(times, div_t, end);
+        out += plot_block(name + " around the first divergence (" + seconds_text(z0) + " to " + seconds_text(z1) + ")",
+                          render_time_plot(make_plot(id, z0, z1, true)));
+        // A close-up when the context window would show the shift as a sliver.
+        if (const auto detail = detail_window(times, div_t); detail && detail->second - detail->first < (z1 - z0) / 4)
+            out += plot_block(name + " close-up (" + seconds_text(detail->first) + " to " +
+                                  seconds_text(detail->second) + ")",
+                              render_time_plot(make_plot(id + "-detail", detail->first, detail->second, true)));
+        TimePlot overview = make_plot(id + "-overview", 0, end, false);
+        overview.shade = std::make_pair(z0, z1);
+        overview.height = binary ? 60 : 110;
+        out += plot_block(name + ", whole run (zoom window shaded)", render_time_plot(overview));
+    } else {
+        out += plot_block(name + ", whole run", render_time_plot(make_plot(id, 0, end, false)));
+    }
+    return true;
+}
+
+void append_comparison(std::string& out, const Context& ctx) {
+    const ComparisonView& cmp = *ctx.report.comparison;
+    const double div_t = to_seconds(cmp.first_divergence_cycle, cmp.first_divergence_clock_hz);
+    append_comparison_text(out, cmp, div_t);
     // Which channels to draw: the first divergence's, then the other non-ok ones.
     std::vector<std::string> names;
     if (!cmp.first_divergence_signal.empty()) names.push_back(cmp.first_divergence_signal);
@@ -192,76 +274,7 @@ void append_comparison(std::string& out, const Context& ctx) {
             out += "<p class=\"note\">" + std::to_string(names.size() - drawn) + " more diverging channels not drawn.</p>\n";
             break;
         }
-        const long g = find_signal(cmp.golden, name);
-        const long a = ctx.report.timeline != nullptr ? find_signal(*ctx.report.timeline, name) : -1;
-        if (g < 0 && a < 0) {
-            out += "<p class=\"note\">" + esc(name) + ": in neither timeline, nothing to draw.</p>\n";
-            continue;
-        }
-        ++drawn;
-        const SignalInfo& any_info = g >= 0 ? cmp.golden.signals()[static_cast<std::size_t>(g)]
-                                            : ctx.report.timeline->signals()[static_cast<std::size_t>(a)];
-        if (any_info.kind == SignalKind::Bus && any_info.characters) {
-            out += plot_block(name + ": bytes, golden and actual", byte_comparison("comparison-" + id_fragment(name),
-                                   g >= 0 ? byte_events(cmp.golden, static_cast<SignalId>(g)) : decltype(byte_events(cmp.golden, 0)){},
-                                   a >= 0 ? byte_events(*ctx.report.timeline, static_cast<SignalId>(a))
-                                          : decltype(byte_events(cmp.golden, 0)){}));
-            continue;
-        }
-        Series golden, actual;
-        const SignalInfo* info = nullptr;
-        if (g >= 0) {
-            golden = extract(cmp.golden, {static_cast<SignalId>(g)})[0];
-            info = &cmp.golden.signals()[static_cast<std::size_t>(g)];
-        }
-        if (a >= 0) {
-            actual = extract(*ctx.report.timeline, {static_cast<SignalId>(a)})[0];
-            info = &ctx.report.timeline->signals()[static_cast<std::size_t>(a)];
-        }
-        const bool binary = info->kind == SignalKind::Wire;
-        const double end = std::max({ctx.end_s, last_time({golden, actual}), div_t, 1e-6});
-        const bool is_first = name == cmp.first_divergence_signal;
-
-        auto make_plot = [&](const std::string& id, double t0, double t1, bool zoomed) {
-            TimePlot plot;
-            plot.id = id;
-            plot.title = name + (zoomed ? ": golden and actual around the first divergence" : ": golden and actual");
-            plot.extra_attrs = " data-signal=\"" + esc(name) + "\"";
-            plot.t0 = t0, plot.t1 = t1;
-            plot.binary = binary;
-            plot.height = binary ? 90 : 150;
-            plot.y_label = binary ? "level" : info->kind == SignalKind::Bus ? "value" : name;
-            if (binary) plot.y = {-0.25, 1.25, 1};
-            else plot.y = value_range({&golden, &actual}, t0, t1, false);
-            if (g >= 0)
-                plot.series.push_back({"golden", kGoldenColor, step_points(golden, t0, t1, kTimePlotWidth), 6, 1, ""});
-            if (a >= 0)
-                plot.series.push_back({"actual", kActualColor, step_points(actual, t0, t1, kTimePlotWidth), 1.6, 1, ""});
-            if (is_first) {
-                plot.marker = VMarker{div_t, "first divergence " + seconds_text(div_t)};
-                plot.extra_legend.push_back({"first divergence", kDivergenceColor, 2, "5 3", ""});
-            }
-            return plot;
-        };
-
-        const std::string id = "comparison-" + id_fragment(name);
-        if (is_first) {
-            const std::vector<double> times = event_times(golden, actual);
-            const auto [z0, z1] = zoom_window(times, div_t, end);
-            out += plot_block(name + " around the first divergence (" + seconds_text(z0) + " to " + seconds_text(z1) + ")",
-                              render_time_plot(make_plot(id, z0, z1, true)));
-            // A close-up when the context window would show the shift as a sliver.
-            if (const auto detail = detail_window(times, div_t); detail && detail->second - detail->first < (z1 - z0) / 4)
-                out += plot_block(name + " close-up (" + seconds_text(detail->first) + " to " +
-                                      seconds_text(detail->second) + ")",
-                                  render_time_plot(make_plot(id + "-detail", detail->first, detail->second, true)));
-            TimePlot overview = make_plot(id + "-overview", 0, end, false);
-            overview.shade = std::make_pair(z0, z1);
-            overview.height = binary ? 60 : 110;
-            out += plot_block(name + ", whole run (zoom window shaded)", render_time_plot(overview));
-        } else {
-            out += plot_block(name + ", whole run", render_time_plot(make_plot(id, 0, end, false)));
-        }
+        if (append_channel_plot(out, ctx, name, div_t)) ++drawn;
     }
     out += "</section>\n";
 }
