@@ -105,7 +105,7 @@ void DeltaRobot::sample() {
     for (auto& fn : move_listeners_) fn(effector_mm_);
 }
 
-void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) {
+std::optional<DeltaRobot::ReachProblem> DeltaRobot::reach_problem(const Eigen::Vector3d& target_mm) const {
     char where[96];
     std::snprintf(where, sizeof where, "(%.3f, %.3f, %.3f) mm", target_mm.x(), target_mm.y(), target_mm.z());
     // The robot hangs below its base (seed 004 §2: z < 0): above the base
@@ -121,22 +121,26 @@ void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std
             for (double sign : {-1.0, 1.0}) {
                 Eigen::Vector3d near = target_mm;
                 near[axis] += sign * kReachMarginMm;
-                if (pose(near)) return;
+                if (pose(near)) return std::nullopt;
             }
         }
-        report(DeltaRobot::kTargetOutOfReach, std::string("no pose of the arms below the base reaches the target; ") + line +
-                                                  " was answered ok, target " + where);
-        return;
+        return ReachProblem{"no pose of the arms below the base reaches the target", std::string(", target ") + where};
     }
     for (std::size_t k = 0; k < 3; ++k) {
         const double horn = offset_deg_[k] - (*theta)[k];
         const double lo = horns_[k]->min_angle_deg(), hi = horns_[k]->max_angle_deg();
         if (horn >= lo - kTravelMarginDeg && horn <= hi + kTravelMarginDeg) continue;
         char detail[200];
-        std::snprintf(detail, sizeof detail, " was answered ok, target %s needs %s at %.1f deg, its travel %g..%g deg", where,
+        std::snprintf(detail, sizeof detail, ", target %s needs %s at %.1f deg, its travel %g..%g deg", where,
                       horn_names_[k].c_str(), horn, lo, hi);
-        report(DeltaRobot::kTargetOutOfReach, "arm " + std::to_string(k + 1) + " beyond its servo's travel; " + line + detail);
-        return;
+        return ReachProblem{"arm " + std::to_string(k + 1) + " beyond its servo's travel", detail};
+    }
+    return std::nullopt;
+}
+
+void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) {
+    if (const auto why = reach_problem(target_mm)) {
+        report(DeltaRobot::kTargetOutOfReach, why->what + "; " + line + " was answered ok" + why->details);
     }
 }
 

@@ -134,12 +134,24 @@ void Bench::check_accepted_moves(UartHost& host) {
         std::size_t acknowledged = 0;
     };
     auto seen = std::make_shared<Seen>();
-    host.on_line_received([&host, robots, seen](const TranscriptEntry& entry) {
+    host.on_line_received([this, &host, robots, seen](const TranscriptEntry& entry) {
         const std::size_t acknowledged = host.lines_acknowledged();
         if (acknowledged == seen->acknowledged) return;
         seen->acknowledged = acknowledged;
-        if (entry.text.rfind("ok", 0) != 0) return;  // an error: the firmware did not take the line
         const GcodeLine& line = host.lines()[acknowledged - 1];
+        if (entry.text.rfind("ok", 0) != 0) {
+            // An error: the firmware did not take the line (its axes stay as
+            // they were). A refused target no robot reaches either is a
+            // right answer, not a finding (findings() leaves it out).
+            CommandedTarget probe = seen->target;
+            const auto target = probe.accept(line.text);
+            if (!target) return;
+            const Eigen::Vector3d t{(*target)[0], (*target)[1], (*target)[2]};
+            for (AcceptedMoves* robot : robots) {
+                if (robot->refusal_is_right(t)) right_refusals_.insert({&host, line.number});
+            }
+            return;
+        }
         const auto target = seen->target.accept(line.text);
         if (!target) return;
         const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
@@ -254,6 +266,7 @@ std::vector<Finding> Bench::findings() const {
     std::vector<Finding> out = board_->findings();
     for (const auto& [name, host] : hosts_) {
         for (const auto& e : host->events()) {
+            if (e.kind == HostEventKind::Error && e.line && right_refusals_.count({host.get(), e.line->number}) != 0) continue;
             Finding f;
             f.kind = UartHost::kHostProtocol;
             f.source = name;

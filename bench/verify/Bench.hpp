@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -120,6 +121,9 @@ private:
     Timeline timeline_;
     Recorder recorder_{timeline_};
     std::map<std::string, std::unique_ptr<UartHost>> hosts_;
+    // Lines a host's firmware refused that the machine cannot reach either
+    // (check_accepted_moves): right answers, not findings.
+    std::set<std::pair<const UartHost*, std::size_t>> right_refusals_;
     std::optional<Picoseconds> last_step_ps_;
     bool traced_ = false;
 };

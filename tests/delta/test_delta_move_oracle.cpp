@@ -68,6 +68,23 @@ TEST(DeltaMoveOracle, TheImprovedBuildRefusesThemAndNothingIsFound) {
     EXPECT_TRUE(reach_findings("delta", kJob).empty());
 }
 
+TEST(DeltaMoveOracle, RightRefusalsAreNotHostFindingsButAWrongOneIs) {
+    // The improved build answers "error: unreachable" to the five targets
+    // above the robot cannot reach: right answers, so no finding at all (they
+    // were five host-protocol findings with exit code 0, issue 40). A line
+    // over 47 characters it refuses ("error: line too long") whose target
+    // (100, -67, -340) the arms do reach stays one.
+    Bench bench(test::source_path("bench/boards/delta-seed004.yaml"), test::firmware("delta"));
+    bench.host().add_lines(std::string(kJob) + "G1 X100.000000000000 Y-67.000000000000 Z-340.0000000000\n");
+    bench.run_until_idle(10.0);
+    ASSERT_TRUE(bench.host().done()) << bench.host().tail(10);
+    const auto findings = bench.findings();
+    ASSERT_EQ(findings.size(), 1u);
+    EXPECT_EQ(findings[0].kind, UartHost::kHostProtocol);
+    EXPECT_NE(findings[0].detail.find("line 7"), std::string::npos) << findings[0].describe();
+    EXPECT_NE(findings[0].detail.find("line too long"), std::string::npos) << findings[0].describe();
+}
+
 TEST(DeltaMoveOracle, ABoardForAnotherFrameTurnsTheCheckOff) {
     BoardSpec spec = load_board_file(test::source_path("bench/boards/delta-seed004.yaml"));
     for (auto& part : spec.parts) {
