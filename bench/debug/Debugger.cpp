@@ -8,10 +8,13 @@
 #include <cctype>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <stdexcept>
 
 #include "core/Errors.hpp"
 #include "core/Lockstep.hpp"
 #include "core/Mcu.hpp"
+#include "core/Scheduler.hpp"
 #include "core/UserStop.hpp"
 #include "debug/DataAccess.hpp"
 #include "debug/GdbConnection.hpp"
@@ -31,6 +34,12 @@ constexpr unsigned kSregNumber = 32, kSpNumber = 33, kPcNumber = 34;
 constexpr std::size_t kRegisterBytes = 32 + 1 + 2 + 4;
 constexpr std::uint64_t kNever = ~std::uint64_t{0};
 constexpr std::uint32_t kInterruptPollSteps = 4096;
+// Instructions between replay checkpoints (a cycle number each).
+constexpr std::uint64_t kCheckpointInstructions = 4096;
+// A replay's hook comes back this many cycles before its checkpoint: more
+// than an instruction plus an interrupt's entry (5 + 5), so the timer that
+// brings it fires before the checkpoint's instruction boundary.
+constexpr Cycle kCheckpointLeadCycles = 16;
 
 std::uint32_t parse_hex(const std::string& s, std::size_t& at) {
     std::uint32_t v = 0;
@@ -94,6 +103,11 @@ struct Debugger::Target {
     std::string last_reply = "S05";
     std::optional<Finding> finding;  // why it stopped, when a finding was why
     bool halted = false;
+    // Every kCheckpointInstructions-th instruction's start cycle (position ->
+    // cycle), from the runs so far: a replay runs to the last one before
+    // where it goes at full speed, without the hook, and goes on from there.
+    std::map<std::uint64_t, Cycle> checkpoints;
+    std::optional<std::pair<std::uint64_t, Cycle>> seeking;  // the checkpoint a replay's hook waits for
 };
 
 struct Debugger::Edit {
@@ -146,7 +160,8 @@ void Debugger::attach(const std::vector<Mcu*>& mcus, DebugRunView view) {
         t->executed = 0;
         t->halted = false;
         t->pending_reply.clear();
-        t->mcu->set_debug_hook(this);
+        t->seeking.reset();
+        if (!resume_from_checkpoint(*t)) t->mcu->set_debug_hook(this);
     }
     findings_seen_ = findings_recorded();
     if (connected_) return;
@@ -186,6 +201,25 @@ void Debugger::run_replays(const std::function<void()>& make_and_run) {
             detach();
         }
     }
+}
+
+// A reverse step of the only debugged MCU, with no write of the debugger's
+// before where it goes: run without the hook (fast path, idle loops skipped:
+// exact, the run loop's tests prove it) to just before the last checkpoint
+// on the way, then hook in and find the checkpoint's instruction by its cycle.
+bool Debugger::resume_from_checkpoint(Target& t) {
+    if (!replay_ || replay_->scan || replay_->target != &t || targets_.size() != 1) return false;
+    std::uint64_t limit = replay_->position;
+    for (const Edit& e : edits_) limit = std::min(limit, e.position);
+    auto it = t.checkpoints.upper_bound(limit);
+    if (it == t.checkpoints.begin()) return false;
+    --it;
+    const auto [position, cycle] = *it;
+    if (position == 0 || cycle < kCheckpointLeadCycles) return false;
+    t.seeking = std::make_pair(position, cycle);
+    Target* const target = &t;
+    t.mcu->scheduler().at(cycle - kCheckpointLeadCycles, [this, target](Cycle) { target->mcu->set_debug_hook(this); });
+    return true;
 }
 
 Debugger::Target* Debugger::target_of(Mcu& mcu) {
@@ -253,6 +287,18 @@ void Debugger::before_step(Mcu& mcu) {
     }
     avr_t* const avr = mcu.avr();
     if (avr->state != cpu_Running) return;  // asleep: no instruction to stop in front of
+    if (t.seeking) {
+        // Hooked in again just before a checkpoint: its instruction is the one
+        // that starts at its cycle.
+        if (avr->cycle < t.seeking->second) return;
+        if (avr->cycle != t.seeking->second) {
+            throw std::logic_error("debugger replay: no instruction starts at the checkpoint's cycle " +
+                                   std::to_string(t.seeking->second));
+        }
+        t.executed = t.seeking->first;
+        t.seeking.reset();
+    }
+    if (t.executed % kCheckpointInstructions == 0) t.checkpoints.emplace(t.executed, avr->cycle);
     // A replay makes the debugger's own writes again where they were made.
     if (runs_ > 1) {
         for (const Edit& e : edits_) {

@@ -92,6 +92,7 @@ private:
     struct Target;
     struct Edit;
     Target* target_of(Mcu& mcu);
+    bool resume_from_checkpoint(Target& t);
     void serve(Target& t, const std::string& stop_reply);
     bool handle(Target& t, const std::string& packet);  // false: the target runs again
     std::string handle_registers(Target& t, const std::string& packet);

@@ -186,6 +186,35 @@ class GdbTests(unittest.TestCase):
         self.assertEqual(ram_before, ram_after)
         self.assertEqual(rc, 0, err)
 
+    def test_reverse_steps_deep_in_a_run_keep_the_debuggers_writes(self):
+        """Half a second in (millions of instructions: replays start from a
+        checkpoint), a write by the debugger, 30 steps on, 30 back and 30 on
+        again: the write is made again where it was, and the state after the
+        second 30 steps is the state after the first."""
+        target = elf("gdb_target")
+        s = Session([target, "--for", "1s", "--break-at", "500ms"])
+        state = ["print ticks", "info registers", "monitor time"]
+        out = gdb(s.port(), target, ["continue", "set var ticks = 1000", "print ticks"] + ["stepi 30"] + state +
+                  ["reverse-stepi 30", "print ticks", "monitor time", "stepi 30"] + state + ["detach"])
+        rc, _, err = s.finish()
+        times = re.findall(r"MCU \S+: cycle (\d+), [0-9.]+ s, (\d+) instructions", out)
+        self.assertEqual(len(times), 3, out)
+        (c1, n1), (c2, n2), (c3, n3) = [(int(c), int(n)) for c, n in times]
+        self.assertGreater(n1, 1000000, out)  # deep: half a second of a busy loop
+        self.assertEqual(n2, n1 - 30)
+        self.assertEqual((c3, n3), (c1, n1))
+        printed = values(out, "ticks")
+        # 1000 written; tick() adds 3 once per ~15-instruction pass: 30 steps cross at least one.
+        self.assertEqual(printed[0], "1000")
+        self.assertEqual(printed[2], "1000", out)  # back at the write: the write was made again
+        self.assertEqual(printed[1], printed[3])
+        self.assertNotEqual(printed[1], "1000")
+        blocks = re.split(r"MCU \S+: cycle", out)
+        regs = lambda block: re.findall(r"^(?:r\d+|SREG|SP|PC2|pc)\s.*$", block, re.M)
+        self.assertEqual(len(regs(blocks[0])), 36, out)
+        self.assertEqual(regs(blocks[0]), regs(blocks[2]))
+        self.assertEqual(rc, 0, err)
+
     def test_reverse_continue_goes_back_to_the_previous_breakpoint_hit(self):
         target = elf("gdb_target")
         s = Session([target, "--for", "10ms"])
