@@ -208,8 +208,10 @@ void Debugger::run_replays(const std::function<void()>& make_and_run) {
 // exact, the run loop's tests prove it) to just before the last checkpoint
 // on the way, then hook in and find the checkpoint's instruction by its cycle.
 bool Debugger::resume_from_checkpoint(Target& t) {
-    if (!replay_ || replay_->scan || replay_->target != &t || targets_.size() != 1) return false;
+    if (!replay_ || replay_->target != &t || targets_.size() != 1) return false;
+    replay_->scan_start = 0;
     std::uint64_t limit = replay_->position;
+    if (replay_->scan) limit = replay_->position > replay_->window ? replay_->position - replay_->window : 0;
     for (const Edit& e : edits_) limit = std::min(limit, e.position);
     auto it = t.checkpoints.upper_bound(limit);
     if (it == t.checkpoints.begin()) return false;
@@ -217,6 +219,7 @@ bool Debugger::resume_from_checkpoint(Target& t) {
     const auto [position, cycle] = *it;
     if (position == 0 || cycle < kCheckpointLeadCycles) return false;
     t.seeking = std::make_pair(position, cycle);
+    replay_->scan_start = position;
     Target* const target = &t;
     t.mcu->scheduler().at(cycle - kCheckpointLeadCycles, [this, target](Cycle) { target->mcu->set_debug_hook(this); });
     return true;
@@ -313,13 +316,17 @@ void Debugger::before_step(Mcu& mcu) {
     if (replay_) {
         findings_seen_ = findings_recorded();
         if (replay_->target == &t) {
-            if (replay_->scan && t.executed < replay_->position &&
-                (!t.pending_reply.empty() || t.breakpoints.count(avr->pc) != 0)) {
+            if (replay_->scan && t.executed < replay_->position && t.breakpoints.count(avr->pc) != 0) {
                 replay_->last_hit = t.executed;
-                replay_->reply = t.pending_reply.empty() ? "S05" : t.pending_reply;
+                replay_->reply = "S05";
             }
             t.pending_reply.clear();
             if (t.executed == replay_->position) {
+                if (replay_->scan && !replay_->last_hit && replay_->scan_start > 0) {
+                    // Nothing since the checkpoint the scan began at: look further back.
+                    replay_->window *= 4;
+                    throw DebugReplay{};
+                }
                 if (replay_->scan) {
                     // The last hit before where reverse-continue started; none: the beginning.
                     Replay go;
@@ -339,7 +346,8 @@ void Debugger::before_step(Mcu& mcu) {
         if (stop_condition(t, reply)) serve(t, reply);
     }
     // Watchpoints: the accesses of the instruction about to execute; a hit
-    // stops in front of the next one (where the access has happened).
+    // stops in front of the next one (where the access has happened), or,
+    // scanning backwards, in front of this one.
     if (!t.watches.empty() && !t.detached && (!replay_ || replay_->target == &t)) {
         const std::uint32_t pc = avr->pc;
         const auto word = [avr](std::uint32_t at) {
@@ -351,7 +359,17 @@ void Debugger::before_step(Mcu& mcu) {
                 if (w.type == '2' && !a.write) continue;
                 if (w.type == '3' && a.write) continue;
                 const char* kind = w.type == '2' ? "watch" : w.type == '3' ? "rwatch" : "awatch";
-                t.pending_reply = std::string("T05") + kind + ":" + hex_u32(kDataBase + w.address) + ";";
+                const std::string reply = std::string("T05") + kind + ":" + hex_u32(kDataBase + w.address) + ";";
+                if (replay_ && replay_->scan) {
+                    // Going backwards a watchpoint stops in front of the access
+                    // (the value as it was before it), as gdb's own record does.
+                    if (t.executed < replay_->position) {
+                        replay_->last_hit = t.executed;
+                        replay_->reply = reply;
+                    }
+                } else {
+                    t.pending_reply = reply;
+                }
             }
         }
     }
@@ -486,6 +504,7 @@ void Debugger::replay_to(Target& t, std::uint64_t position, bool scan_for_hits) 
     r.target = &t;
     r.position = position;
     r.scan = scan_for_hits;
+    r.window = 4 * kCheckpointInstructions;
     r.reply = "S05";
     replay_ = r;
     t.waiting = true;

@@ -125,6 +125,11 @@ private:
         Target* target = nullptr;
         std::uint64_t position = 0;
         bool scan = false;
+        // A scan looks at the last `window` instructions before `position`
+        // (from the checkpoint at or before their start), growing the window
+        // while it finds nothing; scan_start is where this one began (0: power-on).
+        std::uint64_t window = 0;
+        std::uint64_t scan_start = 0;
         std::optional<std::uint64_t> last_hit;
         std::string reply;
     };

@@ -215,6 +215,29 @@ class GdbTests(unittest.TestCase):
         self.assertEqual(regs(blocks[0]), regs(blocks[2]))
         self.assertEqual(rc, 0, err)
 
+    def test_reverse_continue_deep_in_a_run_to_breakpoints_and_a_watchpoint(self):
+        """Half a second in: back to tick()'s entry twice (3 less each time,
+        from the source), then back to the last write of last_seen, stopping
+        in front of it (the value before it, as gdb's own record does) at the
+        STS of its low byte (avr-objdump)."""
+        target = elf("gdb_target")
+        last_seen = symbol_address(target, "last_seen") & 0xFFFF
+        stores = [a for a, op, args in disassembly_of(target, "main")
+                  if op == "sts" and args.split(",")[0].strip().lower() == f"0x{last_seen:04x}"]
+        self.assertEqual(len(stores), 1)
+        s = Session([target, "--for", "1s", "--break-at", "500ms"])
+        out = gdb(s.port(), target, ["continue", "finish", "print ticks", "break tick", "reverse-continue", "print ticks",
+                                     "reverse-continue", "print ticks", "delete", "watch last_seen", "reverse-continue",
+                                     "print last_seen", "print $pc", "detach"])
+        rc, _, err = s.finish()
+        printed = [int(v) for v in re.findall(r"^\$\d+ = (\d+)$", out, re.M)]
+        self.assertEqual(len(printed), 4, out)
+        t = printed[0]
+        self.assertGreater(t, 10000, out)  # half a second of passes
+        self.assertEqual(printed[1:], [t - 3, t - 6, t - 9], out)
+        self.assertEqual(pcs(out), stores, out)
+        self.assertEqual(rc, 0, err)
+
     def test_reverse_continue_goes_back_to_the_previous_breakpoint_hit(self):
         target = elf("gdb_target")
         s = Session([target, "--for", "10ms"])
