@@ -25,12 +25,17 @@
 
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
+#include "debug/DebugRun.hpp"
+#include "debug/RunViews.hpp"
 #include "fuzz/FuzzFindings.hpp"
 #include "core/Units.hpp"
 #include "stimulus/GcodeMutator.hpp"
 #include "stimulus/UartHost.hpp"
+#include "tools/Commands.hpp"
 #include "tools/FirmwareArgs.hpp"
 #include "verify/Bench.hpp"
+#include "verify/BoardRun.hpp"
 
 extern char** environ;
 
@@ -490,7 +495,49 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
 
 }  // namespace
 
+// --replay: one input on the board as the fuzz target sends it (the lines
+// byte for byte through the port's host, or --raw's bytes from power-on),
+// for --bound plus a second, with avr-gdb when --gdb is given. Exit code as
+// `run --strict`'s: every finding the target would report fails it.
+int replay_command(const FuzzArgs& args) {
+    const FuzzFirmware fw = fuzz_firmware(args);
+    const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
+    BoardRunOptions o;
+    o.board = args.board;
+    o.elf = fw.run_firmware.front();
+    for (std::size_t i = 1; i + 1 < fw.run_firmware.size(); i += 2) {
+        const std::string& item = fw.run_firmware[i + 1];
+        o.firmware[item.substr(0, item.find('='))] = item.substr(item.find('=') + 1);
+    }
+    o.duration_ps = ps_from_seconds(bound_s + 1, "--bound");
+    o.read_uart_input = [](const std::string& path) { return read_input_file(path, "--replay", kMaxUartInputBytes); };
+    if (args.raw) {
+        o.uart_in.push_back({"", args.replay});
+    } else {
+        BoardRunOptions::GcodeJob job;
+        job.path = args.replay;
+        job.raw_bytes = true;
+        job.family = fw.family;
+        o.gcode = job;
+    }
+    o.on_announce = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
+    if (auto debug = debug_options(DebugArgs{args.gdb, args.break_at_finding, args.break_at, args.break_at_cycle})) {
+        Debugger debugger(*debug);
+        const auto run = run_board_debugged(o, debugger);
+        for (const std::string& line : run->summary()) std::printf("%s\n", line.c_str());
+        return exit_code(debugged_verdict(debugger, run->verdict(true)));
+    }
+    BoardRun run(o);
+    run.run();
+    for (const std::string& line : run.summary()) std::printf("%s\n", line.c_str());
+    return exit_code(run.verdict(true));
+}
+
 int fuzz_command(const FuzzArgs& args) {
+    if (!args.replay.empty()) return replay_command(args);
+    if (!args.gdb.empty() || args.break_at_finding || !args.break_at.empty() || !args.break_at_cycle.empty()) {
+        throw BadInput("--gdb and the --break-at options need --replay FILE (a campaign runs without a debugger)");
+    }
     const double seconds = seconds_from_ps(parse_duration_ps(args.duration, "--for"));
     const double bound_s = seconds_from_ps(parse_duration_ps(args.bound, "--bound"));
     if (seconds < 1) throw BadInput("--for: fuzz for at least 1s");

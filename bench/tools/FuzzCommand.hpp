@@ -22,6 +22,12 @@ struct FuzzArgs {
     std::string engine = "libfuzzer";  // or "afl"
     int jobs = 1;
     unsigned seed = 1;
+    // --replay FILE: run one input as the campaign's target ran it (no
+    // campaign), under avr-gdb with `debug.gdb`.
+    std::string replay;
+    std::vector<std::string> gdb;
+    bool break_at_finding = false;
+    std::string break_at, break_at_cycle;
 };
 
 // Exit 0: nothing found; 1: findings (listed); BadInput for bad arguments.

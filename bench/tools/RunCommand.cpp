@@ -19,6 +19,7 @@
 #include "core/TimingProfile.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
+#include "debug/DebugRun.hpp"
 #include "debug/Debugger.hpp"
 #include "debug/RunViews.hpp"
 #include "tools/Commands.hpp"
@@ -82,11 +83,6 @@ std::optional<DebugOptions> debug_options(const RunArgs& args) {
     return debug_options(DebugArgs{args.gdb, args.break_at_finding, args.break_at, args.break_at_cycle});
 }
 
-// The verdict of a debugged run: a debugger that killed the program interrupted it.
-RunVerdict debugged_verdict(const Debugger& debugger, RunVerdict verdict) {
-    if (debugger.killed()) return {RunVerdict::Outcome::Interrupted, "the debugger killed the program"};
-    return verdict;
-}
 
 // "FILE" (the board's first serial port, or USART0 without a board) or "PORT=FILE".
 struct PortFile {
@@ -240,17 +236,7 @@ int run_board_command(const RunArgs& args) {
     if (!args.dxf.empty()) options.records = [&args] { return plot_job(args); };
     if (auto debug = debug_options(args)) {
         Debugger debugger(*debug);
-        debugger.listen();
-        std::unique_ptr<BoardRun> run;
-        // Each replay (reverse execution) is a new run of the same options.
-        debugger.run_replays([&] {
-            run.reset();
-            run = std::make_unique<BoardRun>(options);
-            debugger.attach(run->bench().board().mcus(), board_debug_view(run->bench(), run->host(), !options.pty.has_value()));
-            run->run();
-        });
-        debugger.detach();
-        debugger.run_ended();
+        const auto run = run_board_debugged(options, debugger);
         progress.finish();
         for (const std::string& line : run->summary()) std::printf("%s\n", line.c_str());
         return exit_code(debugged_verdict(debugger, run->verdict(args.strict)));
@@ -299,16 +285,7 @@ int run_command(const RunArgs& args) {
     if (auto debug = debug_options(args)) {
         if (args.until_sleep) throw BadInput("--until-sleep and --gdb: break where you want to stop instead");
         Debugger debugger(*debug);
-        debugger.listen();
-        std::unique_ptr<McuRun> run;
-        debugger.run_replays([&] {
-            run.reset();
-            run = std::make_unique<McuRun>(o);
-            debugger.attach({&run->mcu()}, mcu_debug_view(*run));
-            run->run();
-        });
-        debugger.detach();
-        debugger.run_ended();
+        const auto run = run_mcu_debugged(o, debugger);
         progress.finish();
         for (const std::string& text : run->summary()) std::printf("%s\n", text.c_str());
         return exit_code(debugged_verdict(debugger, run->verdict()));

@@ -48,6 +48,12 @@ Command add_fuzz_command(CLI::App& app) {
         ->check(CLI::IsMember({"libfuzzer", "afl"}));
     fuzz_cmd->add_option("--jobs", fuzz.jobs, "parallel jobs: libFuzzer's fork jobs or AFL++ instances (default 1)");
     fuzz_cmd->add_option("--seed", fuzz.seed, "the engine's random seed (default 1)");
+    fuzz_cmd->add_option("--replay", fuzz.replay,
+                         "run this one input (a reproducer) as the fuzz target sends it, no campaign; exit 1 when it finds something");
+    fuzz_cmd->add_option("--gdb", fuzz.gdb, "--replay under avr-gdb: [MCU=]PORT (as run --gdb; docs/DEBUGGING.md)");
+    fuzz_cmd->add_flag("--break-at-finding", fuzz.break_at_finding, "--replay --gdb: stop at each finding");
+    fuzz_cmd->add_option("--break-at", fuzz.break_at, "--replay --gdb: stop at the first instruction at or after this time");
+    fuzz_cmd->add_option("--break-at-cycle", fuzz.break_at_cycle, "--replay --gdb: stop at this cycle");
 
     return {fuzz_cmd, [args] { return fuzz_command(*args); }};
 }

@@ -304,6 +304,33 @@ class GdbTests(unittest.TestCase):
         self.assertIn("cycle 16051,", out)  # the golden's edge was at 16051 before it was moved
         self.assertEqual(proc.returncode, 1, summary + err)  # the scenario still fails its golden
 
+    def test_a_fuzz_reproducer_opens_in_the_debugger_at_its_finding(self):
+        """The delta listing's build accepts G1 Z-500, which no arm reaches
+        (docs/DELTA.md): `fuzz --replay` of those lines under --gdb
+        --break-at-finding stops at the finding, says it, and the run then
+        ends with exit code 1 (a finding, as a replay counts them)."""
+        import tempfile
+        target = elf("delta_thesis")
+        board = os.path.join(BOARDS, "..", "..", "..", "bench", "boards", "delta-seed004.yaml")
+        with tempfile.TemporaryDirectory() as folder:
+            reproducer = os.path.join(folder, "finding-1.gcode")
+            with open(reproducer, "w") as f:
+                f.write("G1 X100 Y-67 Z-340\nG1 Z-500\n")
+            proc = subprocess.Popen([CLI, "fuzz", "--elf", target, "--board", board, "--replay", reproducer, "--gdb", "0",
+                                     "--break-at-finding"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            port = None
+            while port is None:
+                line = proc.stderr.readline()
+                self.assertTrue(line, "no gdb port announced")
+                m = re.search(r"127\.0\.0\.1:(\d+)", line)
+                port = int(m.group(1)) if m else None
+            out = gdb(port, target, ["continue", "monitor findings", "continue"])
+            summary, err = proc.communicate(timeout=GUARD_S)
+        self.assertIn("avrbench: stopped at a finding: robot: target-out-of-reach", out)
+        self.assertIn("line 2 'G1 Z-500' was answered ok", out)
+        self.assertIn("exited", out)  # the second continue runs to the end: W00
+        self.assertEqual(proc.returncode, 1, summary + err)
+
     def test_malformed_packets_get_answers_and_the_run_goes_on(self):
         """A client that is not avr-gdb: every packet gets a reply (an error
         or the empty "unsupported" one), nothing ends the run, and after a

@@ -1,0 +1,41 @@
+#include "debug/DebugRun.hpp"
+
+#include "debug/RunViews.hpp"
+
+namespace avrbench {
+
+std::unique_ptr<BoardRun> run_board_debugged(const BoardRunOptions& options, Debugger& debugger) {
+    debugger.listen();
+    std::unique_ptr<BoardRun> run;
+    // Each replay (reverse execution) is a new run of the same options.
+    debugger.run_replays([&] {
+        run.reset();
+        run = std::make_unique<BoardRun>(options);
+        debugger.attach(run->bench().board().mcus(), board_debug_view(run->bench(), run->host(), !options.pty.has_value()));
+        run->run();
+    });
+    debugger.detach();
+    debugger.run_ended();
+    return run;
+}
+
+std::unique_ptr<McuRun> run_mcu_debugged(const McuRunOptions& options, Debugger& debugger) {
+    debugger.listen();
+    std::unique_ptr<McuRun> run;
+    debugger.run_replays([&] {
+        run.reset();
+        run = std::make_unique<McuRun>(options);
+        debugger.attach({&run->mcu()}, mcu_debug_view(*run));
+        run->run();
+    });
+    debugger.detach();
+    debugger.run_ended();
+    return run;
+}
+
+RunVerdict debugged_verdict(const Debugger& debugger, RunVerdict verdict) {
+    if (debugger.killed()) return {RunVerdict::Outcome::Interrupted, "the debugger killed the program"};
+    return verdict;
+}
+
+}  // namespace avrbench
