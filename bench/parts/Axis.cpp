@@ -86,6 +86,9 @@ void Axis::connect_drive(ShaftMotion& driver) {
         travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
         carriage_256_ = std::llround(start_m_ / metres_per_256_);
     }
+    // STEP pulses the driver took, and the net position in steps (signed).
+    add_readout("steps", [this] { return driver_ != nullptr ? static_cast<double>(driver_->steps_taken()) : 0.0; });
+    add_readout("position_steps", [this] { return driver_ != nullptr ? position_steps() : 0.0; });
     sig_position_ = add_signal({rotary_ ? "angle_deg" : "position_mm", true, rotary_ ? "deg" : "mm", "position", ""},
                                rotary_ ? 0.0 : position_mm());
     driver_->on_step([this](int delta) { on_step(delta); });

@@ -143,6 +143,14 @@ public:
     // How many times the signal was published since the start (0: never changed).
     std::uint64_t signal_changes(std::size_t signal) const { return signal_changes_[signal]; }
 
+    // Values a front end may read at any time that are not traced signals
+    // (an axis's step count): Python's part attributes, beside the signals.
+    struct Readout {
+        std::string name;
+        std::function<double()> value;
+    };
+    const std::vector<Readout>& readouts() const { return readouts_; }
+
     // One line about the part's state for the run summary ("" for none);
     // not const: a model may first catch up with the clock.
     virtual std::string summary() { return {}; }
@@ -179,6 +187,7 @@ protected:
     std::size_t provide_analog(std::string name, std::function<double(Cycle)> volts, std::string help);
     std::size_t add_signal(std::string name, bool real, double initial = 0);
     std::size_t add_signal(PartSignalInfo info, double initial);
+    void add_readout(std::string name, std::function<double()> value) { readouts_.push_back({std::move(name), std::move(value)}); }
     void publish(std::size_t signal, double value);
 
     // Called when an injected fault takes effect ("none": repaired).
@@ -227,6 +236,7 @@ private:
     std::vector<std::function<double(Cycle)>> analog_sources_;  // per port; empty but for Analog providers
     std::vector<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;
+    std::vector<Readout> readouts_;
     std::vector<double> signal_values_;
     std::vector<std::uint64_t> signal_changes_;
     std::vector<SignalListener> signal_listeners_;

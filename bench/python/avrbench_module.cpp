@@ -306,12 +306,21 @@ void bind_part(py::module_& m) {
         .def_property_readonly("faults", &Part::fault_names)
         .def_property_readonly("fault", &Part::fault)
         .def("inject_fault", [](Part& p, const std::string& fault) { p.inject_fault(fault, p.clock().cycle()); })
+        .def_property_readonly("readouts", [](Part& p) {
+            py::dict d;
+            for (const auto& r : p.readouts()) d[py::str(r.name)] = r.value();
+            return d;
+        })
         .def("signal", [](Part& p, const std::string& name) {
             for (std::size_t i = 0; i < p.signals().size(); ++i) {
                 if (p.signals()[i].name == name) return p.signal_value(i);
             }
+            for (const auto& r : p.readouts()) {
+                if (r.name == name) return r.value();
+            }
             std::string names;
             for (const auto& s : p.signals()) names += (names.empty() ? "" : ", ") + s.name;
+            for (const auto& r : p.readouts()) names += (names.empty() ? "" : ", ") + r.name;
             throw BadInput("part " + p.name() + " has no signal '" + name + "' (it has " + (names.empty() ? "none" : names) + ")");
         });
 }

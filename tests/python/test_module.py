@@ -111,6 +111,9 @@ def test_a_gcode_file_streams_through_the_boards_host(elf, tmp_path):
     assert bench.run_until_idle(max="5s") == "idle"
     assert bench.part("x").position_mm == pytest.approx(100.4)
     assert bench.part("y").position_mm == pytest.approx(100.8)
+    # Readouts beside the signals: the STEP pulses each driver took.
+    assert bench.axis("x").steps == 100 and bench.axis("y").steps == 200
+    assert bench.axis("x").readouts == {"steps": 100.0, "position_steps": bench.axis("x").position_steps}
     with pytest.raises(avrbench.BadInput):
         avrbench.Bench("arduino-uno-cnc-shield-v3", elf("grbl_stepper")).serial().stream_gcode(str(job), family="nope")
 

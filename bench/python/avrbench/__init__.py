@@ -24,8 +24,9 @@ __all__ = ["Bench", "BadInput", "Timeout", "Finding", "Part", "Net"]
 
 
 class Part:
-    """A part of the board: each signal it declares is an attribute
-    (`part.position_mm`, `part.block_degC`), its faults are controls."""
+    """A part of the board: each signal and readout it declares is an
+    attribute (`part.position_mm`, `part.block_degC`, `part.steps`), its
+    faults are controls."""
 
     def __init__(self, native):
         object.__setattr__(self, "_native", native)
@@ -38,6 +39,11 @@ class Part:
     def signals(self):
         """Every signal the part declares, name -> present value."""
         return self._native.signals
+
+    @property
+    def readouts(self):
+        """Values the part offers that are not traced signals (an axis's steps), name -> present value."""
+        return self._native.readouts
 
     @property
     def faults(self):
