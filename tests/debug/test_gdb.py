@@ -56,13 +56,13 @@ def disassembly_of(elf_path, function):
 
 
 class Session:
-    """avrbench run ... --gdb [MCU=]0 for each MCU; the ports it announces."""
+    """avrbench run (or `command`) ... --gdb [MCU=]0 for each MCU; the ports it announces."""
 
-    def __init__(self, run_args, mcus=("",)):
+    def __init__(self, run_args, mcus=("",), command=("run", "-q")):
         gdb_args = []
         for mcu in mcus:
             gdb_args += ["--gdb", (mcu + "=0") if mcu else "0"]
-        self.proc = subprocess.Popen([CLI, "run", "-q"] + run_args + gdb_args, stdout=subprocess.PIPE,
+        self.proc = subprocess.Popen([CLI, *command] + run_args + gdb_args, stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, text=True)
         self.ports = {}
         deadline = time.monotonic() + GUARD_S
@@ -289,20 +289,13 @@ class GdbTests(unittest.TestCase):
                 f.write(scenario)
             with open(os.path.join(folder, "moved.timeline"), "w") as f:
                 f.write(golden.replace("\n+16051 1\n", "\n+16061 1\n", 1))
-            proc = subprocess.Popen([CLI, "check", os.path.join(folder, "blink.yaml"), "--firmware-dir", FIRMWARE,
-                                     "--gdb", "0", "--break-at-divergence"], stdout=subprocess.PIPE,
-                                    stderr=subprocess.PIPE, text=True)
-            port = None
-            while port is None:
-                line = proc.stderr.readline()
-                self.assertTrue(line, "no gdb port announced")
-                m = re.search(r"127\.0\.0\.1:(\d+)", line)
-                port = int(m.group(1)) if m else None
-            out = gdb(port, target, ["continue", "print $pc", "monitor time", "detach"])
-            summary, err = proc.communicate(timeout=GUARD_S)
+            s = Session([os.path.join(folder, "blink.yaml"), "--firmware-dir", FIRMWARE, "--break-at-divergence"],
+                        command=("check",))
+            out = gdb(s.port(), target, ["continue", "print $pc", "monitor time", "detach"])
+            rc, summary, err = s.finish()
         self.assertEqual(pcs(out), toggle, out)
         self.assertIn("cycle 16051,", out)  # the golden's edge was at 16051 before it was moved
-        self.assertEqual(proc.returncode, 1, summary + err)  # the scenario still fails its golden
+        self.assertEqual(rc, 1, summary + err)  # the scenario still fails its golden
 
     def test_a_fuzz_reproducer_opens_in_the_debugger_at_its_finding(self):
         """The delta listing's build accepts G1 Z-500, which no arm reaches
@@ -316,20 +309,14 @@ class GdbTests(unittest.TestCase):
             reproducer = os.path.join(folder, "finding-1.gcode")
             with open(reproducer, "w") as f:
                 f.write("G1 X100 Y-67 Z-340\nG1 Z-500\n")
-            proc = subprocess.Popen([CLI, "fuzz", "--elf", target, "--board", board, "--replay", reproducer, "--gdb", "0",
-                                     "--break-at-finding"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-            port = None
-            while port is None:
-                line = proc.stderr.readline()
-                self.assertTrue(line, "no gdb port announced")
-                m = re.search(r"127\.0\.0\.1:(\d+)", line)
-                port = int(m.group(1)) if m else None
-            out = gdb(port, target, ["continue", "monitor findings", "continue"])
-            summary, err = proc.communicate(timeout=GUARD_S)
+            s = Session(["--elf", target, "--board", board, "--replay", reproducer, "--break-at-finding"],
+                        command=("fuzz",))
+            out = gdb(s.port(), target, ["continue", "monitor findings", "continue"])
+            rc, summary, err = s.finish()
         self.assertIn("avrbench: stopped at a finding: robot: target-out-of-reach", out)
         self.assertIn("line 2 'G1 Z-500' was answered ok", out)
         self.assertIn("exited", out)  # the second continue runs to the end: W00
-        self.assertEqual(proc.returncode, 1, summary + err)
+        self.assertEqual(rc, 1, summary + err)
 
     def test_malformed_packets_get_answers_and_the_run_goes_on(self):
         """A client that is not avr-gdb: every packet gets a reply (an error
