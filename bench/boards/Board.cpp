@@ -160,7 +160,13 @@ void Board::build_nets() {
     connect_ports(links);
     set_net_clocks();
     build_twi_buses();
-    for (auto& p : parts_) p->start();
+    for (auto& p : parts_) {
+        try {
+            p->start();
+        } catch (const BadInput& e) {
+            throw BadInput(spec_.find_part(p->name())->location + ": " + e.what());
+        }
+    }
     for (auto& n : nets_) n->settle();
 }
 

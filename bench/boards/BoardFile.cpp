@@ -3,6 +3,7 @@
 
 #include "core/Time.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 
 #include <yaml-cpp/yaml.h>
@@ -20,6 +21,8 @@
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
 #include "core/McuPins.hpp"
+#include "core/Notice.hpp"
+#include "parts/PartRegistry.hpp"
 #include "core/Units.hpp"
 
 namespace avrbench {
@@ -81,6 +84,30 @@ const PartDecl* BoardSpec::find_part(const std::string& n) const {
         if (p.name == n) return &p;
     }
     return nullptr;
+}
+
+bool BoardSpec::has_serial_port() const {
+    for (const auto& part : parts) {
+        const auto type = part_types().find(part.type);
+        if (type != part_types().end() && type->second.host_connector) return true;
+    }
+    return false;
+}
+
+std::string BoardSpec::serial_port_mcu() const {
+    for (const auto& part : parts) {
+        const auto type = part_types().find(part.type);
+        if (type == part_types().end() || !type->second.host_connector) continue;
+        for (const auto& net : nets) {
+            bool joins_port = false;
+            for (const auto& e : net.endpoints) joins_port = joins_port || e.owner == part.name;
+            if (!joins_port) continue;
+            for (const auto& e : net.endpoints) {
+                if (find_mcu(e.owner) != nullptr) return e.owner;
+            }
+        }
+    }
+    return "";
 }
 
 const SerialDecl* BoardSpec::find_serial(const std::string& n) const {
@@ -505,6 +532,46 @@ void check_references(const BoardSpec& spec) {
     }
 }
 
+// The `serial:` section of earlier board files, as what it always meant: a
+// serial_host part on the USART's TXD and RXD pins (parts/SerialHost.hpp),
+// with a deprecation line naming the form that replaces it.
+void translate_serial_ports(BoardSpec& spec) {
+    for (const SerialDecl& s : spec.serial) {
+        const McuDecl& mcu = *spec.find_mcu(s.mcu);  // check_references found it
+        const auto pins = usart_pins(mcu.type, s.usart);
+        if (!pins) {
+            throw BadInput(s.location + ": serial '" + s.name + "': " + mcu.type + " has no USART" + std::to_string(s.usart) +
+                           " the bench knows the pins of; declare a serial_host part on its pins (docs/BOARDS.md)");
+        }
+        const std::string txd = std::string("P") + pins->tx_port + static_cast<char>('0' + pins->tx_bit);
+        const std::string rxd = std::string("P") + pins->rx_port + static_cast<char>('0' + pins->rx_bit);
+        PartDecl part{s.name, "serial_host", {}, s.location};
+        part.params.push_back({"family", s.family, s.location});
+        part.params.push_back({"flow", s.flow, s.location});
+        part.params.push_back({"rx_buffer", std::to_string(s.rx_buffer_bytes), s.location});
+        if (s.line_timeout_s > 0) {
+            char timeout[48];
+            std::snprintf(timeout, sizeof timeout, "%.17gs", s.line_timeout_s);
+            part.params.push_back({"line_timeout", timeout, s.location});
+        }
+        spec.parts.push_back(std::move(part));
+        const std::string rx_net = s.name + "_rx", tx_net = s.name + "_tx";
+        for (const auto& n : spec.nets) {
+            if (n.name == rx_net || n.name == tx_net) {
+                throw BadInput(s.location + ": serial '" + s.name + "' needs the nets " + rx_net + " and " + tx_net + ", and " +
+                               n.location + " declares net '" + n.name + "'; declare a serial_host part instead");
+            }
+        }
+        spec.nets.push_back({rx_net, {{mcu.name, txd, s.location}, {s.name, "rx", s.location}}, s.location});
+        spec.nets.push_back({tx_net, {{s.name, "tx", s.location}, {mcu.name, rxd, s.location}}, s.location});
+        notice(s.location + ": 'serial:' is deprecated; declare the port as a part on the USART's pins: parts: " + s.name +
+               ": {type: serial_host, family: " + s.family + ", flow: " + s.flow + "}, nets: " + rx_net + ": [" + mcu.name +
+               "." + txd + ", " + s.name + ".rx], " + tx_net + ": [" + s.name + ".tx, " + mcu.name + "." + rxd +
+               "] (docs/BOARDS.md)");
+    }
+    spec.serial.clear();
+}
+
 }  // namespace
 
 BoardSpec parse_board(const std::string& text, const std::string& path, int depth) {
@@ -523,6 +590,10 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
     parse_labels(root, path, spec);
     if (base) spec = merge_with_base(std::move(*base), std::move(spec), path);
     check_references(spec);
+    if (depth == 0 && !spec.serial.empty()) {
+        translate_serial_ports(spec);
+        check_references(spec);
+    }
     return spec;
 }
 

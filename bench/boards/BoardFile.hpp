@@ -96,6 +96,10 @@ struct BoardSpec {
     const McuDecl* find_mcu(const std::string& name) const;
     const PartDecl* find_part(const std::string& name) const;
     const SerialDecl* find_serial(const std::string& name) const;
+    // A part a host attaches to (a serial_host: parts/HostConnector.hpp).
+    bool has_serial_port() const;
+    // The MCU the first serial port's nets reach ("" when there is none).
+    std::string serial_port_mcu() const;
 };
 
 // Reads and checks the file's structure (sections, names, endpoint syntax,

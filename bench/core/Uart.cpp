@@ -42,17 +42,10 @@ Uart::~Uart() {
     avr_irq_unregister_notify(irqs_ + UART_IRQ_OUT_XOFF, &Uart::on_xoff, this);
 }
 
-std::string Uart::transmitted_text() const {
-    std::string out;
-    out.reserve(transmitted_.size());
-    for (const auto& b : transmitted_) out.push_back(static_cast<char>(b.value));
-    return out;
-}
-
 Cycle Uart::cycles_per_frame() const { return uart_->cycles_per_byte; }
 
 void Uart::connect_host() {
-    if (rx_pin_ == nullptr || rx_from_line_ || rx_line_held_) return;
+    if (line_driver_ || rx_pin_ == nullptr || rx_from_line_ || rx_line_held_) return;
     rx_line_held_ = true;
     rx_pin_->drive(true);
 }
@@ -113,7 +106,7 @@ void Uart::draw_host_frame(std::uint16_t value) {
     const Cycle start = std::max<Cycle>(avr_->cycle, rx_line_free_at_);
     const Cycle frame_cycles = static_cast<Cycle>(frame.cycles_per_bit) * static_cast<Cycle>(frame.bits());
     rx_line_free_at_ = start + frame_cycles;
-    if (rx_pin_ != nullptr && !rx_from_line_) {
+    if (line_driver_ || (rx_pin_ != nullptr && !rx_from_line_)) {
         const UartFrameLevels levels = uart_frame_levels(frame, value);
         bool level = true;  // the host holds the line idle high
         for (int i = 0; i < levels.count; ++i) {
@@ -121,7 +114,11 @@ void Uart::draw_host_frame(std::uint16_t value) {
             level = !level;
             scheduler_.at(start + static_cast<Cycle>(i) * frame.cycles_per_bit, [this, level](Cycle at) {
                 CycleAt stamp(avr_, at);
-                rx_pin_->drive(level);
+                if (line_driver_) {
+                    line_driver_(level);
+                } else {
+                    rx_pin_->drive(level);
+                }
             });
         }
     }
@@ -139,7 +136,14 @@ void Uart::listen_to_rx_line() {
     rx_pin_->on_change([this](Cycle cycle, bool high) { on_rx_edge(cycle, high); });
 }
 
+void Uart::host_drives_rx_line(std::function<void(bool high)> drive) {
+    line_driver_ = std::move(drive);
+    if (rx_line_held_ && rx_pin_ != nullptr) rx_pin_->release();
+    rx_line_held_ = false;
+}
+
 void Uart::on_rx_edge(Cycle cycle, bool high) {
+    if (line_driver_) return;  // the host's own frames: its bytes went to the receiver already
     if (line_frame_active_) {
         line_edges_.emplace_back(cycle, high);
         return;

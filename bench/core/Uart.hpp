@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/SerialLink.hpp"
 #include "core/Time.hpp"
 
 struct avr_t;
@@ -34,14 +35,9 @@ namespace avrbench {
 class Pin;
 class Scheduler;
 
-struct UartByte {
-    Cycle cycle;
-    std::uint8_t value;
-};
-
-class Uart {
+class Uart final : public SerialLink {
 public:
-    using TxListener = std::function<void(Cycle cycle, std::uint8_t byte)>;
+    using TxListener = ByteListener;
 
     // Throws BadInput if the MCU has no USART `index`. `rx_pin` is its RxDn
     // pin, nullptr where the bench does not know the pin-out.
@@ -53,31 +49,35 @@ public:
     int index() const { return index_; }
 
     // Bytes the firmware transmitted, in order.
-    const std::vector<UartByte>& transmitted() const { return transmitted_; }
-    std::string transmitted_text() const;
-    void on_transmit(TxListener fn) { tx_listeners_.push_back(std::move(fn)); }
+    const std::vector<UartByte>& transmitted() const override { return transmitted_; }
+    void on_transmit(TxListener fn) override { tx_listeners_.push_back(std::move(fn)); }
 
     // A host is connected to RxD from now on: its TX idles high, so a logic
     // analyser sees each start bit as a falling edge (send() does this too).
     // Nothing when a board's net drives RxD.
-    void connect_host();
+    void connect_host() override;
     // Queues bytes for the firmware's receiver.
-    void send(const std::string& bytes);
+    void send(const std::string& bytes) override;
     // Bytes the receiver took (from a host or from the RxDn line), each with
     // the cycle its receive-complete flag was set.
     void on_receive(TxListener fn) { rx_listeners_.push_back(std::move(fn)); }
     // The board drives RxDn through a net: receive the frames on the pin
     // (host bytes still go straight to the receiver, not drawn on the pin).
     void listen_to_rx_line();
+    // A host on the board's RxDn net draws the frames of the bytes sent
+    // through this USART with `drive` (its TX pin), at the same cycles the
+    // pin would show them; the receiver gets the bytes straight, so the line
+    // is no longer decoded. The byte-level attachment of a serial_host part.
+    void host_drives_rx_line(std::function<void(bool high)> drive);
     // Frames read from the line whose stop bit was low, or whose parity bit
     // did not match (§20.7.4, FEn and UPEn; the byte is delivered anyway).
     std::uint64_t line_framing_errors() const { return line_framing_errors_; }
     std::uint64_t line_parity_errors() const { return line_parity_errors_; }
-    std::size_t pending_rx() const { return to_send_.size(); }
-    std::uint64_t bytes_delivered() const { return delivered_; }
+    std::size_t pending_rx() const override { return to_send_.size(); }
+    std::uint64_t bytes_delivered() const override { return delivered_; }
 
     // Datasheet frame time for the current UBRR/U2X/UCSZ settings.
-    Cycle cycles_per_frame() const;
+    Cycle cycles_per_frame() const override;
 
 private:
     static void on_output(avr_irq_t* irq, std::uint32_t value, void* param);
@@ -107,6 +107,7 @@ private:
     std::vector<TxListener> rx_listeners_;
 
     Pin* rx_pin_;
+    std::function<void(bool high)> line_driver_;
     Cycle rx_line_free_at_ = 0;  // the end of the last host frame drawn on RxDn
     bool rx_from_line_ = false;
     bool rx_line_held_ = false;  // RxD driven idle high since the first host byte was queued

@@ -102,11 +102,12 @@ void boot_target(const TargetConfig& config, const char* who) {
     g_config = config;
     try {
         BoardSpec spec = load_board_file(config.board);
-        if (spec.serial.empty()) {
-            std::fprintf(stderr, "%s: %s has no serial port to send the input to\n", who, config.board.c_str());
+        g_mcu_name = spec.serial_port_mcu();
+        if (g_mcu_name.empty()) {
+            std::fprintf(stderr, "%s: %s has no serial port (a serial_host part) to send the input to\n", who,
+                         config.board.c_str());
             std::exit(2);
         }
-        g_mcu_name = spec.serial.front().mcu;
         std::map<std::string, std::string> firmware = config.other_firmware;
         firmware[g_mcu_name] = config.elf;
         g_bench = new Bench(std::move(spec), firmware);
@@ -115,7 +116,7 @@ void boot_target(const TargetConfig& config, const char* who) {
             (void)g_bench->serial();  // the USART model listens from here on
             g_bench->run_for(config.boot_s);
         } else {
-            UartHostOptions options = default_host_options(g_bench->serial_decl());
+            UartHostOptions options = default_host_options(g_bench->serial_port());
             if (!config.family.empty()) options.family = parse_firmware_family(config.family, "AVRBENCH_FUZZ_FAMILY");
             UartHost& host = g_bench->host("", options);
             const Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
@@ -140,7 +141,7 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     Bench& bench = *g_bench;
     Mcu& mcu = bench.mcu(g_mcu_name);
     UartHost* host = g_config.raw ? nullptr : &bench.host();
-    Uart& serial = bench.serial();
+    SerialLink& serial = bench.serial();
     const std::string bytes(reinterpret_cast<const char*>(data), size);
     if (host != nullptr) {
         try {

@@ -13,8 +13,10 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "parts/HostConnector.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 
@@ -28,6 +30,9 @@ struct PartType {
     // Fixed values this type name implies (linear_axis -> kind: linear).
     std::map<std::string, std::string> implied;
     std::function<std::unique_ptr<Part>(const std::string& name, Mcu& clock, const ParamValues& params)> build;
+    // Its parts are serial ports a host attaches to (parts/HostConnector.hpp):
+    // a board file that has one can take a G-code job.
+    bool host_connector = false;
 };
 
 // A part type built from its parameters, with the part's presets if it has any.
@@ -37,6 +42,7 @@ PartType simple_part_type(const std::string& type_name) {
     t.name = type_name;
     t.params = T::param_specs();
     if constexpr (requires { T::presets(); }) t.presets = T::presets();
+    t.host_connector = std::is_base_of_v<HostConnector, T>;
     t.build = [](const std::string& name, Mcu& clock, const ParamValues& params) {
         return std::make_unique<T>(name, clock, params);
     };

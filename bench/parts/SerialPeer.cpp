@@ -2,6 +2,7 @@
 
 #include "parts/PartRegistry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -33,14 +34,19 @@ SerialPeer::SerialPeer(std::string name, Mcu& clock, const ParamValues& params)
       baud_(params.quantity("baud")),
       tolerance_bits_(params.quantity("tolerance")),
       send_at_start_(params.has("send") ? params.text("send") : std::string()),
-      send_at_s_(params.quantity("send_at")) {
+      send_at_s_(params.quantity("send_at")),
+      line_(clock, baud_,
+            {.drive_tx = [this](bool high) { drive_output(tx_pin_, high); },
+             .rx_level = [this] { return input_level(rx_pin_); },
+             .on_byte = [this](Cycle, std::uint8_t byte) { received_.push_back(static_cast<char>(byte)); },
+             .on_framing_error = [this](Cycle) { report(SerialPeer::kSerialFraming, "stop bit read 0 (framing error)"); },
+             .on_edge = [this](double bits) { on_edge(bits); }}) {
     // 50 baud (teleprinters) to 2 Mbaud (the fastest USART setting at 16 MHz, U2X: §20.3.1).
     if (!(baud_ >= 50 && baud_ <= 2e6)) throw BadInput("part '" + this->name() + "': baud must be from 50 to 2000000");
     if (!(tolerance_bits_ > 0 && tolerance_bits_ < 0.5)) {
         throw BadInput("part '" + this->name() + "': tolerance must be more than 0 and less than half a bit");
     }
     if (!(send_at_s_ >= 0 && send_at_s_ <= 1e6)) throw BadInput("part '" + this->name() + "': send_at must be from 0 to 1e6 s");
-    bit_cycles_ = clock.frequency_hz() / baud_;
     rx_pin_ = add_pin("rx", TerminalRole::Input);
     tx_pin_ = add_pin("tx", TerminalRole::Output);
 }
@@ -50,66 +56,22 @@ void SerialPeer::start() {
     if (!send_at_start_.empty()) send(send_at_start_, clock().cycles_from_seconds(send_at_s_));
 }
 
-Cycle SerialPeer::bit_time(Cycle frame_start, double bits) const {
-    return frame_start + static_cast<Cycle>(std::llround(bits * bit_cycles_));
-}
-
-void SerialPeer::send(const std::string& bytes, Cycle at_cycle) {
-    Cycle start = std::max({at_cycle, tx_free_at_, clock().cycle()});
-    for (unsigned char byte : bytes) {
-        // start bit 0, 8 data bits LSB first, stop bit 1
-        std::vector<bool> bits{false};
-        for (int i = 0; i < 8; ++i) bits.push_back(((byte >> i) & 1) != 0);
-        bits.push_back(true);
-        for (std::size_t i = 0; i < bits.size(); ++i) {
-            const bool level = bits[i];
-            clock().scheduler().at(bit_time(start, static_cast<double>(i)), [this, level](Cycle) { drive_output(tx_pin_, level); });
-        }
-        start = bit_time(start, 10.0);
-    }
-    tx_free_at_ = start;
-}
+void SerialPeer::send(const std::string& bytes, Cycle at_cycle) { line_.send(bytes, at_cycle); }
 
 void SerialPeer::on_input(std::size_t pin, bool level) {
-    if (pin != rx_pin_) return;
-    const Cycle now = clock().cycle();
-    if (!receiving_) {
-        if (level) return;
-        receiving_ = true;
-        frame_start_ = now;
-        shift_ = 0;
-        clock().scheduler().at(bit_time(frame_start_, 0.5), [this](Cycle) { sample(0); });
-        return;
-    }
+    if (pin == rx_pin_) line_.rx_edge(level);
+}
+
+void SerialPeer::on_edge(double bits) {
     // An edge inside a frame belongs on a bit boundary.
-    const double bits = static_cast<double>(now - frame_start_) / bit_cycles_;
-    worst_edge_error_bits_ = std::max(worst_edge_error_bits_, std::fabs(bits - std::round(bits)));
-    if (std::fabs(bits - std::round(bits)) > tolerance_bits_) {
+    const double error_bits = std::fabs(bits - std::round(bits));
+    worst_edge_error_bits_ = std::max(worst_edge_error_bits_, error_bits);
+    if (error_bits > tolerance_bits_) {
         char detail[128];
         std::snprintf(detail, sizeof detail, "edge %.3f bits into a frame: off the %g-baud bit grid by more than %g bit",
                       bits, baud_, tolerance_bits_);
         report(SerialPeer::kSerialFraming, detail);
     }
-}
-
-// bit_index 0 = start bit, 1..8 data, 9 stop.
-void SerialPeer::sample(unsigned bit_index) {
-    const bool level = input_level(rx_pin_);
-    if (bit_index == 0 && level) {  // a glitch, not a start bit
-        receiving_ = false;
-        return;
-    }
-    if (bit_index >= 1 && bit_index <= 8 && level) shift_ |= 1u << (bit_index - 1);
-    if (bit_index == 9) {
-        receiving_ = false;
-        if (!level) {
-            report(SerialPeer::kSerialFraming, "stop bit read 0 (framing error)");
-            return;
-        }
-        received_.push_back(static_cast<char>(shift_));
-        return;
-    }
-    clock().scheduler().at(bit_time(frame_start_, bit_index + 1.5), [this, bit_index](Cycle) { sample(bit_index + 1); });
 }
 
 }  // namespace avrbench

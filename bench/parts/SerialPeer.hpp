@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "parts/BitSerial.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 
@@ -34,28 +35,23 @@ public:
     // line is free).
     void send(const std::string& bytes, Cycle at_cycle);
     const std::string& received() const { return received_; }
-    double bit_cycles() const { return bit_cycles_; }
+    double bit_cycles() const { return line_.bit_cycles(); }
     // The longest deviation of a firmware edge from the bit grid of its frame, in bits.
     double worst_edge_error_bits() const { return worst_edge_error_bits_; }
 
 private:
     void on_input(std::size_t pin, bool level) override;
-    void sample(unsigned bit_index);
-    Cycle bit_time(Cycle frame_start, double bits) const;
+    void on_edge(double bits);
 
-    std::size_t rx_pin_, tx_pin_;
+    std::size_t rx_pin_ = 0, tx_pin_ = 0;
     double baud_;
-    double bit_cycles_;
     double tolerance_bits_;
     std::string send_at_start_;
     double send_at_s_;
+    BitSerial line_;
 
-    bool receiving_ = false;
-    Cycle frame_start_ = 0;
-    unsigned shift_ = 0;
     std::string received_;
     double worst_edge_error_bits_ = 0;
-    Cycle tx_free_at_ = 0;
 };
 
 }  // namespace avrbench

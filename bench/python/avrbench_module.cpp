@@ -28,6 +28,7 @@
 #include "trace/HtmlReport.hpp"
 #include "trace/TimelineText.hpp"
 #include "trace/WaveformFiles.hpp"
+#include "core/Notice.hpp"
 #include "verify/Bench.hpp"
 #include "wiring/Net.hpp"
 
@@ -173,7 +174,7 @@ public:
         }
     }
     PySerial& serial(const std::string& port) {
-        bench_->serial_decl(port);  // BadInput for an unknown port
+        bench_->serial_port(port);  // BadInput for an unknown port
         auto& s = serials_[port];
         if (!s) s = std::make_unique<PySerial>(*this, port);
         return *s;
@@ -237,7 +238,7 @@ std::string PySerial::expect(const std::string& pattern, const py::object& timeo
 }
 
 void PySerial::stream_gcode(const std::string& path, const std::string& family, const std::string& flow) {
-    UartHostOptions o = default_host_options(bench_.bench().serial_decl(port_));
+    UartHostOptions o = default_host_options(bench_.bench().serial_port(port_));
     if (!family.empty()) o.family = parse_firmware_family(family, "family");
     if (!flow.empty()) o.flow = parse_flow_control(flow, "flow");
     bench_.bench().host(port_, o).load_file(path);
@@ -378,6 +379,11 @@ void bind_bench(py::module_& m) {
 PYBIND11_MODULE(_avrbench, m) {
     using namespace avrbench;
     m.doc() = "avrbench's library for Python (docs/PYTHON.md); use the avrbench package, not this module";
+    // A deprecated board-file form and the like: Python warnings, which the
+    // caller's filters may silence or turn into errors.
+    set_notice_sink([](const std::string& line) {
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, line.c_str(), 1) < 0) throw py::error_already_set();
+    });
     static py::exception<BadInput> bad_input(m, "BadInput");
     static py::exception<Timeout> timeout(m, "Timeout");
     py::register_exception_translator([](std::exception_ptr p) {

@@ -41,7 +41,7 @@ void check_link_path(const std::string& link) {
 
 }  // namespace
 
-PtyBridge::PtyBridge(Uart& uart, const std::string& link_path) : uart_(uart), link_(link_path) {
+PtyBridge::PtyBridge(SerialLink& uart, const std::string& link_path) : uart_(uart), link_(link_path) {
     uart_.connect_host();
     master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (master_ < 0 || ::grantpt(master_) != 0 || ::unlockpt(master_) != 0) {

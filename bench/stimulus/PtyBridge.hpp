@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/Uart.hpp"
+#include "core/SerialLink.hpp"
 
 namespace avrbench {
 
@@ -18,7 +18,7 @@ class PtyBridge {
 public:
     // Opens the pty; with `link_path`, also makes a symlink to it there
     // (replacing an existing link). Throws BadInput when it cannot.
-    PtyBridge(Uart& uart, const std::string& link_path = "");
+    PtyBridge(SerialLink& uart, const std::string& link_path = "");
     ~PtyBridge();
     PtyBridge(const PtyBridge&) = delete;
     PtyBridge& operator=(const PtyBridge&) = delete;
@@ -40,7 +40,7 @@ public:
 private:
     void flush();
 
-    Uart& uart_;
+    SerialLink& uart_;
     int master_ = -1;
     int slave_keepalive_ = -1;  // our own slave fd: reads do not fail while no host has it open
     int inotify_ = -1;          // IN_OPEN on the slave device, for host_opened()

@@ -4,7 +4,7 @@
 
 namespace avrbench {
 
-RecordHost::RecordHost(Mcu& mcu, Uart& uart, std::vector<std::string> messages, Options options,
+RecordHost::RecordHost(Mcu& mcu, SerialLink& uart, std::vector<std::string> messages, Options options,
                        std::vector<double> busy_seconds)
     : mcu_(mcu), uart_(uart), messages_(std::move(messages)), options_(options), busy_seconds_(std::move(busy_seconds)) {
     uart_.on_transmit([this](Cycle cycle, std::uint8_t byte) { on_byte(cycle, byte); });

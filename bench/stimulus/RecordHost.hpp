@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/Mcu.hpp"
-#include "core/Uart.hpp"
+#include "core/SerialLink.hpp"
 
 namespace avrbench {
 
@@ -23,7 +23,7 @@ public:
 
     // `busy_seconds` (optional, one per message): how long the firmware works
     // on a message before its ACK is due; added to the timeout.
-    RecordHost(Mcu& mcu, Uart& uart, std::vector<std::string> messages, Options options,
+    RecordHost(Mcu& mcu, SerialLink& uart, std::vector<std::string> messages, Options options,
                std::vector<double> busy_seconds = {});
     RecordHost(const RecordHost&) = delete;
     RecordHost& operator=(const RecordHost&) = delete;
@@ -42,7 +42,7 @@ private:
     void fail(Cycle cycle, std::string why);
 
     Mcu& mcu_;
-    Uart& uart_;
+    SerialLink& uart_;
     std::vector<std::string> messages_;
     Options options_;
     std::vector<double> busy_seconds_;

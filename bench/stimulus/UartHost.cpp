@@ -224,7 +224,10 @@ bool is_unsolicited(FirmwareFamily family, const std::string& text) {
 }  // namespace
 
 UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
-    : mcu_(mcu), uart_(mcu.uart(uart_index)), options_(std::move(options)), alive_(std::make_shared<bool>(true)) {
+    : UartHost(mcu, mcu.uart(uart_index), std::move(options)) {}
+
+UartHost::UartHost(Mcu& mcu, SerialLink& link, UartHostOptions options)
+    : mcu_(mcu), uart_(link), options_(std::move(options)), alive_(std::make_shared<bool>(true)) {
     if (options_.flow == FlowControl::CharacterCounting && options_.rx_buffer_bytes == 0) {
         throw BadInput("UART host: rx_buffer_bytes must be at least 1 for character counting");
     }

@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "core/Time.hpp"
-#include "core/Uart.hpp"
+#include "core/SerialLink.hpp"
 
 namespace avrbench {
 
@@ -188,6 +188,9 @@ public:
     // startup timers start now). The host must not outlive the MCU; the MCU
     // may outlive the host.
     UartHost(Mcu& mcu, int uart_index = 0, UartHostOptions options = {});
+    // On any serial link clocked by `clock` (a board's serial_host part:
+    // a USART or two bit-banged pins).
+    UartHost(Mcu& clock, SerialLink& link, UartHostOptions options = {});
     ~UartHost();
     UartHost(const UartHost&) = delete;
     UartHost& operator=(const UartHost&) = delete;
@@ -303,7 +306,7 @@ private:
     std::string seconds_text(double seconds) const;
 
     Mcu& mcu_;
-    Uart& uart_;
+    SerialLink& uart_;
     UartHostOptions options_;
     std::shared_ptr<bool> alive_;  // callbacks held by the Uart and the Scheduler check it
 

@@ -409,10 +409,10 @@ FuzzFirmware fuzz_firmware(const FuzzArgs& args) {
     FuzzFirmware fw;
     // BadInput for a bad board or ELF, as `run` says it.
     BoardSpec spec = load_board_file(args.board);
-    if (spec.serial.empty()) throw BadInput(args.board + ": has no serial port for the fuzz input");
+    if (spec.serial_port_mcu().empty()) throw BadInput(args.board + ": has no serial port (a serial_host part) for the fuzz input");
     std::map<std::string, std::string> firmware = firmware_assignments(args.firmware);
     for (const auto& [mcu, elf] : firmware) fw.other_firmware += (fw.other_firmware.empty() ? "" : ";") + mcu + "=" + elf;
-    firmware[spec.serial.front().mcu] = args.elf;
+    firmware[spec.serial_port_mcu()] = args.elf;
     // run's ELF goes to the board's first MCU, which need not be the serial port's.
     const std::string first_mcu = spec.mcus.front().name;
     fw.run_firmware.push_back(firmware.count(first_mcu) != 0 ? firmware[first_mcu] : args.elf);
@@ -420,7 +420,7 @@ FuzzFirmware fuzz_firmware(const FuzzArgs& args) {
         if (mcu != first_mcu) fw.run_firmware.insert(fw.run_firmware.end(), {"--firmware", mcu + "=" + elf});
     }
     Bench bench(std::move(spec), firmware);
-    fw.family = args.family.empty() ? bench.serial_decl().family : args.family;
+    fw.family = args.family.empty() ? bench.serial_port().protocol().family : args.family;
     (void)parse_firmware_family(fw.family, "--family");
     return fw;
 }

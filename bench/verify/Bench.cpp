@@ -65,12 +65,12 @@ Bench::Bench(BoardSpec spec, const std::map<std::string, std::string>& firmware)
 Bench::~Bench() = default;
 
 void Bench::watch_motion() {
-    // Every declared serial port records what the firmware sends from power-on.
-    for (const auto& decl : board_->spec().serial) {
-        try {
-            board_->mcu(decl.mcu).uart(decl.usart);
-        } catch (const BadInput& e) {
-            throw BadInput(decl.location + ": serial '" + decl.name + "': " + e.what());
+    // The board's serial ports: its parts that hosts attach to (the links
+    // record what the firmware sends from power-on).
+    for (Part* part : board_->parts()) {
+        if (auto* connector = dynamic_cast<HostConnector*>(part)) {
+            const PartDecl* decl = board_->spec().find_part(part->name());
+            serial_ports_.push_back({part->name(), &part->clock(), connector, decl != nullptr ? decl->location : ""});
         }
     }
     for (Part* part : board_->parts()) {
@@ -78,43 +78,42 @@ void Bench::watch_motion() {
     }
 }
 
-UartHostOptions default_host_options(const SerialDecl& decl) {
+UartHostOptions default_host_options(const SerialPort& port) {
+    const HostProtocol& p = port.protocol();
     UartHostOptions o;
-    o.flow = parse_flow_control(decl.flow, decl.location);
-    o.rx_buffer_bytes = decl.rx_buffer_bytes;
-    o.family = parse_firmware_family(decl.family, decl.location);
-    o.line_timeout_s = decl.line_timeout_s;
+    o.flow = parse_flow_control(p.flow, port.location);
+    o.rx_buffer_bytes = p.rx_buffer_bytes;
+    o.family = parse_firmware_family(p.family, port.location);
+    o.line_timeout_s = p.line_timeout_s;
     return o;
 }
 
-const SerialDecl& Bench::serial_decl(const std::string& port) const {
-    const auto& serial = board_->spec().serial;
-    if (serial.empty()) throw BadInput(board_->spec().path + ": the board declares no serial port");
-    const SerialDecl* decl = port.empty() ? &serial.front() : board_->spec().find_serial(port);
-    if (decl == nullptr) {
-        std::string list;
-        for (const auto& s : serial) list += (list.empty() ? "" : ", ") + s.name;
-        throw BadInput(board_->spec().path + ": no serial port '" + port + "' (ports: " + list + ")");
+const SerialPort& Bench::serial_port(const std::string& port) const {
+    if (serial_ports_.empty()) {
+        throw BadInput(board_->spec().path + ": the board has no serial port (a serial_host part, docs/BOARDS.md)");
     }
-    return *decl;
+    if (port.empty()) return serial_ports_.front();
+    for (const auto& s : serial_ports_) {
+        if (s.name == port) return s;
+    }
+    std::string list;
+    for (const auto& s : serial_ports_) list += (list.empty() ? "" : ", ") + s.name;
+    throw BadInput(board_->spec().path + ": no serial port '" + port + "' (ports: " + list + ")");
 }
 
-Uart& Bench::serial(const std::string& port) {
-    const SerialDecl& decl = serial_decl(port);
-    return board_->mcu(decl.mcu).uart(decl.usart);
-}
+SerialLink& Bench::serial(const std::string& port) { return serial_port(port).link(); }
 
 UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> options) {
-    const SerialDecl* decl = &serial_decl(port);
-    auto& slot = hosts_[decl->name];
+    const SerialPort& serial = serial_port(port);
+    auto& slot = hosts_[serial.name];
     if (!slot) {
         UartHostOptions o;
         if (options) {
             o = *options;
         } else {
-            o = default_host_options(*decl);
+            o = default_host_options(serial);
         }
-        slot = std::make_unique<UartHost>(board_->mcu(decl->mcu), decl->usart, o);
+        slot = std::make_unique<UartHost>(*serial.mcu, serial.link(), o);
         check_accepted_moves(*slot);
     }
     return *slot;
@@ -184,13 +183,15 @@ void Bench::trace_board() {
     for (const auto& label : board_->spec().labels) {
         if (const auto id = trace(label.endpoint)) timeline_.add_alias(*id, "labels", label.name);
     }
-    for (const auto& s : board_->spec().serial) {
-        Mcu& m = board_->mcu(s.mcu);
-        recorder_.trace_uart_tx(m, m.uart(s.usart));
-        recorder_.trace_uart_rx(m, m.uart(s.usart));
+    for (const auto& s : serial_ports_) {
+        Uart* usart = s.connector->usart();
+        if (usart == nullptr) continue;  // a bit-level port: its pins are on nets, traced above
+        Mcu& m = *s.mcu;
+        recorder_.trace_uart_tx(m, *usart);
+        recorder_.trace_uart_rx(m, *usart);
         // The port's lines too, under the port's name, where a logic
         // analyser (sigrok's UART decoder) reads them: serial.<port>_txd/_rxd.
-        if (const auto pins = usart_pins(m.mcu_type(), s.usart)) {
+        if (const auto pins = usart_pins(m.mcu_type(), usart->index())) {
             const std::string txd = std::string("P") + pins->tx_port + static_cast<char>('0' + pins->tx_bit);
             const std::string rxd = std::string("P") + pins->rx_port + static_cast<char>('0' + pins->rx_bit);
             timeline_.add_alias(recorder_.trace_pin(m, m.pin(txd)), "serial", s.name + "_txd");
@@ -229,7 +230,7 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
         Picoseconds last_activity = last_step_ps_.value_or(0);
         for (auto& [name, host] : hosts_) {
             if (host->transcript().empty()) continue;
-            const Mcu& m = board_->mcu(board_->spec().find_serial(name)->mcu);
+            const Mcu& m = *port_of(name).mcu;
             last_activity = std::max(last_activity, ps_at_cycle(m, host->transcript().back().cycle));
         }
         const bool motion_settled = now - std::min(now, last_activity) >= settle_ps;
@@ -271,7 +272,7 @@ std::vector<Finding> Bench::findings() const {
             f.kind = UartHost::kHostProtocol;
             f.source = name;
             f.cycle = e.cycle;
-            f.clock_hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
+            f.clock_hz = port_of(name).mcu->frequency_hz();
             f.has_pc = false;
             f.detail = e.message;
             out.push_back(f);
@@ -368,7 +369,7 @@ void Bench::report_plots(RunReport& r) const {
     }
     std::map<const Part*, std::vector<std::pair<double, double>>> targets;
     for (const auto& [name, host] : hosts_) {
-        const std::uint32_t hz = board_->mcu(board_->spec().find_serial(name)->mcu).frequency_hz();
+        const std::uint32_t hz = port_of(name).mcu->frequency_hz();
         for (const auto& e : host->transcript()) {
             if (e.direction != Direction::Sent) continue;
             const auto words = gcode_words(e.text);
@@ -411,10 +412,9 @@ void Bench::report_faults(RunReport& r) const {
 
 // Each serial port's lines: the host's transcript, or the firmware's output.
 void Bench::report_transcripts(RunReport& r) const {
-    for (const auto& decl : board_->spec().serial) {
-        Mcu& m = board_->mcu(decl.mcu);
-        const std::uint32_t hz = m.frequency_hz();
-        auto host = hosts_.find(decl.name);
+    for (const auto& port : serial_ports_) {
+        const std::uint32_t hz = port.mcu->frequency_hz();
+        auto host = hosts_.find(port.name);
         if (host != hosts_.end()) {
             for (const auto& e : host->second->transcript()) {
                 r.transcript.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
@@ -425,7 +425,7 @@ void Bench::report_transcripts(RunReport& r) const {
         // stamped with the cycle of the line's first byte.
         std::string line;
         Cycle line_start = 0;
-        for (const auto& b : m.uart(decl.usart).transmitted()) {
+        for (const auto& b : port.link().transmitted()) {
             if (line.empty()) line_start = b.cycle;
             if (b.value == '\n') {
                 r.transcript.push_back({line_start, hz, false, line});

@@ -19,6 +19,7 @@
 
 #include "boards/Board.hpp"
 #include "parts/Axis.hpp"
+#include "parts/HostConnector.hpp"
 #include "stimulus/UartHost.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/RunReport.hpp"
@@ -42,8 +43,19 @@ const char* to_string(IdleResult result);
 // letter; stops at a ';' or '(' comment or a '*' checksum. "M104 S200 T1".
 std::map<char, double> gcode_words(const std::string& line);
 
+// A serial port of the board: a part where a host attaches
+// (parts/HostConnector.hpp: a serial_host on the firmware's TX/RX nets).
+struct SerialPort {
+    std::string name;  // the part's name
+    Mcu* mcu = nullptr;  // the MCU it talks to (its clock)
+    HostConnector* connector = nullptr;
+    std::string location;  // the part's file:line
+    const HostProtocol& protocol() const { return connector->protocol(); }
+    SerialLink& link() const { return connector->link(); }
+};
+
 // A host's options as the board file's serial port declares them.
-UartHostOptions default_host_options(const SerialDecl& decl);
+UartHostOptions default_host_options(const SerialPort& port);
 
 class Bench {
 public:
@@ -65,10 +77,12 @@ public:
     // unless `options` is given then.
     UartHost& host(const std::string& port = "", std::optional<UartHostOptions> options = std::nullopt);
     bool has_host() const { return !hosts_.empty(); }
-    // The USART behind serial port `port` of the board file ("" = the first):
+    // The link behind serial port `port` of the board file ("" = the first):
     // raw bytes to the firmware (send) and everything it transmitted.
-    Uart& serial(const std::string& port = "");
-    const SerialDecl& serial_decl(const std::string& port = "") const;
+    SerialLink& serial(const std::string& port = "");
+    // BadInput naming the ports for an unknown one, or when there is none.
+    const SerialPort& serial_port(const std::string& port = "") const;
+    const std::vector<SerialPort>& serial_ports() const { return serial_ports_; }
 
     // Records every MCU pin on a net or named by a label, every serial port's
     // transmitted bytes, and every part signal (call before running).
@@ -117,7 +131,10 @@ private:
     // machines that can judge them (parts/DeltaRobot: target-out-of-reach).
     void check_accepted_moves(UartHost& host);
 
+    // The serial port of host `name` (one that exists).
+    const SerialPort& port_of(const std::string& name) const { return serial_port(name); }
     std::unique_ptr<Board> board_;
+    std::vector<SerialPort> serial_ports_;
     Timeline timeline_;
     Recorder recorder_{timeline_};
     std::map<std::string, std::unique_ptr<UartHost>> hosts_;

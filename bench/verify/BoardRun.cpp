@@ -116,14 +116,14 @@ BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
     }
     if (!options_.periodic_waves) board.set_periodic_waves(false);
     const bool job = options_.gcode || static_cast<bool>(options_.records);
-    if (board.spec().serial.empty() && (!options_.uart_in.empty() || !options_.uart_out.empty() || job)) {
+    if (bench_->serial_ports().empty() && (!options_.uart_in.empty() || !options_.uart_out.empty() || job)) {
         throw BadInput(options_.board +
-                       ": the board declares no serial port (needed by --gcode, --dxf, --uart-in, --uart-out)");
+                       ": the board has no serial port, no serial_host part (needed by --gcode, --dxf, --uart-in, --uart-out)");
     }
     // Resolve every named port now, so a typo fails before the run.
-    for (const auto& pb : options_.uart_in) bench_->serial_decl(pb.port);
-    for (const auto& pb : options_.uart_out) bench_->serial_decl(pb.port);
-    if (!options_.job_port.empty()) bench_->serial_decl(options_.job_port);
+    for (const auto& pb : options_.uart_in) bench_->serial_port(pb.port);
+    for (const auto& pb : options_.uart_out) bench_->serial_port(pb.port);
+    if (!options_.job_port.empty()) bench_->serial_port(options_.job_port);
     if (options_.gcode) {
         start_gcode_job();
     }
@@ -162,9 +162,9 @@ void BoardRun::check_files(const BoardSpec& spec) {
 
 void BoardRun::start_gcode_job() {
     const BoardRunOptions::GcodeJob& job = *options_.gcode;
-    const SerialDecl& decl = bench_->serial_decl(options_.job_port);
+    const SerialPort& decl = bench_->serial_port(options_.job_port);
     for (const auto& pb : options_.uart_in) {
-        if (bench_->serial_decl(pb.port).name == decl.name) {
+        if (bench_->serial_port(pb.port).name == decl.name) {
             throw BadInput("--uart-in: port " + decl.name + " already streams --gcode; give another port (PORT=FILE)");
         }
     }
@@ -183,7 +183,7 @@ void BoardRun::start_gcode_job() {
         host_->load_file(job.path);
     }
     for (const auto& [at_ps, bytes] : job.realtime) {
-        host_->send_bytes_at(bytes, bench_->mcu(decl.mcu).cycles_from_seconds(seconds_from_ps(at_ps)));
+        host_->send_bytes_at(bytes, decl.mcu->cycles_from_seconds(seconds_from_ps(at_ps)));
     }
 }
 
@@ -191,20 +191,20 @@ void BoardRun::start_record_job() {
     const BoardRunOptions::RecordJob job = options_.records();
     plot_source_ = job.source;
     plot_variant_ = job.variant;
-    Uart& port = bench_->serial(options_.job_port);
-    plot_ = std::make_unique<RecordHost>(bench_->mcu(bench_->serial_decl(options_.job_port).mcu), port, job.messages,
+    const SerialPort& port = bench_->serial_port(options_.job_port);
+    plot_ = std::make_unique<RecordHost>(*port.mcu, port.link(), job.messages,
                                          RecordHost::Options{}, job.busy_seconds);
     plot_->start();
 }
 
 void BoardRun::open_pty() {
     const BoardRunOptions::Pty& pty = *options_.pty;
-    const SerialDecl& decl = bench_->serial_decl(pty.port);
-    if ((options_.gcode || plot_) && bench_->serial_decl(options_.job_port).name == decl.name) {
+    const SerialPort& decl = bench_->serial_port(pty.port);
+    if ((options_.gcode || plot_) && bench_->serial_port(options_.job_port).name == decl.name) {
         throw BadInput("--pty: port " + decl.name + " already carries the job");
     }
     pty_ = std::make_unique<PtyBridge>(bench_->serial(decl.name), pty.link);
-    pty_mcu_ = &bench_->mcu(decl.mcu);
+    pty_mcu_ = decl.mcu;
     // At once, so a host can connect while the run goes on.
     if (options_.on_announce) {
         options_.on_announce("avrbench run: serial " + decl.name + " on " + pty_->path() + (pty.link.empty() ? "" : " = ") +
@@ -401,9 +401,9 @@ std::vector<std::string> BoardRun::summary() const {
         out.push_back("  transcript (last lines):");
         append_text_tail(out, host_->tail(10), 10);
     }
-    for (const auto& decl : board.spec().serial) {
-        if ((host_ != nullptr || plot_) && bench_->serial_decl(options_.job_port).name == decl.name) continue;
-        const Uart& u = bench_->serial(decl.name);
+    for (const auto& decl : bench_->serial_ports()) {
+        if ((host_ != nullptr || plot_) && bench_->serial_port(options_.job_port).name == decl.name) continue;
+        const SerialLink& u = decl.link();
         out.push_back(format_text("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
                              u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
                              u.transmitted().empty() ? "" : "; last lines:"));

@@ -159,9 +159,9 @@ public:
     }
 
     void check_serial(const std::string& kind, const std::string& location) const {
-        if (board_.serial.empty()) {
-            throw BadInput(location + ": '" + kind + "' needs a serial port, and " + board_.path + " declares none");
-        }
+        if (board_.has_serial_port()) return;
+        throw BadInput(location + ": '" + kind + "' needs a serial port (a serial_host part), and " + board_.path +
+                       " has none");
     }
 
 private:

@@ -442,7 +442,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     Bench bench(spec.board_path, spec.firmware);
     bind(spec, bench);
     if (spec.host_family || spec.host_line_timeout_ps) {
-        UartHostOptions o = default_host_options(bench.serial_decl());
+        UartHostOptions o = default_host_options(bench.serial_port());
         if (spec.host_family) o.family = parse_firmware_family(*spec.host_family, spec.path);
         if (spec.host_line_timeout_ps) o.line_timeout_s = seconds_from_ps(*spec.host_line_timeout_ps);
         bench.host("", o);

@@ -44,6 +44,7 @@ public:
     std::string label() const override { return mcu_.name() + "." + pin_.name(); }
     TerminalRole role() const override { return TerminalRole::Bidirectional; }
     Mcu* clock_mcu() const override { return &mcu_; }
+    Pin* mcu_pin() const override { return &pin_; }
     Drive drive_state() const override;
     void receive(const Resolution& resolution) override;
     bool begin_wave(const PeriodicWave& wave) override;

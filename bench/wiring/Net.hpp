@@ -32,6 +32,8 @@ public:
     virtual TerminalRole role() const = 0;
     // The MCU whose clock the terminal lives on (its own, or its part's), if any.
     virtual Mcu* clock_mcu() const { return nullptr; }
+    // The MCU pin this terminal is (of clock_mcu()), nullptr for a part's pin.
+    virtual Pin* mcu_pin() const { return nullptr; }
     // What the terminal puts on the net now.
     virtual Drive drive_state() const = 0;
     // The net settled to `resolution` (delivered to every terminal, the

@@ -31,7 +31,7 @@ std::string hall_board() {
 std::unique_ptr<Bench> hall_bench() {
     auto bench = std::make_unique<Bench>(hall_board(), test::firmware("grbl_stepper"));
     // grbl_stepper greets with its own banner, not grbl's: a generic host.
-    UartHostOptions host = default_host_options(bench->serial_decl(""));
+    UartHostOptions host = default_host_options(bench->serial_port(""));
     host.family = FirmwareFamily::Generic;
     bench->host("", host);
     return bench;

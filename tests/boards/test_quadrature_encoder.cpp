@@ -36,7 +36,7 @@ struct EncoderRun {
     test::PinLog a{bench.mcu(), "PC3"}, b{bench.mcu(), "PC4"}, step{bench.mcu(), "PD2"};
     explicit EncoderRun(int lines) : bench(encoder_board("encoder" + std::to_string(lines), lines), test::firmware("grbl_stepper")) {
         // grbl_stepper answers ok like grbl but greets with its own banner: a generic host.
-        UartHostOptions host = default_host_options(bench.serial_decl(""));
+        UartHostOptions host = default_host_options(bench.serial_port(""));
         host.family = FirmwareFamily::Generic;
         bench.host("", host).add_lines("X2500\n");
         bench.run_until_idle(10.0);

@@ -52,7 +52,7 @@ TEST(TimingProfile, BlinkTimer1sIsrMatchesItsListing) {
 TEST(TimingProfile, NestedIsrTimeIsAttributedToTheInnerVector) {
     Bench bench(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), test::firmware("grbl_stepper"));
     bench.mcu().enable_profile();
-    UartHostOptions host = default_host_options(bench.serial_decl(""));
+    UartHostOptions host = default_host_options(bench.serial_port(""));
     host.family = FirmwareFamily::Generic;
     bench.host("", host).add_lines("X1600\n");
     bench.run_until_idle(10.0);

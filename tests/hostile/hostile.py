@@ -59,8 +59,11 @@ UNO_BOARD = """board: hostile-uno
 description: an UNO for hostile inputs
 mcus:
   uno: {type: atmega328p, clock: 16MHz}
-serial:
-  host: {mcu: uno, usart: 0, flow: send_and_wait}
+parts:
+  host: {type: serial_host, flow: send_and_wait}
+nets:
+  host_rx: [uno.PD1, host.rx]
+  host_tx: [host.tx, uno.PD0]
 labels:
   led: uno.PB5
 """
@@ -75,13 +78,20 @@ def laughs(depth, width=10):
 
 
 def board_with(extra_top="", description="plain", mcus=None, parts="", serial=None, labels=None, name="hostile"):
+    """A board with a serial_host on USART0, or with `serial`: the deprecated
+    serial section's entries (hostile shapes of it)."""
     mcus = mcus if mcus is not None else "  uno: {type: atmega328p, clock: 16MHz}"
-    serial = serial if serial is not None else "  host: {mcu: uno, usart: 0, flow: send_and_wait}"
     labels = labels if labels is not None else "  led: uno.PB5"
     text = extra_top + f"board: {name}\ndescription: {description}\nmcus:\n{mcus}\n"
+    if serial is None:
+        parts = "  host: {type: serial_host, flow: send_and_wait}" + ("\n" + parts if parts else "")
     if parts:
         text += "parts:\n" + parts + "\n"
-    text += f"serial:\n{serial}\nlabels:\n{labels}\n"
+    if serial is None:
+        text += "nets:\n  host_rx: [uno.PD1, host.rx]\n  host_tx: [host.tx, uno.PD0]\n"
+    else:
+        text += f"serial:\n{serial}\n"
+    text += f"labels:\n{labels}\n"
     return text
 
 
@@ -176,7 +186,7 @@ def cases(fw):
     # YAML of the wrong shape, section by section.
     shapes = {"list": "[a, b]", "scalar": "hello", "number": "42", "null": "~", "nested": "{a: {b: [c]}}", "empty-map": "{}"}
     sections = {"mcus": "\n  uno: {type: atmega328p, clock: 16MHz}", "parts": " {}", "nets": " {}",
-                "serial": "\n  host: {mcu: uno, usart: 0, flow: send_and_wait}", "labels": "\n  led: uno.PB5"}
+                "serial": " {}", "labels": "\n  led: uno.PB5"}
     for section in sections:
         for shape, text in shapes.items():
             board = "board: hostile\n" + "".join(
@@ -238,7 +248,7 @@ def cases(fw):
             ("kilovolt-small-block", "resistance: 0.01ohm, supply: 1000V", "heat_capacity: 1J/K")):
         parts = (f"  plant: {{type: thermal_plant, preset: custom, {plant}, ambient_conductance: 0.1W/K, sensor_time_constant: 1s}}\n"
                  f"  heat: {{type: heater, preset: custom, {heater}}}")
-        board = board_with(parts=parts).replace("labels:\n", "nets:\n  body: [heat.body, plant.body]\n  gate: [uno.PD6, heat.gate]\nlabels:\n")
+        board = board_with(parts=parts).replace("labels:\n", "  body: [heat.body, plant.body]\n  gate: [uno.PD6, heat.gate]\nlabels:\n")
         out.append(Case(f"physics-{label}", run_board, files={"board.yaml": board},
                         says="is outside 0.001" if label == "tiny-resistance" else "not a physical combination"))
 

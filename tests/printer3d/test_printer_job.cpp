@@ -86,7 +86,7 @@ std::string without_busy(std::string out) {
 // Sends one line on the raw port and runs until its answer ends with "ok";
 // the answer without keep-alives.
 std::string send_line(Bench& bench, const std::string& line) {
-    Uart& port = bench.serial();
+    SerialLink& port = bench.serial();
     const std::size_t from = port.transmitted_text().size();
     port.send(line + "\n");
     for (int i = 0; i < 300; ++i) {

@@ -235,7 +235,7 @@ std::string rendered_dom(const ScratchDir& dir, const RunReport& report, const s
 TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
     ScratchDir dir;
     Bench bench(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), test::firmware("stepdir_test"));
-    UartHostOptions generic = default_host_options(bench.serial_decl());
+    UartHostOptions generic = default_host_options(bench.serial_port());
     generic.family = FirmwareFamily::Generic;  // our test firmware prints no grbl welcome
     bench.host("", generic);
     bench.trace_board();
@@ -268,7 +268,7 @@ TEST(HtmlReport, ConstantStepRateIsDrawnAsAConstantVelocity) {
 TEST(HtmlReport, ThermalRunShowsSensorTargetDutyInsideTheFrameAndTheFault) {
     ScratchDir dir;
     Bench bench(test::source_path("bench/boards/ramps-1.4.yaml"), test::firmware("thermal_pid"));
-    UartHostOptions generic = default_host_options(bench.serial_decl());
+    UartHostOptions generic = default_host_options(bench.serial_port());
     generic.family = FirmwareFamily::Generic;  // thermal_pid prints no Marlin welcome
     bench.host("", generic);
     bench.trace_board();

@@ -251,12 +251,17 @@ TEST(GtkwaveAcceptsOurFiles, CliRunOpensFromAnyFolderWithLabelsAndUartText) {
         };
         EXPECT_EQ(flags_of("uart0_tx[7:0]"), "820") << cwd;  // 0x800 ASCII | 0x20 right-justified
         EXPECT_EQ(flags_of("led"), "28") << cwd;             // the D13 LED label of the board file
-        // What gtkwave shows first is the board file's names; the MCU's raw
+        // What gtkwave shows first is the board file's names (its nets -
+        // the serial host's rx and tx - then its labels); the MCU's raw
         // pins come last, in a collapsed group (TR_CLOSED 0x400000 | group begin).
-        EXPECT_EQ(values["TRACE0"], "labels/800200") << cwd;
-        EXPECT_EQ(values["TRACE1"], "led/28") << cwd;
-        bool pins_collapsed = false;
-        for (const auto& [key, value] : values) pins_collapsed = pins_collapsed || value == "uno pins/c00200";
+        EXPECT_EQ(values["TRACE0"], "nets/800200") << cwd;
+        EXPECT_EQ(values["TRACE1"], "host_rx/28") << cwd;
+        bool labels_group = false, pins_collapsed = false;
+        for (const auto& [key, value] : values) {
+            labels_group = labels_group || value == "labels/800200";
+            pins_collapsed = pins_collapsed || value == "uno pins/c00200";
+        }
+        EXPECT_TRUE(labels_group) << cwd;
         EXPECT_TRUE(pins_collapsed) << cwd;
         EXPECT_EQ(values["AT1ms"], "r/0") << cwd;
     }

@@ -35,7 +35,7 @@ TEST(BenchIdle, QuietIsCountedFromTheLastHostLineNotFromPowerOn) {
     // host_peer_grbl answers at once and never steps: idle comes exactly one
     // settle time (300 ms) after its last line.
     Bench bench(test::source_path("bench/boards/arduino-uno.yaml"), test::firmware("host_peer_grbl"));
-    UartHostOptions o = default_host_options(bench.serial_decl());
+    UartHostOptions o = default_host_options(bench.serial_port());
     o.family = FirmwareFamily::Grbl;
     bench.host("", o).add_line("G1 X1");
     ASSERT_EQ(bench.run_until_idle(5.0, 0.3), IdleResult::Idle);

@@ -1,0 +1,37 @@
+// A part where a host program attaches to the firmware: the byte link it
+// offers and how the host should talk on it. The bench attaches G-code
+// senders, pty bridges and raw byte files to these parts by name, without
+// knowing their type (parts/SerialHost is one).
+#pragma once
+
+#include <string>
+
+#include "core/SerialLink.hpp"
+
+namespace avrbench {
+
+class Uart;
+
+// How a host talks to the firmware behind this connector (the spelling of
+// board files: stimulus/UartHost.hpp parses it).
+struct HostProtocol {
+    std::string family = "generic";      // grbl, marlin, teacup, generic
+    std::string flow = "send_and_wait";  // or character_counting
+    unsigned rx_buffer_bytes = 128;      // the firmware's receive buffer (character counting)
+    double line_timeout_s = 0;           // 0: the family's
+};
+
+class HostConnector {
+public:
+    virtual ~HostConnector() = default;
+    // The link to the firmware; valid once the board has started its parts.
+    virtual SerialLink& link() = 0;
+    virtual const HostProtocol& protocol() const = 0;
+    // The USART behind the link when it is one (its bytes are traced as a
+    // bus), nullptr for a bit-level link.
+    virtual Uart* usart() const = 0;
+    // For messages and the summary: "USART0 (PD1/PD0)", "PB3/PB2 at 9600 baud".
+    virtual std::string link_text() const = 0;
+};
+
+}  // namespace avrbench
