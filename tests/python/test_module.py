@@ -227,3 +227,16 @@ def test_bad_arguments_raise_exceptions_and_never_crash(elf):
         except (avrbench.BadInput, avrbench.Timeout, TypeError, ValueError, OverflowError):
             pass
     bench.run_for("1ms")  # still works
+
+
+def test_a_deprecated_serial_section_is_a_deprecation_warning(elf, tmp_path):
+    # docs/BOARDS.md: the old `serial:` section still loads, as a serial_host
+    # on the USART's pins, and says it is deprecated - in Python, a warning
+    # the caller's filters can turn into an error.
+    board = tmp_path / "old-serial-python.yaml"
+    board.write_text("mcus:\n  uno: {type: atmega328p, clock: 16MHz}\n"
+                     "serial:\n  host: {mcu: uno, usart: 0}\n")
+    with pytest.warns(DeprecationWarning, match=r"old-serial-python.yaml:4: 'serial:' is deprecated"):
+        bench = avrbench.Bench(str(board), elf("uart_echo"))
+    bench.run_for("5ms")
+    assert bench.serial("host").received.startswith("avrbench uart_echo")
