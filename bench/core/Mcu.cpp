@@ -341,8 +341,10 @@ StopReason Mcu::run_until(Cycle target_cycle) {
         return run_coverage_ != nullptr ? run_until_impl<true, true>(target_cycle, run_coverage_)
                                         : run_until_impl<false, true>(target_cycle, nullptr);
     }
-    return run_coverage_ != nullptr ? run_until_impl<true, false>(target_cycle, run_coverage_)
-                                    : run_until_impl<false, false>(target_cycle, nullptr);
+    if (run_coverage_ != nullptr) return run_until_impl<true, false>(target_cycle, run_coverage_);
+    // run_until_sleep: the fast path too, stopping in front of SLEEP.
+    if (__builtin_expect(stop_at_sleep_, 0)) return run_until_impl<false, false, true>(target_cycle, nullptr);
+    return run_until_impl<false, false>(target_cycle, nullptr);
 }
 
 StopReason Mcu::run_until_covering(Cycle target_cycle, PcEdgeMap& edges) {
@@ -357,7 +359,7 @@ void Mcu::enable_profile() {
 // kCover: every instruction's new PC goes into `edges` (fuzzing); without it
 // the loop is the plain run loop (a separate instantiation, so the coverage
 // costs the ordinary runs nothing).
-template <bool kCover, bool kProfile>
+template <bool kCover, bool kProfile, bool kStopAtSleep>
 StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     stop_requested_ = false;
     real_stop_ = false;
@@ -406,9 +408,10 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         check(state, pc_before);
         if constexpr (kCover) edges->hit(avr->pc);
         if (__builtin_expect(stop_requested_, 0)) break;
-        // A profile sees every step, run_until_sleep looks at every opcode, a
-        // debugger may stop in front of any instruction: no fast path.
-        if (kProfile || stop_at_sleep_ || debug_ != nullptr || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
+        // A profile sees every step, a debugger may stop in front of any
+        // instruction: no fast path. run_until_sleep takes it only in its own
+        // instantiation, which looks at every opcode there.
+        if (kProfile || (!kStopAtSleep && stop_at_sleep_) || debug_ != nullptr || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
         // Fast path: while the core runs, no interrupt is on its way and no
         // cycle timer is due, a step of SimavrStepper is avr_run_one and the
@@ -426,6 +429,10 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         const std::uint16_t stack_floor = stack_floor_;
         const std::uint32_t bad_interrupt_pc = bad_interrupt_pc_;
         while (countdown > 1) {  // at 1 the general step ticks the skipper
+            // In front of SLEEP: the general step above stops there.
+            if constexpr (kStopAtSleep) {
+                if (opcode_at(avr, avr->pc) == kSleepOpcode) break;
+            }
             --countdown;
             // avr_run_one leaves avr->pc alone: it still holds the PC before the instruction.
             const std::uint32_t pc = avr_run_one(avr);

@@ -262,7 +262,7 @@ private:
     void application_started();
     bool in_boot_section(std::uint32_t pc_bytes) const { return boot_ && pc_bytes >= boot_->start_bytes; }
     bool check_after_step(int state, std::uint32_t pc_before);
-    template <bool kCover, bool kProfile>
+    template <bool kCover, bool kProfile, bool kStopAtSleep = false>
     StopReason run_until_impl(Cycle target_cycle, PcEdgeMap* edges);
     void after_reset();
     void add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string detail, bool halt);

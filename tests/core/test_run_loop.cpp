@@ -108,3 +108,47 @@ TEST(RunLoop, CoveringRunEndsWhereThePlainRunEndsAndCountsEdges) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// run_until_sleep on the fast path (issue 37) against the general step of
+// simavr's avr_run: on every firmware the build makes, 20 ms or up to the
+// first SLEEP, the same end (cycle, PC, RAM, steps, sleeping or not). Where
+// it stopped at a SLEEP, that is what the instruction in front of the PC is:
+// 0x9588 (the AVR instruction set manual's SLEEP encoding).
+TEST(RunLoop, RunUntilSleepStopsWhereTheGeneralStepStopsOnEveryFirmware) {
+    const auto names = test::all_firmware();
+    ASSERT_GT(names.size(), 100u);
+    std::size_t slept = 0;
+    for (const auto& name : names) {
+        const ElfImage elf = ElfImage::load(test::firmware(name));
+        McuOptions fast_options, skipping_options, reference_options;
+        for (McuOptions* o : {&fast_options, &skipping_options, &reference_options}) test::set_board_mcu(name, elf, *o);
+        fast_options.skip_idle_loops = false;  // the same steps as the reference
+        skipping_options.skip_idle_loops = true;  // as `run --until-sleep` runs
+        reference_options.reference_run_loop = true;
+        reference_options.skip_idle_loops = false;
+        Mcu fast(elf, fast_options), skipping(elf, skipping_options), reference(elf, reference_options);
+        const Cycle end = fast.frequency_hz() / 50;
+        const bool reference_slept = reference.run_until_sleep(end);
+        for (Mcu* m : {&fast, &skipping}) {
+            EXPECT_EQ(m->run_until_sleep(end), reference_slept) << name;
+            EXPECT_EQ(m->cycle(), reference.cycle()) << name;
+            EXPECT_EQ(m->pc_bytes(), reference.pc_bytes()) << name;
+            EXPECT_TRUE(m->data_memory() == reference.data_memory()) << name;
+        }
+        EXPECT_EQ(fast.steps(), reference.steps()) << name;
+        const bool fast_slept = reference_slept;
+        if (fast_slept) {
+            ++slept;
+            const std::uint32_t at = fast.pc_bytes() - 2;
+            const std::uint16_t word = static_cast<std::uint16_t>(fast.avr()->flash[at] | fast.avr()->flash[at + 1] << 8);
+            EXPECT_EQ(word, 0x9588u) << name << " stopped at 0x" << std::hex << fast.pc_bytes();
+        }
+    }
+    EXPECT_GT(slept, 3u);  // sleep_idle and the Arduino sketches that sleep, at least
+}
+
+}  // namespace
+}  // namespace avrbench
