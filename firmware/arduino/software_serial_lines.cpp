@@ -3,7 +3,9 @@
 // line whole and answers "echo:" with the line in upper case, then "ok" - a
 // G-code firmware's answer on a port with no USART behind it. The library
 // transmits with interrupts off and cannot receive meanwhile (its documented
-// half-duplex limit), which a host that waits for "ok" never runs into.
+// half-duplex limit), so lines end in '\n' alone: after println's '\r' a host
+// that takes it as the line's end (the bench's does) would start sending
+// while the '\n' still goes out, and the sketch would miss the start bits.
 #include <Arduino.h>
 #include <SoftwareSerial.h>
 
@@ -13,7 +15,7 @@ unsigned length = 0;
 
 void setup() {
     soft.begin(9600);
-    soft.println("start");
+    soft.print("start\n");
 }
 
 void loop() {
@@ -26,7 +28,7 @@ void loop() {
     }
     line[length] = '\0';
     soft.print("echo:");
-    soft.println(line);
-    soft.println("ok");
+    soft.print(line);
+    soft.print("\nok\n");
     length = 0;
 }
