@@ -5,9 +5,11 @@
  * overwrites the stack), every word goes through atof() * BLU_PER_MM into a
  * 16-bit int (more than 32.767 mm wraps), a missing word is 0, F is read
  * per line and `dt_const = 1000000 / gc.f` divides by zero on a line
- * without F, coordinates are relative, Z is ignored and G00 leaves the
- * extruder as it was. Moves run to completion before the next line (the
- * thesis' loop), then "ok"; the motion itself is the fixed engine's.
+ * without F, coordinates are relative, and G00 leaves the extruder as it
+ * was. Moves run to completion before the next line (the thesis' loop),
+ * then "ok" (ours: the thesis has no host protocol); the motion itself is
+ * the fixed engine's, so a line moves Z alone first, as the improved build
+ * does, and a zero-length XY line does no tick, as the thesis' DDA does.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -58,9 +60,20 @@ static void parse_Gcode_command(const char *command)
             case 0:
             case 1:
                 if (gc.command_number == 1) extruder = 1;
-                queue_line(AXIS_X, gc.x, AXIS_Y, gc.y, dtc_half_us, gc.command_number == 1);
-                plan_position[AXIS_X] += gc.x;
-                plan_position[AXIS_Y] += gc.y;
+                /* `G00/G01 Z<z> F<feed>` (§4.6 syntax): Z moves alone,
+                 * between layers (§3: "when Z moves, no other motion is
+                 * performed"). */
+                if (gc.z != 0) {
+                    queue_line(AXIS_Z, gc.z, AXES, 0, dtc_half_us, 0);
+                    plan_position[AXIS_Z] += gc.z;
+                }
+                /* L = 0: the DDA's loop (Code 4.1-4.3, "while
+                 * number_of_executions < L") runs no tick at all. */
+                if (gc.x != 0 || gc.y != 0) {
+                    queue_line(AXIS_X, gc.x, AXIS_Y, gc.y, dtc_half_us, gc.command_number == 1);
+                    plan_position[AXIS_X] += gc.x;
+                    plan_position[AXIS_Y] += gc.y;
+                }
                 break;
             case 2:
             case 3:

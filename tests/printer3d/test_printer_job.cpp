@@ -168,6 +168,20 @@ TEST(Printer3dThesisParser, ALineWithoutFNeverFinishes) {
     EXPECT_EQ(test::drive_position(*fine, "drive_x"), 500);
 }
 
+// The thesis' syntax moves Z on its own line (`G01 Z<z> F<feed>`, §4.6) and
+// a line with no X/Y travel is an L = 0 DDA: no tick, done. Both are
+// answered, and Z takes the listing's 1000 BLU/mm: Z0.2 = 200 full steps.
+TEST(Printer3dThesisParser, AZOnlyLineMovesZAloneAndAZeroLengthLineIsAnswered) {
+    auto bench = test::powered_printer("printer3d_interp_thesis_parser");
+    bench->run_for(0.2);
+    EXPECT_EQ(send_line(*bench, "G01 Z0.2 F10"), "ok\n");
+    EXPECT_EQ(test::drive_position(*bench, "drive_z"), 200);
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 0);
+    EXPECT_EQ(send_line(*bench, "G01 X0 Y0 F10"), "ok\n");
+    EXPECT_EQ(test::drive_position(*bench, "drive_x"), 0);
+    EXPECT_EQ(test::drive_position(*bench, "drive_y"), 0);
+}
+
 // strcpy into char s[50]: a longer line runs over the parser's stack frame
 // and its return address; the bench reports the crash with PC and cycle.
 TEST(Printer3dThesisParser, ALineLongerThan50BytesCrashesTheInterpolator) {
