@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/Time.hpp"
 #include "parts/PortType.hpp"
 
 namespace avrbench {
@@ -22,6 +23,11 @@ public:
     virtual double sensor_degC() = 0;
     // A sensor fallen out of its bore follows ambient instead.
     virtual void set_sensor_detached(bool detached) = 0;
+    // A thermistor sits on this body (it calls this once, when connected),
+    // and the firmware read it now (an ADC conversion started on its
+    // divider): heating with no sensor read is a finding of the body's.
+    virtual void attach_sensor() = 0;
+    virtual void sensor_read(Cycle cycle) = 0;
 };
 
 }  // namespace avrbench

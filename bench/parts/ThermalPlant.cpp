@@ -13,6 +13,11 @@ namespace avrbench {
 
 REGISTER_PART(ThermalPlant, "thermal_plant");
 
+const FindingKind ThermalPlant::kHeatingUnmonitored = FindingKind::declare(
+    "heating-unmonitored",
+    "a heater heated a body whose thermistor the firmware did not read for `unmonitored_after` (no temperature control, "
+    "no thermal-runaway protection)",
+    Severity::Warning);
 const FindingKind ThermalPlant::kOverheat = FindingKind::declare("overheat", "a thermal plant passed its safe maximum temperature", Severity::Warning);
 
 std::vector<ParamSpec> ThermalPlant::param_specs() {
@@ -48,6 +53,11 @@ std::vector<ParamSpec> ThermalPlant::param_specs() {
          .help = "heat to warm 1 mm of filament by 1 K", .min = 0, .max = 10},
         {.name = "max_temperature", .type = PT::Quantity, .dimension = D::Temperature, .source = "preset",
          .help = "an overheat finding when the block passes it"},
+        {.name = "unmonitored_after", .type = PT::Quantity, .dimension = D::Time, .default_value = "5s",
+         .source = "assumed: a firmware that regulates reads its sensor far more often (Marlin's temperature ISR "
+                   "about every millisecond, Teacup's every 10 ms); 5 s leaves room for a slow loop",
+         .help = "heating-unmonitored when a heater heats this long with no read of a thermistor on the body",
+         .min = 1e-3, .max = 3600},
         {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "100ms",
          .source = "assumed", .help = "period of the temperature traces and of the filament-feed update"},
     };
@@ -112,6 +122,7 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     const double interval = params.quantity("sample_interval");
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
+    unmonitored_cycles_ = clock.cycles_from_seconds(params.quantity("unmonitored_after"));
 
     sig_block_ = add_signal({"block_degC", true, "degC", "temperature", ""}, initial);
     sig_sensor_ = add_signal({"sensor_degC", true, "degC", "sensor-temperature", ""}, initial);
@@ -141,6 +152,7 @@ std::string ThermalPlant::summary() {
 
 void ThermalPlant::start() {
     last_cycle_ = clock().cycle();
+    last_sensor_read_ = last_cycle_;
     clock().scheduler().at(last_cycle_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
 }
 
@@ -221,7 +233,26 @@ double ThermalPlant::heater_power_W() const {
     return p;
 }
 
+void ThermalPlant::sensor_read(Cycle cycle) {
+    last_sensor_read_ = cycle;
+    unmonitored_reported_ = false;  // a new spell, if it comes
+}
+
+void ThermalPlant::check_monitoring(Cycle now) {
+    const bool heating = heated_since_sample_ || heater_power_W() > 0;
+    heated_since_sample_ = false;
+    if (sensors_ == 0 || !heating || unmonitored_reported_ || now - last_sensor_read_ < unmonitored_cycles_) return;
+    unmonitored_reported_ = true;
+    char detail[200];
+    std::snprintf(detail, sizeof detail,
+                  "heating with no read of its thermistor for %.1f s (the firmware neither controls the temperature "
+                  "nor would see a runaway); block at %.1f degC",
+                  static_cast<double>(now - last_sensor_read_) / clock().frequency_hz(), network_.temperature(block_));
+    report(ThermalPlant::kHeatingUnmonitored, detail);
+}
+
 void ThermalPlant::set_heat_source_power(int source, double watts) {
+    if (watts > 0) heated_since_sample_ = true;
     auto& s = sources_.at(static_cast<std::size_t>(source));
     if (s.second == watts) return;
     advance();
@@ -303,6 +334,7 @@ void ThermalPlant::on_sample(Cycle scheduled) {
     publish(sig_sensor_, sensor_ == block_ && detached_ ? network_.ambient() : network_.temperature(sensor_));
     if (surface_ >= 0) publish(sig_surface_, network_.temperature(surface_));
     publish(sig_fan_, fan_speed_);
+    check_monitoring(scheduled);
     clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });
 }
 

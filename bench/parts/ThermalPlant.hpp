@@ -31,6 +31,7 @@ class ThermalPlant final : public Part, public ThermalBody {
 public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kOverheat;  // overheat
+    static const FindingKind kHeatingUnmonitored;  // heating-unmonitored
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 
@@ -61,6 +62,8 @@ public:
     // Sensor detached: it follows ambient instead of the block (a thermistor
     // fallen out of its bore).
     void set_sensor_detached(bool detached) override;
+    void attach_sensor() override { ++sensors_; }
+    void sensor_read(Cycle cycle) override;
 
     double fan_speed() const override { return fan_speed_; }
     double filament_feed_mm_per_s() const { return feed_mm_per_s_; }
@@ -95,6 +98,14 @@ private:
     double fan_speed_ = 0, feed_mm_per_s_ = 0;
     bool detached_ = false;
     bool overheated_ = false;
+    // heating-unmonitored: thermistors on the body, the last one read, and
+    // whether a heater was on since the last sample.
+    int sensors_ = 0;
+    Cycle last_sensor_read_ = 0;
+    Cycle unmonitored_cycles_ = 0;
+    bool heated_since_sample_ = false;
+    bool unmonitored_reported_ = false;
+    void check_monitoring(Cycle now);
     std::vector<std::pair<int, double>> sources_;  // node, watts
     Cycle last_cycle_ = 0;
     Cycle sample_cycles_;

@@ -136,6 +136,7 @@ Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params)
 
 void Thermistor::connect_body(ThermalBody& body) {
     plant_ = &body;
+    plant_->attach_sensor();
     sig_temperature_ = add_signal("bead_degC", true, plant_->sensor_degC());
     sig_volts_ = add_signal("volts", true, divider_volts(plant_->sensor_degC()));
 }
@@ -166,6 +167,7 @@ double Thermistor::gaussian() {
 
 double Thermistor::sample(Cycle cycle) {
     ++samples_;
+    plant_->sensor_read(cycle);
     double v = volts_now();
     if (noise_v_ > 0) v = std::clamp(v + noise_v_ * gaussian(), 0.0, reference_v_);
     if (!published_once_ || cycle - last_publish_ >= publish_cycles_) {
