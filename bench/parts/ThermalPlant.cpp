@@ -18,6 +18,9 @@ const FindingKind ThermalPlant::kHeatingUnmonitored = FindingKind::declare(
     "a heater heated a body whose thermistor the firmware did not read for `unmonitored_after` (no temperature control, "
     "no thermal-runaway protection)",
     Severity::Warning);
+const FindingKind ThermalPlant::kReadyWhileCold = FindingKind::declare(
+    "ready-while-cold", "the firmware's \"at temperature\" line (the plant's `ready` pin) was high at a sample with the "
+    "sensor below `ready_min`", Severity::Warning);
 const FindingKind ThermalPlant::kOverheat = FindingKind::declare("overheat", "a thermal plant passed its safe maximum temperature", Severity::Warning);
 
 std::vector<ParamSpec> ThermalPlant::param_specs() {
@@ -58,6 +61,9 @@ std::vector<ParamSpec> ThermalPlant::param_specs() {
                    "about every millisecond, Teacup's every 10 ms); 5 s leaves room for a slow loop",
          .help = "heating-unmonitored when a heater heats this long with no read of a thermistor on the body",
          .min = 1e-3, .max = 3600},
+        {.name = "ready_min", .type = PT::Quantity, .dimension = D::Temperature, .default_value = "150degC",
+         .source = "assumed: below any filament's printing temperature (PLA from about 180 degC)",
+         .help = "ready-while-cold when the `ready` pin (the firmware's TEMP_OK, if wired) is high below this"},
         {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "100ms",
          .source = "assumed", .help = "period of the temperature traces and of the filament-feed update"},
     };
@@ -123,6 +129,8 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     unmonitored_cycles_ = clock.cycles_from_seconds(params.quantity("unmonitored_after"));
+    ready_min_degC_ = params.quantity("ready_min");
+    ready_pin_ = add_pin("ready", TerminalRole::Input);
 
     sig_block_ = add_signal({"block_degC", true, "degC", "temperature", ""}, initial);
     sig_sensor_ = add_signal({"sensor_degC", true, "degC", "sensor-temperature", ""}, initial);
@@ -238,6 +246,23 @@ void ThermalPlant::sensor_read(Cycle cycle) {
     unmonitored_reported_ = false;  // a new spell, if it comes
 }
 
+void ThermalPlant::on_input(std::size_t pin, bool level) {
+    // Checked at the samples: a line that only passes high for a moment (pull-ups
+    // on before DDR after a reset) is not the firmware saying "ready".
+    if (pin == ready_pin_ && !level) ready_reported_ = false;  // a new spell, if it comes
+}
+
+void ThermalPlant::check_ready() {
+    if (!connected(ready_pin_) || !input_level(ready_pin_) || ready_reported_) return;
+    const double sensor = sensor_degC();
+    if (sensor >= ready_min_degC_) return;
+    ready_reported_ = true;
+    char detail[160];
+    std::snprintf(detail, sizeof detail, "the firmware says the temperature is reached (ready high) with the sensor at %.1f degC, "
+                  "below %.1f degC", sensor, ready_min_degC_);
+    report(ThermalPlant::kReadyWhileCold, detail);
+}
+
 void ThermalPlant::check_monitoring(Cycle now) {
     const bool heating = heated_since_sample_ || heater_power_W() > 0;
     heated_since_sample_ = false;
@@ -335,6 +360,7 @@ void ThermalPlant::on_sample(Cycle scheduled) {
     if (surface_ >= 0) publish(sig_surface_, network_.temperature(surface_));
     publish(sig_fan_, fan_speed_);
     check_monitoring(scheduled);
+    check_ready();
     clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });
 }
 

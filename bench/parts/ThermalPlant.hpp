@@ -32,6 +32,7 @@ public:
     // What this part finds (docs/FINDINGS.md).
     static const FindingKind kOverheat;  // overheat
     static const FindingKind kHeatingUnmonitored;  // heating-unmonitored
+    static const FindingKind kReadyWhileCold;      // ready-while-cold
     static std::vector<ParamSpec> param_specs();
     static const std::map<std::string, std::map<std::string, std::string>>& presets();
 
@@ -106,6 +107,12 @@ private:
     bool heated_since_sample_ = false;
     bool unmonitored_reported_ = false;
     void check_monitoring(Cycle now);
+    // ready-while-cold: the firmware's "at temperature" line on pin `ready`.
+    std::size_t ready_pin_ = 0;
+    double ready_min_degC_ = 0;
+    bool ready_reported_ = false;
+    void check_ready();
+    void on_input(std::size_t pin, bool level) override;
     std::vector<std::pair<int, double>> sources_;  // node, watts
     Cycle last_cycle_ = 0;
     Cycle sample_cycles_;

@@ -165,25 +165,36 @@ TEST(Printer3dDrive, TheListingWithItsTriggerFixedHoldsTheHeaterFullOn) {
 // has passed: at 5 s = 80 000 000 cycles of 16 MHz, on the plant's 100 ms
 // sample grid. The build with the trigger fixed reads its sensor (no such
 // finding, whatever else it gets wrong: §9.4), and so does the heater MCU's
-// own firmware on the same pins.
-std::vector<Finding> hot_end_findings(const std::string& firmware) {
+// own firmware on the same pins. TEMP_OK is wired to the plant's `ready`
+// check: the listing holds it high on a cold hot end (the pull-up PORTD =
+// 0xFF set before DDRD, §9.x), a ready-while-cold finding at the plant's
+// first sample, 100 ms = 1 600 000 cycles.
+std::vector<Finding> hot_end_findings(const std::string& firmware, const FindingKind& kind) {
     Board board(load_board_file(test::source_path("bench/boards/printer3d-drive-hotend-seed001.yaml")),
                 {{"drive", test::firmware(firmware)}});
     board.run_for_seconds(6.0);
     std::vector<Finding> out;
     for (const Finding& f : board.findings()) {
-        if (f.kind == ThermalPlant::kHeatingUnmonitored) out.push_back(f);
+        if (f.kind == kind) out.push_back(f);
     }
     return out;
 }
 
 TEST(Printer3dDrive, TheListingHeatsAnUnreadHotEndAndTheRunReportsIt) {
-    const auto listing = hot_end_findings("printer3d_drive_thesis");
-    ASSERT_EQ(listing.size(), 1u);
-    EXPECT_EQ(listing[0].source, "hotend");
-    EXPECT_EQ(listing[0].cycle, 80'000'000u);
-    EXPECT_TRUE(hot_end_findings("printer3d_drive_thesis_triggered").empty());
-    EXPECT_TRUE(hot_end_findings("printer3d_heater").empty());
+    const auto unread = hot_end_findings("printer3d_drive_thesis", ThermalPlant::kHeatingUnmonitored);
+    ASSERT_EQ(unread.size(), 1u);
+    EXPECT_EQ(unread[0].source, "hotend");
+    EXPECT_EQ(unread[0].cycle, 80'000'000u);
+    EXPECT_TRUE(hot_end_findings("printer3d_drive_thesis_triggered", ThermalPlant::kHeatingUnmonitored).empty());
+    EXPECT_TRUE(hot_end_findings("printer3d_heater", ThermalPlant::kHeatingUnmonitored).empty());
+}
+
+TEST(Printer3dDrive, TheListingsTempOkOnAColdHotEndIsReportedByTheRun) {
+    const auto ready = hot_end_findings("printer3d_drive_thesis", ThermalPlant::kReadyWhileCold);
+    ASSERT_EQ(ready.size(), 1u);
+    EXPECT_EQ(ready[0].cycle, 1'600'000u);
+    EXPECT_TRUE(hot_end_findings("printer3d_drive_thesis_triggered", ThermalPlant::kReadyWhileCold).empty());
+    EXPECT_TRUE(hot_end_findings("printer3d_heater", ThermalPlant::kReadyWhileCold).empty());
 }
 
 }  // namespace
