@@ -210,3 +210,35 @@ TEST(StepperOpenLoop, ThesisWholeMillisecondDelaysLoseSteps) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// sketch_08 (digest §7.6): "-50" moves 1000 steps BACKWARD at 50 rpm. AF_Stepper
+// at 50 rpm: 60e6 / (200 * 50) = 6000 us per step, delay(6) and no remainder,
+// so the steps are 6 ms apart (plus the 74HC595 shifting, tens of us). The
+// line ending left behind is a second parseInt that times out after
+// 1000 ms and returns 0 (Stream::parseInt): the motor is released then.
+TEST(Sketch08, MinusFiftyIsAThousandStepsBackwardAtFiftyRpmThenARelease) {
+    OpenLoopRun run("sketch08");
+    run.board.run_for_seconds(0.1);
+    EXPECT_EQ(run.output(), "Enter Speed\r\n");
+    run.send("-50\n");
+    run.run_until_done(1, 10.0);
+    EXPECT_EQ(run.position(), -1000);
+    const double move_end_s = run.board.now_seconds();
+    std::vector<double> intervals = run.intervals_us();
+    ASSERT_GE(intervals.size(), 999u);
+    std::sort(intervals.begin(), intervals.end());
+    EXPECT_GE(intervals[intervals.size() / 2], 6000.0);
+    EXPECT_LT(intervals[intervals.size() / 2], 6100.0);
+    run.motor.sync();
+    EXPECT_EQ(run.motor.lost_steps(), 0);  // 50 rpm: far below the 200 rpm pull-out
+    EXPECT_EQ(run.uno.read_ram_u16("releases"), 0u);
+    run.board.run_until_seconds(move_end_s + 1.2);
+    EXPECT_EQ(run.uno.read_ram_u16("releases"), 1u);
+    EXPECT_EQ(run.bytes().back() & 0xE1u, 0u);  // port 2's coil bits (0x20, 0x01, 0x80, 0x40) off
+}
+
+}  // namespace
+}  // namespace avrbench
