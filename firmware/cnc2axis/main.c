@@ -224,7 +224,13 @@ static void pen_init(void)
     ICR1 = 19999;
     OCR1A = PEN_UP_OCR;
     TCCR1A = _BV(COM1A1) | _BV(WGM11);           /* mode 10: phase-correct PWM, TOP = ICR1 */
+#ifdef SERVO_MODE14
+    /* The thesis' words, "Fast PWM mode 14", with the same ICR1/OCR1A (digest
+     * §1): 100 Hz and 0.75 ms / 1.0 ms pulses instead of 50 Hz, 1.5 / 2.0 ms. */
+    TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11); /* mode 14: fast PWM, TOP = ICR1; clk/8 */
+#else
     TCCR1B = _BV(WGM13) | _BV(CS11);             /* clk/8 */
+#endif
 }
 
 /* --- commands -------------------------------------------------------------------- */

@@ -216,5 +216,23 @@ TEST(Cnc2Axis, PenServoIsPhaseCorrectPwmMode10) {
     EXPECT_EQ(run.servo.high_times().back(), 32000u);
 }
 
+// The servo as the thesis names its mode, "Fast PWM mode 14", with the same
+// ICR1 = 19999 and OCR1A (digest §1, §7 check 13): period 8 * (19999 + 1)
+// = 160 000 cycles (100 Hz), pen up 8 * (1499 + 1) = 12 000 cycles
+// (0.75 ms), pen down 8 * (2000 + 1) = 16 008 cycles (1.0 ms): half the
+// widths the thesis' formula promises, at twice the rate.
+TEST(Cnc2Axis, PenServoInTheThesisNamedMode14RunsAtTwiceTheRateWithHalfThePulse) {
+    CncRun run("cnc2axis_servo_mode14");
+    run.board.run_for_seconds(0.2);
+    const auto periods = test::PinLog::differences(run.servo.rises());
+    ASSERT_GE(periods.size(), 5u);
+    EXPECT_EQ(periods.back(), 160000u);
+    EXPECT_EQ(run.servo.high_times().back(), 12000u);
+    run.send(run.g01(160, 0, 3, 3, kYOff));
+    run.run_until_acks(1, 5);
+    run.board.run_for_seconds(0.1);
+    EXPECT_EQ(run.servo.high_times().back(), 16008u);
+}
+
 }  // namespace
 }  // namespace avrbench
