@@ -362,6 +362,26 @@ static void home(void)
     OCR2A = HOMING_OCR;
     timers_run();
     uint8_t x_home = 0, y_home = 0;
+#ifdef HOMING_AS_WRITTEN
+    /* The thesis' order (digest §1): on a switch, wait the debounce with the
+     * motor still stepping, re-read, and only then switch its driver off. */
+    while (!(x_home && y_home)) {
+        if (!x_home && (PIND & _BV(PD2))) {
+            _delay_ms(2);
+            if (PIND & _BV(PD2)) {
+                PORTB |= _BV(X_EN);
+                x_home = 1;
+            }
+        }
+        if (!y_home && (PIND & _BV(PD3))) {
+            _delay_ms(2);
+            if (PIND & _BV(PD3)) {
+                PORTB |= _BV(Y_EN);
+                y_home = 1;
+            }
+        }
+    }
+#endif
     while (!(x_home && y_home)) {
         if (!x_home && (PIND & _BV(PD2))) {
             PORTB |= _BV(X_EN);

@@ -89,6 +89,24 @@ TEST(Cnc2Axis, HomesBothAxesBeforeTheFirstRecord) {
     EXPECT_TRUE(run.board.findings().empty());  // no crash into the frame, DRV8825 timing kept
 }
 
+// Homing in the thesis' order (digest §1: re-read after the debounce, then
+// switch the driver off): the motor steps on through the 2 ms delay. At the
+// homing rate, one step per 2 * 1024 * (3 + 1) = 8192 cycles, 2 ms = 32 000
+// cycles hold 3 or 4 steps (by phase) past the switch at 0 mm - what digest
+// §7 check 3 bounds ("at most the steps issued during the debounce delay") -
+// and the run reports the carriage driven past its end of travel.
+TEST(Cnc2Axis, HomingInTheThesisOrderOvershootsTheOriginByTheDebounceSteps) {
+    CncRun run("cnc2axis_homing_as_written");
+    const auto x_over = run.xd.steps_taken() - 6400u, y_over = run.yd.steps_taken() - 4000u;
+    EXPECT_GE(x_over, 3u);
+    EXPECT_LE(x_over, 4u);
+    EXPECT_GE(y_over, 3u);
+    EXPECT_LE(y_over, 4u);
+    std::size_t out_of_travel = 0;
+    for (const Finding& f : run.board.findings()) out_of_travel += f.kind == Axis::kAxisOutOfTravel ? 1 : 0;
+    EXPECT_EQ(out_of_travel, 2u);  // x and y
+}
+
 TEST(Cnc2Axis, StepPeriodIsTwoNTimesOcrPlusOne) {
     CncRun run;
     // G01 (0,0) -> (10,0) at OCR0A = 3: 10 mm * 160 = 1600 X steps, Y off.
