@@ -279,6 +279,11 @@ static void g01(void)
 #endif
     apply_start(start);
     timers_run();
+#ifdef G01_TIMER2_AS_WRITTEN
+    /* Appendix A3's G_01: TCCR2B = 0b00000110 - clk/256 on Timer2 (its
+     * comment says 128), where every other move and the PC's OCR2A use 1024. */
+    TCCR2B = _BV(CS22) | _BV(CS21);
+#endif
     count_x_polled(sx);
 #ifdef IMPROVED
     PORTB |= _BV(X_EN);

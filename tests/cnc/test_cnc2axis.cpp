@@ -144,6 +144,19 @@ TEST(Cnc2Axis, DiagonalG01CountsXAndRunsYOpenLoop) {
     }
 }
 
+// Appendix A3's G_01 sets TCCR2B = 0b110: Timer2 at clk/256 (digest §4:
+// "comment says 128; bits = clk/256"), while the PC computes OCR2A for 1024
+// (check 7). The same record then runs Y at 16e6 / (2 * 256 * 10) = 3125
+// steps/s for X's 1.024 s: 3200 (+-1) steps, 20 mm instead of 5.
+TEST(Cnc2Axis, G01WithTheListingsTimer2PrescalerRunsYFourTimesTooFar) {
+    CncRun run("cnc2axis_g01_timer2_as_written");
+    run.send(run.g01(1600, 800, 4, 9, 0));
+    run.run_until_acks(1, 5);
+    EXPECT_EQ(run.xd.steps_taken() - 6400u, 1600u);
+    EXPECT_NEAR(static_cast<double>(run.yd.steps_taken() - 4000u), 3200.0, 1.0);
+    EXPECT_NEAR(run.y.position_mm(), 20.0, 1.0 / 160.0 + 1e-9);
+}
+
 TEST(Cnc2Axis, LongMovesWrapIn16BitsAndAreExactIn24) {
     // 460 mm at 1/32 = 73600 microsteps; 16 bits hold 73600 - 65536 = 8064
     // (50.4 mm, digest §5 Table 6.2 and §7.12). G00 at OCR0A = 0 (48.8 mm/s).
