@@ -14,19 +14,22 @@
 namespace avrbench {
 namespace {
 
-// SoftwareSerial's pins in firmware/arduino/software_serial_lines.cpp: D11
-// (PB3) transmits, D10 (PB2) receives.
-std::string soft_serial_board(const std::string& host_params) {
+// An UNO with a serial_host whose rx joins `firmware_tx` and tx `firmware_rx`.
+std::string host_board(const std::string& host_params, const std::string& firmware_tx, const std::string& firmware_rx) {
     return R"(
 mcus:
   uno: {type: atmega328p, clock: 16MHz}
 parts:
   host: {type: serial_host)" + host_params + R"(}
 nets:
-  from_sketch: [uno.PB3, host.rx]
-  to_sketch: [host.tx, uno.PB2]
+  from_firmware: [uno.)" + firmware_tx + R"(, host.rx]
+  to_firmware: [host.tx, uno.)" + firmware_rx + R"(]
 )";
 }
+
+// SoftwareSerial's pins in firmware/arduino/software_serial_lines.cpp: D11
+// (PB3) transmits, D10 (PB2) receives.
+std::string soft_serial_board(const std::string& host_params) { return host_board(host_params, "PB3", "PB2"); }
 
 TEST(SerialHost, OnAUsartsPinsItWorksAtByteLevelAndDrawsItsFramesOnTheNet) {
     Bench bench(test::source_path("bench/boards/arduino-uno.yaml"), test::firmware("uart_echo"));
@@ -109,16 +112,8 @@ TEST(SerialHost, AnUnosOneKiloOhmLetsASketchDriveItsRxPin) {
     // 16U2's TX reaches PD0 through 1 kohm (RN4, the UNO R3 schematic), so
     // the sketch wins without a fight; a host wired directly contends.
     auto contentions = [](const std::string& host_params) {
-        const std::string text = R"(
-mcus:
-  uno: {type: atmega328p, clock: 16MHz}
-parts:
-  host: {type: serial_host)" + host_params + R"(}
-nets:
-  host_rx: [uno.PD1, host.rx]
-  host_tx: [host.tx, uno.PD0]
-)";
-        Bench bench(parse_board_text(text, "busy.yaml"), {{"uno", test::firmware("busy_poll")}});
+        // ATmega328P Table 14-9: TXD PD1, RXD PD0.
+        Bench bench(parse_board_text(host_board(host_params, "PD1", "PD0"), "busy.yaml"), {{"uno", test::firmware("busy_poll")}});
         bench.run_for(0.001);
         std::size_t n = 0;
         for (const auto& f : bench.findings()) n += f.kind == Net::kNetContention ? 1 : 0;
