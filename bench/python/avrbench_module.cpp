@@ -382,6 +382,7 @@ PYBIND11_MODULE(_avrbench, m) {
     // A deprecated board-file form and the like: Python warnings, which the
     // caller's filters may silence or turn into errors.
     set_notice_sink([](const std::string& line) {
+        py::gil_scoped_acquire gil;  // boards load with the GIL held today; a notice must not depend on it
         if (PyErr_WarnEx(PyExc_DeprecationWarning, line.c_str(), 1) < 0) throw py::error_already_set();
     });
     static py::exception<BadInput> bad_input(m, "BadInput");
