@@ -80,13 +80,20 @@ void Board::build_parts() {
         return name;
     };
     for (const auto& decl : spec_.parts) group_of[decl.name] = decl.name;
+    // An observer's ports join nothing (PartType::observer).
+    const auto grouped = [this](const std::string& owner) {
+        const PartDecl* part = spec_.find_part(owner);
+        if (part == nullptr) return false;
+        const auto type = part_types().find(part->type);
+        return type == part_types().end() || !type->second.observer;
+    };
     for (const auto& net : spec_.nets) {
         bool has_mcu = false;
         for (const auto& e : net.endpoints) has_mcu = has_mcu || spec_.find_mcu(e.owner) != nullptr;
         if (has_mcu) continue;
         std::string first;
         for (const auto& e : net.endpoints) {
-            if (spec_.find_part(e.owner) == nullptr) continue;
+            if (!grouped(e.owner)) continue;
             if (first.empty()) first = find(e.owner);
             else group_of[find(e.owner)] = first;
         }
@@ -99,7 +106,7 @@ void Board::build_parts() {
         }
         if (net_mcu == nullptr) continue;
         for (const auto& e : net.endpoints) {
-            if (spec_.find_part(e.owner) != nullptr) group_clock.emplace(find(e.owner), net_mcu);
+            if (grouped(e.owner)) group_clock.emplace(find(e.owner), net_mcu);
         }
     }
     std::map<std::string, Mcu*> clock_of;
@@ -523,7 +530,10 @@ std::size_t Board::finding_count() const {
 std::vector<Finding> Board::findings() const {
     std::vector<Finding> out;
     for (const auto& m : mcus_) out.insert(out.end(), m->findings().begin(), m->findings().end());
-    for (const auto& p : parts_) out.insert(out.end(), p->findings().begin(), p->findings().end());
+    for (const auto& p : parts_) {
+        out.insert(out.end(), p->findings().begin(), p->findings().end());
+        for (Finding& f : p->pending_findings()) out.push_back(std::move(f));
+    }
     for (const auto& n : nets_) out.insert(out.end(), n->findings().begin(), n->findings().end());
     return out;
 }

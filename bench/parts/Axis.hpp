@@ -34,6 +34,7 @@ public:
     double position_mm() const override { return static_cast<double>(carriage_256_) * metres_per_256_ * 1e3; }
     double position_deg() const;
     double travel_mm() const override { return travel_m_ * 1e3; }
+    double step_mm() const override { return 1e3 / steps_per_unit_; }
     std::string summary() override;
     unsigned crashes() const { return crashes_; }
 

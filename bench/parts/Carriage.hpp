@@ -15,6 +15,9 @@ public:
     virtual ~Carriage() = default;
     virtual double position_mm() const = 0;  // 0 .. travel_mm()
     virtual double travel_mm() const = 0;
+    // How far one STEP pulse moves it: the finest position the axis can
+    // reach, so the tolerance of "it got there" (parts/MotionOracle).
+    virtual double step_mm() const = 0;
     virtual void on_move(std::function<void(double position_m)> fn) = 0;
 };
 

@@ -119,7 +119,7 @@ void Part::inject_fault_at_seconds(const std::string& fault, double seconds) {
     inject_fault(fault, clock_->cycles_from_seconds(seconds));
 }
 
-void Part::report(FindingKind kind, std::string detail) {
+std::size_t Part::report(FindingKind kind, std::string detail) {
     Finding f;
     f.kind = kind;
     f.source = name_;
@@ -129,6 +129,7 @@ void Part::report(FindingKind kind, std::string detail) {
     f.detail = std::move(detail);
     findings_.push_back(std::move(f));
     count_finding_recorded();
+    return findings_.size() - 1;
 }
 
 }  // namespace avrbench

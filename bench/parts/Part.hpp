@@ -121,6 +121,10 @@ public:
     virtual void start() {}
 
     const std::vector<Finding>& findings() const { return findings_; }
+    // Findings about what is still under way, as they stand if the run ends
+    // now (a move the machine has not left yet): not recorded, asked again
+    // at each look (Board::findings()).
+    virtual std::vector<Finding> pending_findings() const { return {}; }
 
     // Faults, by name, for tests and scenario files ("open", "stuck_on", ...;
     // "none" repairs). inject_fault applies one when this part's clock reaches
@@ -218,7 +222,11 @@ protected:
     bool input_level(std::size_t pin) const { return pins_[pin]->level(); }
     bool connected(std::size_t pin) const { return pins_[pin]->connected(); }
 
-    void report(FindingKind kind, std::string detail);
+    // Records a finding now; returns its index among this part's findings.
+    std::size_t report(FindingKind kind, std::string detail);
+    // A finding recorded when a fault began, told in full once it is over
+    // (a path deviation's worst distance): only its text changes.
+    void revise_finding(std::size_t index, std::string detail) { findings_.at(index).detail = std::move(detail); }
     void note_activity() {
         for (auto& fn : activity_listeners_) fn();
     }

@@ -33,6 +33,10 @@ struct PartType {
     // Its parts are serial ports a host attaches to (parts/HostConnector.hpp):
     // a board file that has one can take a G-code job.
     bool host_connector = false;
+    // Its ports only watch other parts (a motion oracle reading carriages on
+    // several MCUs' boards): it joins no clock group, and takes the board's
+    // first MCU's clock. A type says so with `static constexpr bool kObserver = true;`.
+    bool observer = false;
 };
 
 // A part type built from its parameters, with the part's presets if it has any.
@@ -43,6 +47,7 @@ PartType simple_part_type(const std::string& type_name) {
     t.params = T::param_specs();
     if constexpr (requires { T::presets(); }) t.presets = T::presets();
     t.host_connector = std::is_base_of_v<HostConnector, T>;
+    if constexpr (requires { T::kObserver; }) t.observer = T::kObserver;
     t.build = [](const std::string& name, Mcu& clock, const ParamValues& params) {
         return std::make_unique<T>(name, clock, params);
     };

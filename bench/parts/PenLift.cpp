@@ -31,6 +31,7 @@ PenLift::PenLift(std::string name, Mcu& clock, const ParamValues& params) : Part
     require_port<ServoHorn>("horn", true, "the pen servo's horn", [this](ServoHorn& horn) { servo_ = &horn; });
     require_port<Carriage>("x", true, "the X axis' carriage", [this](Carriage& x) { connect_carriage(x_, x); });
     require_port<Carriage>("y", true, "the Y axis' carriage", [this](Carriage& y) { connect_carriage(y_, y); });
+    provide_port<ToolContact>("tool", *this, "a motion_oracle's tool");
     sig_down_ = add_signal("down", false, 0);
     sig_x_ = add_signal({"tip_x_mm", true, "mm", "", ""}, 0);
     sig_y_ = add_signal({"tip_y_mm", true, "mm", "", ""}, 0);

@@ -2,7 +2,8 @@
 // the servo, ports `x` and `y` the two linear axes' carriages. The pen is down
 // while the horn is at or beyond `down_angle`; while down, every carriage move
 // adds to the current stroke, so the drawing is a trace (`down`, and the pen
-// tip's `tip_x_mm` / `tip_y_mm`) and a list of polylines for checks.
+// tip's `tip_x_mm` / `tip_y_mm`) and a list of polylines for checks. It
+// provides port `tool` (the pen's contact) for a motion_oracle.
 #pragma once
 
 #include <vector>
@@ -11,11 +12,12 @@
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 #include "parts/ServoHorn.hpp"
+#include "parts/ToolContact.hpp"
 
 namespace avrbench {
 
 
-class PenLift final : public Part {
+class PenLift final : public Part, public ToolContact {
 public:
     static std::vector<ParamSpec> param_specs();
 
@@ -28,6 +30,7 @@ public:
         double x_mm, y_mm;
     };
     bool down() const { return down_; }
+    bool tool_down() const override { return down_; }
     // Every stroke drawn: the tip's positions from pen down to pen up.
     const std::vector<std::vector<Point>>& strokes() const { return strokes_; }
 

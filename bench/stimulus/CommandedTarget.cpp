@@ -9,9 +9,9 @@ namespace {
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
-// The words of a line in the strict form CommandedTarget.hpp describes, or
-// nothing when any byte is outside it.
-std::optional<std::map<char, double>> strict_words(std::string_view line) {
+}  // namespace
+
+std::optional<std::map<char, double>> strict_gcode_words(std::string_view line, std::vector<double>* g_words) {
     if (const auto star = line.find('*'); star != std::string_view::npos) {
         const auto checksum = line.substr(star + 1);
         if (checksum.empty()) return std::nullopt;
@@ -44,17 +44,20 @@ std::optional<std::map<char, double>> strict_words(std::string_view line) {
         // A number must end at a space, the line's end or another word's
         // letter - never E (an exponent to atof/strtod) or anything else.
         if (j < line.size() && line[j] != ' ' && (line[j] < 'A' || line[j] > 'Z' || line[j] == 'E')) return std::nullopt;
-        if (words.count(letter) != 0) return std::nullopt;
-        words[letter] = std::strtod(std::string(line.substr(i + 1, j - i - 1)).c_str(), nullptr);
+        const double value = std::strtod(std::string(line.substr(i + 1, j - i - 1)).c_str(), nullptr);
+        if (letter == 'G' && g_words != nullptr) {
+            g_words->push_back(value);
+        } else {
+            if (words.count(letter) != 0) return std::nullopt;
+            words[letter] = value;
+        }
         i = j;
     }
     return words;
 }
 
-}  // namespace
-
 std::optional<std::array<double, 3>> CommandedTarget::accept(std::string_view line) {
-    const auto words = strict_words(line);
+    const auto words = strict_gcode_words(line);
     if (!words) {
         forget();
         return std::nullopt;

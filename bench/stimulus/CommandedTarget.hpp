@@ -15,10 +15,18 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 namespace avrbench {
+
+// The words of a line in the strict form above (letter -> value, the N word
+// included), or nothing when any byte is outside it. With `g_words`, G words
+// go there in their order and may be several ("G21 G90"); without, a second
+// G is outside the form like any repeated letter.
+std::optional<std::map<char, double>> strict_gcode_words(std::string_view line, std::vector<double>* g_words = nullptr);
 
 class CommandedTarget {
 public:

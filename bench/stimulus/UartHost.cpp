@@ -531,6 +531,7 @@ void UartHost::send_line(std::size_t index) {
     if (outstanding_bytes_ > max_outstanding_bytes_) max_outstanding_bytes_ = outstanding_bytes_;
     transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
     uart_.send(line.text + "\n");
+    for (auto& fn : sent_listeners_) fn(line);
     if (was_idle) {
         // The pause a keep-alive ends is counted from the later of the last
         // output and this line: the silence the line timeout measures.

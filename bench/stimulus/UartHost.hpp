@@ -256,6 +256,10 @@ public:
     std::string tail(std::size_t n) const;
     // Called for every line received (after the host has handled it).
     void on_line_received(LineListener fn) { line_listeners_.push_back(std::move(fn)); }
+    // Called when a job line first goes out (not for resends, nor for grbl's
+    // real-time bytes), before the firmware has its first byte.
+    using SentListener = std::function<void(const GcodeLine& line)>;
+    void on_line_sent(SentListener fn) { sent_listeners_.push_back(std::move(fn)); }
 
     // --- running -------------------------------------------------------------
     // Runs the MCU until finished() or `max_seconds` of simulated time from
@@ -335,6 +339,7 @@ private:
     std::optional<std::string> banner_;
     std::vector<TranscriptEntry> transcript_;
     std::vector<LineListener> line_listeners_;
+    std::vector<SentListener> sent_listeners_;
 };
 
 }  // namespace avrbench
