@@ -169,7 +169,7 @@ BoardRunOptions::RecordJob plot_job(const RunArgs& args) {
     RecordOptions options;
     options.improved = args.records == "improved";
     const RecordProgram program = records_from_gcode(gcode.text, options, args.dxf);
-    return {args.dxf, args.records, program.messages, program.busy_seconds};
+    return {args.dxf, args.records, program.messages, program.busy_seconds, gcode.text};
 }
 
 // `run --board`'s arguments as the library's run options, checked as far as

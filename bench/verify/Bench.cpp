@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <deque>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "core/UserStop.hpp"
 #include "parts/AcceptedMoves.hpp"
 #include "stimulus/CommandedTarget.hpp"
+#include "verify/CommandedPath.hpp"
 
 namespace avrbench {
 
@@ -119,7 +121,115 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
     return *slot;
 }
 
+std::vector<CommandedMoves*> Bench::motion_judges() const {
+    std::vector<CommandedMoves*> judges;
+    for (Part* part : board_->parts()) {
+        if (auto* judge = dynamic_cast<CommandedMoves*>(part)) judges.push_back(judge);
+    }
+    return judges;
+}
+
+void Bench::command_program(const std::string& gcode, const std::string& source) {
+    std::vector<CommandedPath> paths;
+    for (CommandedMoves* judge : motion_judges()) paths.emplace_back(*judge);
+    if (paths.empty()) return;
+    std::size_t number = 0;
+    std::size_t begin = 0;
+    while (begin < gcode.size()) {
+        std::size_t end = gcode.find('\n', begin);
+        if (end == std::string::npos) end = gcode.size();
+        std::string line = gcode.substr(begin, end - begin);
+        begin = end + 1;
+        ++number;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) continue;
+        const std::string quoted = source + " line " + std::to_string(number) + " " + quoted_line(line);
+        for (auto& path : paths) path.accept(line, quoted);
+    }
+}
+
+namespace {
+
+// A host's lines handed to one motion judge as they go out, so a firmware
+// that answers once a move is done is followed while it moves. A line it
+// refuses is taken back: its moves and those of the lines sent after it are
+// retracted, the reading state from before it is put back and the later
+// lines read again; where the judge cannot (the machine began one of those
+// moves) or a G92 is among them, the judge stops.
+struct SentLineFeed {
+    explicit SentLineFeed(CommandedMoves& j) : judge(&j), path(j) {}
+    CommandedMoves* judge;
+    CommandedPath path;
+    struct Unanswered {
+        GcodeLine line;
+        CommandedPath before;  // the reading state before the line
+        std::size_t moves = 0;
+        bool renamed = false;
+        bool changed = false;  // it moved, renamed or changed a mode
+    };
+    std::deque<Unanswered> unanswered;
+
+    void sent(const GcodeLine& line) {
+        Unanswered u{line, path};
+        path.accept(line.text, "line " + std::to_string(line.number) + " " + quoted_line(line.text));
+        u.moves = path.moves_told() - u.before.moves_told();
+        u.renamed = path.renames_told() != u.before.renames_told();
+        u.changed = u.moves != 0 || u.renamed || !path.same_state(u.before);
+        unanswered.push_back(std::move(u));
+    }
+    void answered(const GcodeLine& line, bool refused) {
+        while (!unanswered.empty() && unanswered.front().line.number < line.number) unanswered.pop_front();
+        if (unanswered.empty() || unanswered.front().line.number != line.number) return;
+        Unanswered refused_line = std::move(unanswered.front());
+        unanswered.pop_front();
+        if (!refused || !refused_line.changed) return;
+        std::size_t moves = refused_line.moves;
+        bool renamed = refused_line.renamed;
+        for (const auto& later : unanswered) {
+            moves += later.moves;
+            renamed = renamed || later.renamed;
+        }
+        if (renamed || !judge->retract(moves)) {
+            path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
+            return;
+        }
+        path = std::move(refused_line.before);
+        std::deque<Unanswered> again = std::move(unanswered);
+        unanswered.clear();
+        for (const auto& later : again) sent(later.line);
+    }
+};
+
+}  // namespace
+
+void Bench::follow_sent_lines(UartHost& host) {
+    auto feeds = std::make_shared<std::vector<SentLineFeed>>();
+    for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge);
+    if (feeds->empty()) return;
+    auto last_sent = std::make_shared<std::size_t>(0);
+    host.on_line_sent([feeds, last_sent](const GcodeLine& line) {
+        if (line.number <= *last_sent) return;  // a resend: read once
+        *last_sent = line.number;
+        for (auto& feed : *feeds) feed.sent(line);
+    });
+    auto acknowledged = std::make_shared<std::size_t>(0);
+    host.on_line_received([&host, feeds, acknowledged](const TranscriptEntry& entry) {
+        if (host.lines_acknowledged() == *acknowledged) return;
+        *acknowledged = host.lines_acknowledged();
+        const GcodeLine& line = host.lines()[*acknowledged - 1];
+        // Refused: answered with an error, or (Marlin) an "Error:" line
+        // before the "ok" that frees the slot.
+        bool refused = entry.text.rfind("ok", 0) != 0;
+        for (auto e = host.events().rbegin(); !refused && e != host.events().rend(); ++e) {
+            if (e->line && e->line->number < line.number) break;
+            refused = e->kind == HostEventKind::Error && e->line && e->line->number == line.number;
+        }
+        for (auto& feed : *feeds) feed.answered(line, refused);
+    });
+}
+
 void Bench::check_accepted_moves(UartHost& host) {
+    follow_sent_lines(host);
     std::vector<AcceptedMoves*> robots;
     for (Part* part : board_->parts()) {
         auto* checker = dynamic_cast<AcceptedMoves*>(part);

@@ -27,6 +27,7 @@
 
 namespace avrbench {
 
+class CommandedMoves;
 
 enum class IdleResult {
     Idle,        // every host finished its job and no STEP edge for the settle time
@@ -112,6 +113,12 @@ public:
     // Simulated time of the last STEP edge any driver counted, or -1.
     double last_step_seconds() const { return last_step_ps_ ? seconds_from_ps(*last_step_ps_) : -1.0; }
 
+    // A program the firmware takes in another form (seed 002's binary
+    // records made from this G-code): the board's motion judges are told
+    // its moves up front, in order, as if each line had been accepted.
+    // `source` names it in findings ("drawing.dxf's G-code").
+    void command_program(const std::string& gcode, const std::string& source);
+
     // Board findings plus one HostProtocol finding per host error, alarm,
     // fatal answer or timeout.
     std::vector<Finding> findings() const;
@@ -128,8 +135,12 @@ private:
     void report_timing(RunReport& r) const;
     void watch_motion();
     // G0/G1 targets the firmware answers ok to, checked against the board's
-    // machines that can judge them (parts/DeltaRobot: target-out-of-reach).
+    // machines that can judge them (parts/DeltaRobot: target-out-of-reach);
+    // and every line the host sends handed to the board's motion judges
+    // (parts/CommandedMoves: a motion_oracle), taken back if refused.
     void check_accepted_moves(UartHost& host);
+    void follow_sent_lines(UartHost& host);
+    std::vector<CommandedMoves*> motion_judges() const;
 
     // The serial port of host `name` (one that exists).
     const SerialPort& port_of(const std::string& name) const { return serial_port(name); }

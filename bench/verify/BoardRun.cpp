@@ -195,6 +195,7 @@ void BoardRun::start_record_job() {
     plot_ = std::make_unique<RecordHost>(*port.mcu, port.link(), job.messages,
                                          RecordHost::Options{}, job.busy_seconds);
     plot_->start();
+    if (!job.gcode.empty()) bench_->command_program(job.gcode, job.source + "'s G-code");
 }
 
 void BoardRun::open_pty() {

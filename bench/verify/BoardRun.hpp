@@ -61,6 +61,9 @@ struct BoardRunOptions {
         std::string variant;  // "faithful" / "improved", for the summary
         std::vector<std::string> messages;
         std::vector<double> busy_seconds;
+        // The G-code the records were made from: the path the board's
+        // motion judges hold the machine to ("" for none).
+        std::string gcode;
     };
     // Made once the board's files are checked and the board is built (the
     // CLI reads a drawing through the CAM then); empty = no such job.

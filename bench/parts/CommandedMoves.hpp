@@ -1,0 +1,54 @@
+// What a part that judges the machine's motion is told about the motion the
+// firmware was commanded: the moves of the lines it accepted, in the
+// firmware's own coordinates (mm), in the order it accepted them. The bench
+// reads them from a host's G-code (verify/CommandedPath) or from the program
+// a record job was made from, and hands them to every part with this
+// interface (parts/MotionOracle), without knowing its type.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+
+namespace avrbench {
+
+// X, Y, Z in the firmware's coordinates (mm); an axis the bench cannot know
+// (a line it could not read, a relative move from an unknown place) is empty.
+using AxisPositions = std::array<std::optional<double>, 3>;
+
+struct CommandedMove {
+    enum class Kind {
+        Rapid,            // G0: travel, the tool lifted
+        Feed,             // G1: a straight line, the tool working
+        ArcClockwise,     // G2, in the XY plane about `centre_mm`
+        ArcCounterClockwise,  // G3
+        Home,             // G28: to the firmware's zero on the axes `to_mm` names, by switches
+    };
+    Kind kind = Kind::Feed;
+    AxisPositions from_mm{};
+    AxisPositions to_mm{};
+    std::array<double, 2> centre_mm{};  // arcs: X, Y of the centre
+    std::array<bool, 3> homed{};        // Home: the axes it homes
+    std::string line;                   // "line 7 'G2 X60 Y50 I0 J-10'", for findings
+};
+
+class CommandedMoves {
+public:
+    virtual ~CommandedMoves() = default;
+    // The next move the firmware accepted.
+    virtual void commanded(const CommandedMove& move) = 0;
+    // The firmware calls its position on these axes something else from
+    // here on (G92): axis k was `was_mm[k]` (empty: unknown) and is now
+    // `now_mm[k]`; axes with an empty `now_mm` keep their frame.
+    virtual void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) = 0;
+    // From here on the bench cannot tell what the firmware's coordinates
+    // mean (a line it could not read, a work offset, a G code it does not
+    // model): stop judging until the end of the run.
+    virtual void frame_lost(const std::string& line) = 0;
+    // The firmware refused the line that gave the last `moves` moves (they
+    // were told as the line went out): forget them. False when it cannot,
+    // because the machine began one (the bench then loses the frame).
+    virtual bool retract(std::size_t moves) = 0;
+};
+
+}  // namespace avrbench

@@ -1,0 +1,489 @@
+#include "parts/MotionOracle.hpp"
+
+#include "parts/PartRegistry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/Errors.hpp"
+
+namespace avrbench {
+
+REGISTER_PART(MotionOracle, "motion_oracle");
+
+const FindingKind MotionOracle::kPathDeviation = FindingKind::declare(
+    "path-deviation", "the tool strayed from the commanded line or arc by more than the board's tolerance", Severity::Warning);
+const FindingKind MotionOracle::kMoveEndMissed = FindingKind::declare(
+    "move-end-missed", "the tool left a commanded move, or came to rest, away from the move's end", Severity::Warning);
+const FindingKind MotionOracle::kToolDownOffPath = FindingKind::declare(
+    "tool-down-off-path", "the pen was down while the machine travelled away from every drawing move", Severity::Warning);
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr char kAxisLetters[3] = {'X', 'Y', 'Z'};
+// Accepted moves the machine may be behind by before the oracle gives up
+// (memory stays bounded on a firmware that acknowledges and never moves).
+constexpr std::size_t kMaxPendingMoves = 4096;
+// How many moves past the cursor a stray tool is compared with.
+constexpr std::size_t kLookahead = 8;
+
+double wrap_2pi(double rad) {
+    double r = std::fmod(rad, 2 * kPi);
+    if (r < 0) r += 2 * kPi;
+    return r;
+}
+
+std::string mm_text(double mm) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3f", mm);
+    return text;
+}
+
+}  // namespace
+
+std::vector<ParamSpec> MotionOracle::param_specs() {
+    using PT = ParamType;
+    using D = Dimension;
+    std::vector<ParamSpec> specs = {
+        {.name = "path_tolerance", .type = PT::Quantity, .dimension = D::Length, .default_value = "0.1mm",
+         .source = "assumed: a few steps of a 80-160 steps/mm axis; a board with coarser timing states its own",
+         .help = "how far the tool may stray from a commanded line or arc", .min = 1e-6, .max = 1.0},
+        {.name = "end_tolerance", .type = PT::Quantity, .dimension = D::Length,
+         .source = "default: one step of each axis (issue 40: end positions to one step)",
+         .help = "how far from a move's end the tool may stop, per axis (default: one step)", .min = 0, .max = 1.0},
+        {.name = "rapids", .type = PT::Choice, .default_value = "straight", .choices = {"straight", "any"},
+         .source = "grbl, Marlin and Teacup move G0 on a straight line; a firmware that runs each axis at its own rate (seed 002) does not",
+         .help = "whether a G0's path is judged (straight) or only its end (any)"},
+        {.name = "z_moves", .type = PT::Choice, .default_value = "with_xy", .choices = {"with_xy", "before_xy"},
+         .source = "with_xy: a line moves all its axes together; seed 001 (digest §3) moves Z alone first",
+         .help = "how a line that changes Z and X/Y moves"},
+        {.name = "rest_time", .type = PT::Quantity, .dimension = D::Time, .default_value = "200ms",
+         .source = "assumed: longer than the step interval of any move but the slowest homing (5 steps/s)",
+         .help = "how long no carriage moves before the machine counts as at rest"},
+    };
+    for (char axis : {'x', 'y', 'z'}) {
+        const std::string a(1, axis);
+        specs.push_back({.name = "origin_" + a, .type = PT::Quantity, .dimension = D::Length,
+                         .source = "default: the carriage's position at power-up (firmware count from where they start)",
+                         .help = "where the firmware's " + a + " = 0 is on the carriage (default: where it starts)",
+                         .min = -10.0, .max = 10.0});
+        specs.push_back({.name = "home_" + a, .type = PT::Quantity, .dimension = D::Length,
+                         .source = "the board: where the firmware's homing puts its zero (a switch's trip point)",
+                         .help = "where " + a + " = 0 is on the carriage after G28 (absent: G28 ends judging)",
+                         .min = -10.0, .max = 10.0});
+    }
+    return specs;
+}
+
+MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
+    path_tolerance_mm_ = params.quantity("path_tolerance") * 1e3;
+    if (params.has("end_tolerance")) end_tolerance_mm_ = params.quantity("end_tolerance") * 1e3;
+    rapids_straight_ = params.text("rapids") == "straight";
+    z_before_xy_ = params.text("z_moves") == "before_xy";
+    rest_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(params.quantity("rest_time")));
+    static constexpr const char* kAxes[3] = {"x", "y", "z"};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const std::string a = kAxes[k];
+        if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
+        if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
+        require_port<Carriage>(a, false, "the " + std::string(1, kAxisLetters[k]) + " axis' carriage",
+                               [this, k](Carriage& c) {
+                                   carriages_[k] = &c;
+                                   c.on_move([this](double) { on_carriage(); });
+                               });
+    }
+    require_port<ToolContact>("tool", false, "the pen (a pen_lift's tool)", [this](ToolContact& t) { tool_ = &t; });
+}
+
+void MotionOracle::start() {
+    bool any = false;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!connected(k)) continue;
+        any = true;
+        origin_mm_[k] = origin_given_mm_[k] ? *origin_given_mm_[k] : carriages_[k]->position_mm();
+    }
+    if (!any) throw BadInput("part '" + name() + "': join at least one of ports x, y, z to a linear axis' carriage");
+    last_position_ = tool_position();
+    rest_anchor_ = last_position_;
+    last_move_cycle_ = clock().cycle();
+    double finest_step = 1e300;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (connected(k)) finest_step = std::min(finest_step, carriages_[k]->step_mm());
+    }
+    rest_jitter_mm_ = finest_step / 2;
+}
+
+bool MotionOracle::Tracked::drawing() const {
+    return !barrier && (kind == CommandedMove::Kind::Feed || kind == CommandedMove::Kind::ArcClockwise ||
+                        kind == CommandedMove::Kind::ArcCounterClockwise);
+}
+
+Eigen::Vector3d MotionOracle::tool_position() const {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (connected(k)) p[static_cast<Eigen::Index>(k)] = carriages_[k]->position_mm();
+    }
+    return p;
+}
+
+void MotionOracle::lose(const std::string& why) {
+    if (lost_) return;
+    lost_ = true;
+    lost_why_ = why;
+    Tracked barrier;
+    barrier.barrier = true;
+    moves_.push_back(barrier);
+}
+
+void MotionOracle::frame_lost(const std::string& line) {
+    lose(line + " means different things to different firmware");
+}
+
+void MotionOracle::position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) {
+    if (lost_) return;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!now_mm[k] || !connected(k)) continue;
+        if (!was_mm[k] || !origin_mm_[k]) return lose(std::string("G92 renames ") + kAxisLetters[k] + " from an unknown position");
+        origin_mm_[k] = *origin_mm_[k] + *was_mm[k] - *now_mm[k];
+    }
+}
+
+void MotionOracle::commanded(const CommandedMove& move) {
+    if (lost_) return;
+    if (moves_.size() >= kMaxPendingMoves) return lose("the machine is more than 4096 accepted moves behind");
+    Tracked t;
+    t.kind = move.kind;
+    t.line = move.line;
+    t.command = commands_++;
+    const bool home = move.kind == CommandedMove::Kind::Home;
+    t.free = home || (move.kind == CommandedMove::Kind::Rapid && !rapids_straight_);
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!connected(k)) continue;
+        const auto i = static_cast<Eigen::Index>(k);
+        const double step = end_tolerance_mm_ ? *end_tolerance_mm_ : carriages_[k]->step_mm();
+        t.end_tolerance[i] = step + 1e-9;
+        if (!origin_mm_[k] || !move.from_mm[k]) return lose(move.line + " starts where the bench cannot know");
+        t.from[i] = *move.from_mm[k] + *origin_mm_[k];
+        if (home && move.homed[k]) {
+            origin_mm_[k] = home_mm_[k];
+            if (!origin_mm_[k]) {
+                return lose(move.line + " homes " + kAxisLetters[k] + " and the board gives no home_" +
+                            static_cast<char>(kAxisLetters[k] - 'A' + 'a'));
+            }
+            // Where a switch trips is not a step-exact place.
+            t.end_tolerance[i] = std::max(t.end_tolerance[i], path_tolerance_mm_);
+        }
+        if (!move.to_mm[k]) return lose(move.line + " ends where the bench cannot know");
+        t.to[i] = *move.to_mm[k] + *origin_mm_[k];
+        t.origin[i] = *origin_mm_[k];
+    }
+    const bool arc = move.kind == CommandedMove::Kind::ArcClockwise || move.kind == CommandedMove::Kind::ArcCounterClockwise;
+    if (arc) {
+        t.centre = {move.centre_mm[0] + t.origin[0], move.centre_mm[1] + t.origin[1]};
+        const Eigen::Vector2d start = t.from.head<2>() - t.centre;
+        const Eigen::Vector2d end = t.to.head<2>() - t.centre;
+        t.radius = start.norm();
+        if (t.radius < 1e-9) {
+            t.kind = CommandedMove::Kind::Feed;  // no circle: the firmware moves straight, if at all
+        } else {
+            t.start_rad = std::atan2(start.y(), start.x());
+            const double end_rad = std::atan2(end.y(), end.x());
+            const bool ccw = move.kind == CommandedMove::Kind::ArcCounterClockwise;
+            double sweep = ccw ? wrap_2pi(end_rad - t.start_rad) : wrap_2pi(t.start_rad - end_rad);
+            if (sweep < 1e-9) sweep = 2 * kPi;  // back to its start: a whole circle
+            t.sweep_rad = ccw ? sweep : -sweep;
+            t.length = std::hypot(sweep * t.radius, t.to.z() - t.from.z());
+        }
+    }
+    if (!arc || t.kind == CommandedMove::Kind::Feed) t.length = (t.to - t.from).norm();
+    const bool z_and_xy = t.from.z() != t.to.z() && (t.from.head<2>() - t.to.head<2>()).norm() > 0;
+    if (z_before_xy_ && z_and_xy && !arc && !home) {
+        Tracked z_alone = t;
+        z_alone.to.head<2>() = t.from.head<2>();
+        z_alone.length = std::abs(t.to.z() - t.from.z());
+        t.from.z() = t.to.z();
+        t.length = (t.to - t.from).norm();
+        moves_.push_back(z_alone);
+    }
+    moves_.push_back(t);
+    // A firmware that answers once the move is done (seed 001's thesis
+    // parser) is told of it when the tool already stands at its end: judge
+    // the tool where it is now, as if it had just moved there.
+    const Eigen::Vector3d p = tool_position();
+    observe(moves_.front(), p, clock().cycle());
+    advance(p);
+}
+
+bool MotionOracle::retract(std::size_t moves) {
+    if (lost_ || moves > commands_) return false;
+    const std::uint64_t first = commands_ - moves;
+    std::size_t drop = 0;
+    for (auto it = moves_.rbegin(); it != moves_.rend() && it->command >= first; ++it) {
+        const bool begun = it->progress > it->end_tolerance.maxCoeff() || it->end_reached || it->deviation_finding ||
+                           it->tool_finding;
+        if (begun && &*it == &moves_.front()) return false;
+        ++drop;
+    }
+    moves_.erase(moves_.end() - static_cast<std::ptrdiff_t>(drop), moves_.end());
+    commands_ = first;
+    return true;
+}
+
+double MotionOracle::distance(const Tracked& m, const Eigen::Vector3d& p, double* along) const {
+    if (along != nullptr) *along = 0;
+    if (m.barrier) return 0;
+    if (m.free) {
+        // Its path is any within the box its ends span (a dog-leg, a homing run).
+        const Eigen::Vector3d low = m.from.cwiseMin(m.to), high = m.from.cwiseMax(m.to);
+        return (p - p.cwiseMax(low).cwiseMin(high)).norm();
+    }
+    if (m.kind == CommandedMove::Kind::Feed || m.kind == CommandedMove::Kind::Rapid) {
+        const Eigen::Vector3d d = m.to - m.from;
+        const double len2 = d.squaredNorm();
+        const double t = len2 > 0 ? std::clamp((p - m.from).dot(d) / len2, 0.0, 1.0) : 0.0;
+        if (along != nullptr) *along = t * m.length;
+        return (p - (m.from + t * d)).norm();
+    }
+    const Eigen::Vector2d v = p.head<2>() - m.centre;
+    const double angle = std::atan2(v.y(), v.x());
+    const double sweep = std::abs(m.sweep_rad);
+    const double turned = m.sweep_rad > 0 ? wrap_2pi(angle - m.start_rad) : wrap_2pi(m.start_rad - angle);
+    if (turned <= sweep) {
+        const double fraction = turned / sweep;
+        const double z = m.from.z() + fraction * (m.to.z() - m.from.z());
+        if (along != nullptr) *along = fraction * m.length;
+        return std::hypot(v.norm() - m.radius, p.z() - z);
+    }
+    const double to_start = (p - m.from).norm();
+    const double to_end = (p - m.to).norm();
+    if (along != nullptr && to_end < to_start) *along = m.length;
+    return std::min(to_start, to_end);
+}
+
+bool MotionOracle::ends_within(const Tracked& m, const Eigen::Vector3d& p, const Eigen::Vector3d& target) const {
+    return ((p - target).cwiseAbs().array() <= m.end_tolerance.array()).all();
+}
+
+void MotionOracle::observe(Tracked& m, const Eigen::Vector3d& p, Cycle now) {
+    if (m.barrier) return;
+    double along = 0;
+    double d = distance(m, p, &along);
+    // On the way from this move onto the next, a point is judged against
+    // both: the cursor moves on only once the next is clearly closer.
+    if (&m == &moves_.front() && moves_.size() >= 2) d = std::min(d, distance(moves_[1], p));
+    if (!m.free && d > m.worst) {
+        m.worst = d;
+        m.worst_at = p;
+        m.worst_cycle = now;
+        // Told at once (a fuzzer's input ends at its first finding), then
+        // again each time it grows by a micrometre.
+        if (m.worst > path_tolerance_mm_ && m.worst > m.deviation_told + 1e-3) {
+            m.deviation_told = m.worst;
+            if (!m.deviation_finding) {
+                m.deviation_finding = report(kPathDeviation, deviation_text(m));
+            } else {
+                revise_finding(*m.deviation_finding, deviation_text(m));
+            }
+        }
+    }
+    // Progress only runs on along the path: a point just behind the start of
+    // a whole circle is not its end.
+    const double jump = 2 * path_tolerance_mm_ + 0.5;
+    if (along > m.progress && along <= m.progress + jump) m.progress = along;
+    const double to_end = (p - m.to).norm();
+    if (to_end < m.closest_end) {
+        m.closest_end = to_end;
+        m.closest_at = p;
+    }
+    const double slack = path_tolerance_mm_ + m.end_tolerance.maxCoeff();
+    if (ends_within(m, p, m.to) && (m.free || m.progress >= m.length - slack)) m.end_reached = true;
+}
+
+void MotionOracle::advance(const Eigen::Vector3d& p) {
+    const Cycle now = clock().cycle();
+    while (moves_.size() >= 2 && !moves_.front().barrier) {
+        const Tracked& cur = moves_.front();
+        const double here = distance(cur, p);
+        std::size_t go = 0;
+        if (cur.end_reached && distance(moves_[1], p) <= here + path_tolerance_mm_) {
+            go = 1;
+        } else {
+            for (std::size_t j = 1; j < moves_.size() && j <= kLookahead; ++j) {
+                if (distance(moves_[j], p) + path_tolerance_mm_ < here) {
+                    go = j;
+                    break;
+                }
+            }
+        }
+        if (go == 0) return;
+        for (std::size_t i = 0; i < go; ++i) finish_front(now);
+        Tracked& next = moves_.front();
+        double along = 0;
+        distance(next, p, &along);
+        // A closed path (a whole circle) starts at its start, whatever the angle says.
+        next.progress = (next.to - next.from).norm() <= next.end_tolerance.maxCoeff() ? 0.0 : along;
+        observe(next, p, now);
+    }
+}
+
+void MotionOracle::check_tool(const Eigen::Vector3d& p, Cycle now) {
+    if (tool_ == nullptr || !tool_->tool_down() || moves_.empty()) return;
+    Tracked& cur = moves_.front();
+    if (cur.barrier || cur.drawing()) return;  // a drawing move: path-deviation judges it
+    double nearest = last_drawing_ ? distance(*last_drawing_, p) : 1e300;
+    for (std::size_t j = 1; j < moves_.size() && j <= kLookahead; ++j) {
+        if (moves_[j].drawing()) {
+            nearest = std::min(nearest, distance(moves_[j], p));
+            break;
+        }
+    }
+    if (nearest <= path_tolerance_mm_) return;
+    if (cur.tool_off_mm == 0) {
+        cur.tool_off_from = last_position_;
+        cur.tool_off_cycle = now;
+    }
+    cur.tool_off_mm += (p - last_position_).norm();
+    if (cur.tool_off_mm > path_tolerance_mm_ && cur.tool_off_mm > cur.tool_told + 1e-2) {
+        cur.tool_told = cur.tool_off_mm;
+        if (!cur.tool_finding) {
+            cur.tool_finding = report(kToolDownOffPath, tool_text(cur));
+        } else {
+            revise_finding(*cur.tool_finding, tool_text(cur));
+        }
+    }
+}
+
+std::string MotionOracle::deviation_text(const Tracked& m) const {
+    const bool arc = m.kind == CommandedMove::Kind::ArcClockwise || m.kind == CommandedMove::Kind::ArcCounterClockwise;
+    char at[48];
+    std::snprintf(at, sizeof at, "%.6f s", static_cast<double>(m.worst_cycle) / clock().frequency_hz());
+    return m.line + ": the tool strays " + mm_text(m.worst) + " mm from the commanded " + (arc ? "arc" : "line") +
+           " (tolerance " + mm_text(path_tolerance_mm_) + " mm), at " + firmware_text(m, m.worst_at) + " at " + at;
+}
+
+std::string MotionOracle::tool_text(const Tracked& m) const {
+    char at[48];
+    std::snprintf(at, sizeof at, "%.6f s", static_cast<double>(m.tool_off_cycle) / clock().frequency_hz());
+    return m.line + ": the pen was down for " + mm_text(m.tool_off_mm) + " mm of this move away from the drawing, from " +
+           firmware_text(m, m.tool_off_from) + " at " + at;
+}
+
+void MotionOracle::on_carriage() {
+    const Eigen::Vector3d p = tool_position();
+    const Cycle now = clock().cycle();
+    // A rotor settling about its step (a fraction of one) is not motion.
+    if ((p - rest_anchor_).cwiseAbs().maxCoeff() > rest_jitter_mm_) {
+        rest_anchor_ = p;
+        last_move_cycle_ = now;
+        rest_judged_ = false;
+        arm_rest_check();
+    }
+    if (!moves_.empty()) {
+        observe(moves_.front(), p, now);
+        advance(p);
+        check_tool(p, now);
+    }
+    last_position_ = p;
+}
+
+void MotionOracle::arm_rest_check() {
+    if (rest_check_armed_) return;
+    rest_check_armed_ = true;
+    clock().scheduler().at(last_move_cycle_ + rest_cycles_, [this](Cycle) { on_rest_check(); });
+}
+
+void MotionOracle::on_rest_check() {
+    rest_check_armed_ = false;
+    const Cycle now = clock().cycle();
+    if (now < last_move_cycle_ + rest_cycles_) return arm_rest_check();
+    if (rest_judged_) return;
+    rest_judged_ = true;
+    if (auto f = rest_verdict(tool_position(), now)) {
+        report(f->kind, f->detail);
+        Tracked& cur = moves_.front();  // rest_verdict found one, so there is a move
+        if (cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached) cur.rest_reported = true;
+    }
+}
+
+std::string MotionOracle::firmware_text(const Tracked& m, const Eigen::Vector3d& carriage_mm) const {
+    std::string text;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!connected(k)) continue;
+        const auto i = static_cast<Eigen::Index>(k);
+        text += (text.empty() ? "" : " ") + std::string(1, kAxisLetters[k]) + mm_text(carriage_mm[i] - m.origin[i]);
+    }
+    return text;
+}
+
+Finding MotionOracle::make_finding(FindingKind kind, Cycle cycle, std::string detail) const {
+    Finding f;
+    f.kind = kind;
+    f.source = name();
+    f.cycle = cycle;
+    f.clock_hz = clock().frequency_hz();
+    f.has_pc = false;
+    f.detail = std::move(detail);
+    return f;
+}
+
+std::optional<Finding> MotionOracle::rest_verdict(const Eigen::Vector3d& p, Cycle now) const {
+    if (moves_.empty() || moves_.front().barrier) return std::nullopt;
+    const Tracked& cur = moves_.front();
+    // On its way (or done): it should have stopped at its end; not started:
+    // at its start, the end of the move before.
+    const bool started = cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached;
+    if (started && cur.rest_reported) return std::nullopt;
+    const Eigen::Vector3d& target = started ? cur.to : cur.from;
+    if (ends_within(cur, p, target)) return std::nullopt;
+    std::string detail = cur.line + ": the machine came to rest " + mm_text((p - target).norm()) + " mm from " +
+                         (started ? "this move's end " : "this move's start, before it began, ") + firmware_text(cur, target) + ", at " +
+                         firmware_text(cur, p) + " (tolerance " +
+                         (end_tolerance_mm_ ? mm_text(*end_tolerance_mm_) + " mm" : std::string("one step")) + " per axis)";
+    return make_finding(kMoveEndMissed, now, detail);
+}
+
+std::vector<Finding> MotionOracle::verdict(const Tracked& m, Cycle now) const {
+    std::vector<Finding> out;
+    if (m.barrier || m.end_reached || m.rest_reported) return out;
+    const std::string what = m.closest_end > 1e299
+                                 ? m.line + ": the tool skipped this move (to " + firmware_text(m, m.to) + ")"
+                                 : m.line + ": the tool left this move " + mm_text(m.closest_end) + " mm from its end " +
+                                       firmware_text(m, m.to) + " (closest at " + firmware_text(m, m.closest_at) + ")";
+    out.push_back(make_finding(kMoveEndMissed, now, what));
+    return out;
+}
+
+void MotionOracle::finish_front(Cycle now) {
+    Tracked& m = moves_.front();
+    for (const Finding& f : verdict(m, now)) report(f.kind, f.detail);
+    if (m.drawing()) last_drawing_ = m;
+    ++moves_judged_;
+    moves_.pop_front();
+}
+
+std::vector<Finding> MotionOracle::pending_findings() const {
+    std::vector<Finding> out;
+    if (moves_.empty()) return out;
+    const Cycle now = clock().cycle();
+    // The run's end is a rest once nothing moved for half the bench's own
+    // settle time (Bench::run_until_idle ends 50 ms after the last STEP; a
+    // motor's rotor settles a few ms after it).
+    const Cycle settle = std::min(rest_cycles_, clock().cycles_from_seconds(0.025));
+    if (!rest_judged_ && now >= last_move_cycle_ + settle) {
+        if (auto f = rest_verdict(tool_position(), now)) out.push_back(*f);
+    }
+    return out;
+}
+
+std::string MotionOracle::summary() {
+    std::size_t found = findings().size();
+    char line[200];
+    std::snprintf(line, sizeof line, "oracle     %s: %zu moves judged, %zu findings", name().c_str(), moves_judged_, found);
+    std::string text = line;
+    if (lost_) text += "; stopped judging: " + lost_why_;
+    return text;
+}
+
+}  // namespace avrbench

@@ -1,0 +1,216 @@
+// The motion oracle (parts/MotionOracle) and the G-code reading that feeds it
+// (verify/CommandedPath): what the accepted lines command, by hand, and the
+// seed systems' wrong motion reported by the run (issue 40 item 1). Each run
+// here is bounded in simulated time; ctest's limit is the wall-clock guard.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "cam/Chain.hpp"
+#include "cam/DxfReader.hpp"
+#include "cam/Records.hpp"
+#include "parts/Axis.hpp"
+#include "parts/MotionOracle.hpp"
+#include "printer3d/PrinterBench.hpp"
+#include "support/Paths.hpp"
+#include "verify/BoardRun.hpp"
+#include "verify/CommandedPath.hpp"
+
+namespace avrbench {
+namespace {
+
+// What the G-code reading tells a judge, as text.
+struct Recorded final : CommandedMoves {
+    std::vector<CommandedMove> moves;
+    std::vector<std::pair<AxisPositions, AxisPositions>> renames;
+    std::vector<std::string> lost;
+    void commanded(const CommandedMove& m) override { moves.push_back(m); }
+    void position_renamed(const AxisPositions& was, const AxisPositions& now) override { renames.push_back({was, now}); }
+    void frame_lost(const std::string& line) override { lost.push_back(line); }
+    bool retract(std::size_t n) override {
+        moves.resize(moves.size() - std::min(n, moves.size()));
+        return true;
+    }
+};
+
+void feed(CommandedPath& path, const std::vector<std::string>& lines) {
+    for (const auto& l : lines) path.accept(l, "'" + l + "'");
+}
+
+TEST(CommandedPath, AbsoluteRelativeAndInchMovesFromTheFirmwaresZero) {
+    Recorded r;
+    CommandedPath path(r);
+    feed(path, {"G21 G90", "G1 X10 Y5 F600", "G1 F1200", "G91", "G0 X-2.5 Y1", "G20 G90", "G1 X1"});
+    ASSERT_EQ(r.moves.size(), 3u);  // G1 F1200 moves nothing
+    EXPECT_EQ(r.moves[0].kind, CommandedMove::Kind::Feed);
+    EXPECT_EQ(r.moves[0].from_mm, (AxisPositions{0.0, 0.0, 0.0}));
+    EXPECT_EQ(r.moves[0].to_mm, (AxisPositions{10.0, 5.0, 0.0}));
+    EXPECT_EQ(r.moves[1].kind, CommandedMove::Kind::Rapid);
+    EXPECT_EQ(r.moves[1].to_mm, (AxisPositions{7.5, 6.0, 0.0}));  // 10 - 2.5, 5 + 1
+    EXPECT_EQ(r.moves[2].to_mm, (AxisPositions{25.4, 6.0, 0.0}));  // 1 inch
+    EXPECT_TRUE(r.lost.empty());
+}
+
+TEST(CommandedPath, ArcCentresByOffsetsAndByRadius) {
+    // From (0, 0) to (1, 1) with R 1: the centres at distance 1 from both
+    // ends are (1, 0) and (0, 1). Clockwise the short way turns about (1, 0)
+    // (180 deg to 90 deg); counter-clockwise about (0, 1); a negative R
+    // takes the long way, about the other one.
+    const auto centre = [](const std::string& arc) {
+        Recorded r;
+        CommandedPath path(r);
+        feed(path, {arc});
+        EXPECT_EQ(r.moves.size(), 1u) << arc;
+        return r.moves.empty() ? std::array<double, 2>{NAN, NAN} : r.moves[0].centre_mm;
+    };
+    const auto near = [](std::array<double, 2> c, double x, double y) { return std::abs(c[0] - x) < 1e-12 && std::abs(c[1] - y) < 1e-12; };
+    EXPECT_TRUE(near(centre("G2 X1 Y1 R1"), 1, 0));
+    EXPECT_TRUE(near(centre("G3 X1 Y1 R1"), 0, 1));
+    EXPECT_TRUE(near(centre("G2 X1 Y1 R-1"), 0, 1));
+    EXPECT_TRUE(near(centre("G2 X10 Y0 I5 J0"), 5, 0));
+    EXPECT_TRUE(near(centre("G3 X0 Y0 I-8 J0"), -8, 0));  // a whole circle, back to its start
+}
+
+TEST(CommandedPath, HomingRenamingAndLinesThatLoseTheFrame) {
+    Recorded r;
+    CommandedPath path(r);
+    feed(path, {"G1 X10 Y4", "G28 X0", "G92 Y1.5", "G1 X2"});
+    ASSERT_EQ(r.moves.size(), 3u);
+    EXPECT_EQ(r.moves[1].kind, CommandedMove::Kind::Home);
+    EXPECT_EQ(r.moves[1].homed, (std::array<bool, 3>{true, false, false}));
+    EXPECT_EQ(r.moves[1].to_mm, (AxisPositions{0.0, 4.0, 0.0}));
+    ASSERT_EQ(r.renames.size(), 1u);
+    EXPECT_EQ(r.renames[0].first, (AxisPositions{std::nullopt, 4.0, std::nullopt}));
+    EXPECT_EQ(r.renames[0].second, (AxisPositions{std::nullopt, 1.5, std::nullopt}));
+    EXPECT_EQ(r.moves[2].from_mm, (AxisPositions{0.0, 1.5, 0.0}));
+    // Lines every firmware does not read alike: nothing after them is judged.
+    for (const std::string line : {"X10", "G1 X1E3", "G54", "g1 x1", "$H", "G0 G1 X1", "G2 X1 Y1"}) {
+        Recorded lost;
+        CommandedPath p(lost);
+        feed(p, {line, "G1 X5"});
+        EXPECT_EQ(lost.lost.size(), 1u) << line;
+        EXPECT_TRUE(lost.moves.empty()) << line;
+    }
+}
+
+// Seed 002's plot job as `avrbench run --dxf` makes it (bench/tools/RunCommand.cpp).
+BoardRunOptions::RecordJob plot_job(const std::string& dxf, bool improved) {
+    Drawing drawing = read_dxf(dxf).drawing;
+    align_segments(drawing, 0.01);
+    const GcodeProgram gcode = emit_gcode(drawing, 0.01, 120);
+    RecordOptions options;
+    options.improved = improved;
+    const RecordProgram program = records_from_gcode(gcode.text, options, dxf);
+    return {dxf, improved ? "improved" : "faithful", program.messages, program.busy_seconds, gcode.text};
+}
+
+struct PlotRun {
+    std::unique_ptr<BoardRun> run;
+    std::vector<Finding> findings;
+    double y_end_mm = 0;
+};
+
+PlotRun plot_example(bool improved) {
+    BoardRunOptions o;
+    o.board = test::source_path("bench/boards/cnc2axis-seed002.yaml");
+    o.firmware = {{"uno", test::firmware(improved ? "cnc2axis_improved" : "cnc2axis")}};
+    o.duration_ps = 200'000 * kPsPerMs;  // the job takes ~106 s at 2 mm/s
+    const std::string dxf = test::source_path("examples/drawings/plotter_demo.dxf");
+    o.records = [dxf, improved] { return plot_job(dxf, improved); };
+    PlotRun p;
+    p.run = std::make_unique<BoardRun>(std::move(o));
+    p.run->run();
+    p.findings = p.run->bench().findings();
+    p.y_end_mm = p.run->bench().axis("y").position_mm();
+    return p;
+}
+
+std::vector<const Finding*> of_kind(const std::vector<Finding>& all, FindingKind kind) {
+    std::vector<const Finding*> out;
+    for (const Finding& f : all) {
+        if (f.kind == kind) out.push_back(&f);
+    }
+    return out;
+}
+
+// The number a finding's detail gives after `before` ("strays 0.759 mm").
+double number_after(const std::string& detail, const std::string& before) {
+    const auto at = detail.find(before);
+    if (at == std::string::npos) return NAN;
+    return std::stod(detail.substr(at + before.size()));
+}
+
+// The drawing (examples/drawings/plotter_demo.dxf) through the CAM: line 8
+// is the rapid "G00 X48.000 Y40.000" to the circle, line 9 the circle
+// "G02 X48.000 Y40.000 I-8.000 J0.000" (R 8 about (40, 40)).
+TEST(MotionOracle, SeedTwosFaithfulPlotIsOffAndTheImprovedOneIsNot) {
+    const PlotRun faithful = plot_example(false);
+    // The thesis' G01 counts X only and lets Y run open loop at its own
+    // OCR2A rate (digest §7.7), so Y ends off its target; the thesis'
+    // firmware lowers and lifts the pen without waiting for the servo, so
+    // the pen drags into the next rapid (docs/CNC.md).
+    const auto deviations = of_kind(faithful.findings, MotionOracle::kPathDeviation);
+    bool circle_off = false;
+    for (const Finding* f : deviations) {
+        if (f->detail.find("line 9 'G02 X48.000 Y40.000 I-8.000 J0.000") == std::string::npos) continue;
+        circle_off = true;
+        EXPECT_GT(number_after(f->detail, "strays "), 0.5) << f->detail;  // the board's path_tolerance
+    }
+    EXPECT_TRUE(circle_off) << "no path-deviation on the circle";
+    // At rest after the circle: Y where the axis part says it is, against
+    // the commanded 40 mm (the firmware's zero is the homed 0 mm).
+    bool rest_off = false;
+    for (const Finding* f : of_kind(faithful.findings, MotionOracle::kMoveEndMissed)) {
+        if (f->detail.find("line 9 ") == std::string::npos || f->detail.find("came to rest") == std::string::npos) continue;
+        rest_off = true;
+        EXPECT_NEAR(number_after(f->detail, "came to rest "), std::abs(faithful.y_end_mm - 40.0), 0.001) << f->detail;
+    }
+    EXPECT_TRUE(rest_off) << "no move-end-missed at the end";
+    EXPECT_GT(std::abs(faithful.y_end_mm - 40.0), 1.0 / 160);  // more than one microstep
+    bool dragged = false;
+    for (const Finding* f : of_kind(faithful.findings, MotionOracle::kToolDownOffPath)) {
+        dragged = dragged || f->detail.find("line 8 'G00 X48.000 Y40.000'") != std::string::npos;
+    }
+    EXPECT_TRUE(dragged) << "no tool-down-off-path on the rapid to the circle";
+
+    const PlotRun improved = plot_example(true);
+    for (const Finding& f : improved.findings) ADD_FAILURE() << f.describe();
+    // The G-code's eight moves (two rapids, four lines and an arc, the
+    // circle): all but the last one left behind, the last one at rest.
+    const auto& oracle = improved.run->bench().board().part_as<MotionOracle>("motion");
+    EXPECT_EQ(oracle.moves_judged(), 7u);
+    EXPECT_TRUE(oracle.judging());
+    EXPECT_NEAR(improved.y_end_mm, 40.0, 1.0 / 160);
+}
+
+// Code 4.11 reads every coordinate into a 16-bit int of 1000 BLU/mm, relative
+// (digest §9.8): X40 is 40 000 BLU, -25 536 as an int16, so X runs the other
+// way. The job says G91 as a host must for a relative firmware.
+TEST(MotionOracle, TheThesisParsersSixteenBitWrapIsAFinding) {
+    auto bench = test::powered_printer("printer3d_interp_thesis_parser");
+    bench->run_for(0.2);
+    bench->host().add_lines("G91\nG01 X40 F10\n");
+    bench->run_until_idle(10.0);
+    const auto findings = bench->findings();
+    bool wrong_way = false;
+    for (const Finding* f : of_kind(findings, MotionOracle::kPathDeviation)) {
+        wrong_way = wrong_way || f->detail.find("line 2 'G01 X40 F10'") != std::string::npos;
+    }
+    EXPECT_TRUE(wrong_way) << "no path-deviation on G01 X40";
+    // The carriage went below its power-up place (the firmware's 0), away
+    // from the commanded +40 mm.
+    EXPECT_LT(bench->axis("x").position_mm(), 3.5);
+
+    // The fixed parser takes the same two lines: X ends 40 mm on, no finding.
+    auto fixed = test::powered_printer();
+    fixed->run_for(0.2);
+    fixed->host().add_lines("G91\nG1 X40 F600\nM400\n");  // M400: the job ends when the move does
+    fixed->run_until_idle(20.0);
+    EXPECT_NEAR(fixed->axis("x").position_mm(), 3.5 + 40.0, 0.01);
+    for (const Finding& f : fixed->findings()) ADD_FAILURE() << f.describe();
+}
+
+}  // namespace
+}  // namespace avrbench
