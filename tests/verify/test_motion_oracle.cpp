@@ -212,5 +212,25 @@ TEST(MotionOracle, TheThesisParsersSixteenBitWrapIsAFinding) {
     for (const Finding& f : fixed->findings()) ADD_FAILURE() << f.describe();
 }
 
+// Lines go to the oracle as they are sent; one the firmware refuses is taken
+// back. The improved interpolator answers "Error:target out of range" (and
+// its "ok") to X99999 (more than its 32-bit BLU range allows), already after
+// the host queued the next line: the line after it is read again from the
+// position before it, X10, and the job ends at X20 with nothing found.
+TEST(MotionOracle, ARefusedLineIsTakenBack) {
+    auto bench = test::powered_printer();
+    bench->run_for(0.2);
+    bench->host().add_lines("G1 X10 F300\nG1 X99999 F300\nG1 X20 F300\nM400\n");
+    bench->run_until_idle(20.0);
+    EXPECT_EQ(bench->host().errors(), 1u);
+    EXPECT_NEAR(bench->axis("x").position_mm(), 3.5 + 20.0, 0.01);
+    for (const Finding& f : bench->findings()) {
+        if (f.kind != UartHost::kHostProtocol) ADD_FAILURE() << f.describe();
+    }
+    const auto& oracle = bench->board().part_as<MotionOracle>("motion");
+    EXPECT_TRUE(oracle.judging());
+    EXPECT_EQ(oracle.moves_judged(), 1u);  // X10 left behind, X20 where it rests
+}
+
 }  // namespace
 }  // namespace avrbench
