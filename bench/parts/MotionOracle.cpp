@@ -447,10 +447,17 @@ std::optional<Finding> MotionOracle::rest_verdict(const Eigen::Vector3d& p, Cycl
 std::vector<Finding> MotionOracle::verdict(const Tracked& m, Cycle now) const {
     std::vector<Finding> out;
     if (m.barrier || m.end_reached || m.rest_reported) return out;
-    const std::string what = m.closest_end > 1e299
-                                 ? m.line + ": the tool skipped this move (to " + firmware_text(m, m.to) + ")"
-                                 : m.line + ": the tool left this move " + mm_text(m.closest_end) + " mm from its end " +
-                                       firmware_text(m, m.to) + " (closest at " + firmware_text(m, m.closest_at) + ")";
+    const double slack = path_tolerance_mm_ + m.end_tolerance.maxCoeff();
+    std::string what;
+    if (m.closest_end > 1e299) {
+        what = m.line + ": the tool skipped this move (to " + firmware_text(m, m.to) + ")";
+    } else if (ends_within(m, m.closest_at, m.to) && !m.free && m.progress < m.length - slack) {
+        // At its end only by standing at its start: a closed path not run.
+        what = m.line + ": the tool left this move after " + mm_text(m.progress) + " of its " + mm_text(m.length) + " mm";
+    } else {
+        what = m.line + ": the tool left this move " + mm_text(m.closest_end) + " mm from its end " + firmware_text(m, m.to) +
+               " (closest at " + firmware_text(m, m.closest_at) + ")";
+    }
     out.push_back(make_finding(kMoveEndMissed, now, what));
     return out;
 }

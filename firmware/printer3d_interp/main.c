@@ -148,10 +148,20 @@ void queue_line(uint8_t axis_a, int32_t a, uint8_t axis_b, int32_t b, uint32_t d
     m.axis_b = axis_b;
     m.a = a;
     m.b = b;
+#ifdef THESIS_DDA
+    /* Code 4.1 as printed: L = round(sqrt(_a*_a + _b*_b)) with 16-bit ints
+     * (an int is 16 bits on the AVR): a square above 32767 wraps, so L is
+     * too short once |a| > 181 BLU and the DDA, one pulse per tick at most,
+     * runs short of |a| (digest §3). */
+    const unsigned int square = (unsigned int)(int16_t)a * (unsigned int)(int16_t)a +
+                                (unsigned int)(int16_t)b * (unsigned int)(int16_t)b;
+    m.ticks = (uint16_t)lround(sqrt((double)(int)square));
+#else
     int32_t l = (int32_t)isqrt64((uint64_t)((int64_t)a * a + (int64_t)b * b));
     if (l < labs(a)) l = labs(a); /* L >= each component: exactly |a| and |b| pulses in L ticks */
     if (l < labs(b)) l = labs(b);
     m.ticks = l;
+#endif
     m.dtc_half_us = dtc;
     m.ramp = 1;
     extruder_for(&m, deposit);
@@ -167,6 +177,13 @@ const char *queue_arc(int32_t ci, int32_t cj, int32_t x, int32_t y, uint8_t cw, 
     if (radius < 1 || fabsf(end_r - (float)radius) > 2.0f + 0.001f * (float)radius) {
         return "arc end point not on the circle";
     }
+#ifdef THESIS_DDA
+    /* Code 4.6 as printed: the arc's length from its chord AB, theta =
+     * arcsin(AB / 2R), s = 2 theta R: at most a half circle (a 270-degree
+     * arc runs 90 degrees), nothing for a whole one (AB = 0, no tick). */
+    const float chord_x = (float)(x - sx), chord_y = (float)(y - sy);
+    const float sweep = 2.0f * asinf(sqrtf(chord_x * chord_x + chord_y * chord_y) / 2.0f / (float)radius);
+#else
     /* The swept angle, from the start and end angles about the centre:
      * any angle up to a full circle (end = start), which the thesis'
      * arcsin-based length cannot give. */
@@ -174,6 +191,7 @@ const char *queue_arc(int32_t ci, int32_t cj, int32_t x, int32_t y, uint8_t cw, 
     float sweep = cw ? a0 - a1 : a1 - a0;
     while (sweep <= 1e-6f) sweep += 2.0f * (float)M_PI;
     while (sweep > 2.0f * (float)M_PI + 1e-6f) sweep -= 2.0f * (float)M_PI;
+#endif
     move_t m = {0};
     m.kind = MOVE_ARC;
     m.cw = cw;
@@ -181,6 +199,13 @@ const char *queue_arc(int32_t ci, int32_t cj, int32_t x, int32_t y, uint8_t cw, 
     m.py = -cj;
     m.radius = radius;
     m.ticks = lroundf(sweep * (float)radius);
+#ifdef THESIS_DDA
+    if (m.ticks < 1) { /* the DDA loop runs no tick */
+        plan_position[AXIS_X] = x;
+        plan_position[AXIS_Y] = y;
+        return 0;
+    }
+#endif
     if (m.ticks < 1) m.ticks = 1;
     m.end_x = x;
     m.end_y = y;

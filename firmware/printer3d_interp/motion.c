@@ -46,10 +46,24 @@ static void arm(uint32_t counts)
 static uint32_t interval_before(int32_t n)
 {
     if (!cur.ramp) return cur.dtc_half_us;
+#ifdef THESIS_DDA
+    /* Code 4.7-4.8 as printed, in 16-bit unsigned ints and microseconds:
+     * the ramp up has precedence, `total - N` wraps below N ticks (no ramp
+     * down at all), the ramps overlap below 2N, and N * dt_const wraps
+     * above 1310 us (digest §3). */
+    const unsigned int total = (unsigned int)cur.ticks, k = (unsigned int)n;
+    const unsigned int dt_const_us = (unsigned int)(cur.dtc_half_us / 2);
+    unsigned int dt_us;
+    if (k < RAMP_N) dt_us = (unsigned int)(RAMP_N * dt_const_us) / k;
+    else if (k > total - RAMP_N) dt_us = (unsigned int)(RAMP_N * dt_const_us) / (total - k + 1);
+    else dt_us = dt_const_us;
+    return 2UL * dt_us;
+#else
     int32_t k = n;
     if (cur.ticks - n + 1 < k) k = cur.ticks - n + 1;
     if (k >= RAMP_N) return cur.dtc_half_us;
     return (uint32_t)RAMP_N * cur.dtc_half_us / (uint32_t)k;
+#endif
 }
 
 /* Loads queue[tail] into cur, or stops the timer when the queue is empty. */
@@ -213,6 +227,10 @@ ISR(TIMER1_COMPA_vect)
     ++done;
     if (done < cur.ticks) {
         arm(interval_before(done + 1));
+#ifdef THESIS_DDA
+    } else if (1) { /* the thesis counts the arc's length and stops: no fix-up */
+        start_next();
+#endif
     } else if (!(cur.kind == MOVE_ARC && arc_fixup())) {
         start_next();
     }
