@@ -73,7 +73,8 @@ int cam_command(const CamArgs& args) {
     std::printf("avrbench cam: %s\n", args.dxf.c_str());
     std::printf("  entities   %zu (lines, arcs, circles); %u others skipped\n", read.drawing.segments.size(),
                 read.skipped_entities);
-    std::printf("  aligned    %u passes, tolerance %g mm\n", stats.revisions, tolerance_mm);
+    std::printf("  aligned    %u passes, tolerance %g mm%s\n", stats.revisions, tolerance_mm,
+                stats.revisions >= 100 ? " (the thesis' cap: on a closed path its case 3 fires on every pass)" : "");
     std::printf("  commands   %u -> %u (rapids %u -> %u)\n", before.commands, after.commands, before.rapids, after.rapids);
     std::printf("  g-code     %s\n", out.c_str());
     return kExitOk;

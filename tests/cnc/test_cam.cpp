@@ -59,6 +59,21 @@ TEST(Cam, AligningThreeLinesSavesTwoRapids) {
     }
 }
 
+TEST(Cam, AClosedPathRunsTheThesisLoopToItsCap) {
+    // App. A1's case 3 ("k ends where j starts: k goes first") holds for
+    // some pair of every closed path whatever its order (its first segment
+    // starts where a later one ends), so the loop's flag is set on every pass
+    // and it stops only at the thesis' cap of 100 revisions. The example
+    // drawing (a closed outline of four lines and an arc, and a circle) is
+    // two paths: two rapids whatever the passes did.
+    auto r = read_dxf(test::source_path("examples/drawings/plotter_demo.dxf"));
+    const ChainStats stats = align_segments(r.drawing, 0.01);
+    EXPECT_EQ(stats.revisions, 100u);
+    const GcodeProgram p = emit_gcode(r.drawing, 0.01, 120);
+    EXPECT_EQ(p.rapids, 2u);
+    EXPECT_EQ(p.pen_cycles, 2u);
+}
+
 TEST(Cam, ToleranceJoinsEndpointsThatExactEqualityWouldNot) {
     // One endpoint 0.004 mm off: with the thesis' exact comparison the path
     // breaks there (an extra pen lift); within 0.01 mm it is one path.
