@@ -202,6 +202,28 @@ TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
     EXPECT_EQ(inside.err.find("FINDING"), std::string::npos) << inside.err;
 }
 
+// The board's motion oracle is one of the fuzz target's oracles: seed 001's
+// DDA as printed (16-bit L: G1 X3 = 300 BLU gets L = 156, 1.56 mm) stops
+// the line short, which only the oracle sees; the fixed DDA runs it clean.
+TEST(Fuzz, TheMotionOracleJudgesEachInput) {
+    const auto dir = test::scratch_dir("fuzz-motion");
+    const std::string drive = test::firmware("printer3d_drive");
+    const auto env = [&](const std::string& interp) {
+        return "env AVRBENCH_FUZZ_BOARD=printer3d-seed001 AVRBENCH_FUZZ_ELF=" + test::firmware(interp) +
+               " 'AVRBENCH_FUZZ_FIRMWARE=drive_x=" + drive + ";drive_y=" + drive + ";drive_z=" + drive + ";drive_e=" + drive +
+               ";heater=" + test::firmware("printer3d_heater") + "' " +
+               (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
+    };
+    std::ofstream(dir / "long_line") << "G1 X3 F600\nM400\n";
+    const auto literal = test::run_command(env("printer3d_interp_thesis_dda") + (dir / "long_line").string(), dir, 60);
+    EXPECT_NE(literal.exit_code, 0) << literal.err;
+    EXPECT_NE(literal.err.find("motion: move-end-missed"), std::string::npos) << literal.err;
+    EXPECT_NE(literal.err.find("line 1 'G1 X3 F600'"), std::string::npos) << literal.err;
+    const auto fixed = test::run_command(env("printer3d_interp") + (dir / "long_line").string(), dir, 60);
+    EXPECT_EQ(fixed.exit_code, 0) << fixed.err;
+    EXPECT_EQ(fixed.err.find("FINDING"), std::string::npos) << fixed.err;
+}
+
 // The hang oracle of `--hang` (AVRBENCH_FUZZ_HANG=1): a line still
 // unanswered when the input's bound ends. A 10 s dwell (G4 P10000) against a
 // 2 s bound: the improved interpolator sends `echo:busy` every second, under
