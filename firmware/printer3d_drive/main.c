@@ -88,11 +88,18 @@ ISR(INT0_vect)
 #define KD 500
 #define REFERENCE_TEMP 190
 #define TEMP_ACCEPTABLE_ERR 5
-static int16_t errorSum;
-static int16_t previousError;
+int16_t errorSum; /* not static: the bench's tests read them by their symbols */
+int16_t previousError;
 volatile uint16_t temperature_samples;
 
+#ifdef THESIS_ADCH_UNSIGNED
+/* §9.4 fixed as well: the counts 0..255 as they are, so §9.5 (raw counts
+ * of an NTC in the lower leg: the error grows as the hot end heats) and
+ * §9.6 (an unbounded int16_t errorSum) show on their own. */
+static void temperature_sample(int16_t currentMeasurement)
+#else
 static void temperature_sample(int8_t currentMeasurement)
+#endif
 {
     const int16_t error = (int16_t)(REFERENCE_TEMP - currentMeasurement);
     int32_t temp = (int32_t)error * KP;
@@ -110,7 +117,11 @@ static void temperature_sample(int8_t currentMeasurement)
 ISR(ADC_vect)
 {
 #ifdef THESIS_LITERAL
+#ifdef THESIS_ADCH_UNSIGNED
+    const int16_t sample = ADCH;
+#else
     const int8_t sample = (int8_t)ADCH;
+#endif
     if (channel == SENSE_TEMPERATURE) {
         temperature_sample(sample);
         channel = 0;

@@ -197,5 +197,62 @@ TEST(Printer3dDrive, TheListingsTempOkOnAColdHotEndIsReportedByTheRun) {
     EXPECT_TRUE(hot_end_findings("printer3d_heater", ThermalPlant::kReadyWhileCold).empty());
 }
 
+// printer3d_drive_thesis_counts: the listing with §9.1-9.4 fixed (the
+// conversions run, ADCH read as 0..255), so the PID's own defects show.
+// Cold, the NTC in the lower leg reads 5 V x 100 k / (100 k + 891.7) = 4.956 V
+// = 253 of 256 counts: error = 190 - 253 = -63 on every sample, the output
+// negative, the heater at its 1/256 minimum - until errorSum (§9.6: an
+// int16_t with no bound) passes -32 768: -63 x 521 = -32 823 wraps to
+// +32 713, and 200 x -63 + 32 713 = 20 113 is full heat (OCR2 = 255).
+TEST(Printer3dDrive, TheCountsPidsErrorSumWrapsAndHeatsAColdHotEnd) {
+    Board board(load_board_file(test::source_path("bench/boards/printer3d-drive-hotend-seed001.yaml")),
+                {{"drive", test::firmware("printer3d_drive_thesis_counts")}});
+    Mcu& drive = board.mcu("drive");
+    const auto error_sum = [&] { return static_cast<std::int16_t>(drive.read_ram_u16("errorSum")); };
+    double t = 0;
+    while (error_sum() <= 0 && t < 1.0) board.run_until_seconds(t += 0.0005);
+    const unsigned samples = drive.read_ram_u16("temperature_samples");
+    EXPECT_EQ(samples, 521u);
+    EXPECT_EQ(error_sum(), static_cast<std::int16_t>(-63 * 521 + 65536));
+    constexpr std::uint32_t kOcr2 = 0x23 + 0x20;  // ATmega32: OCR2 at I/O 0x23
+    EXPECT_EQ(drive.peek(kOcr2), 255u);
+}
+
+// §9.5: error = 190 - counts, and the counts fall as the NTC heats (lower
+// leg), so above the temperature that reads 190 counts (about 134.5 degC)
+// the error is positive and grows with every degree: the hotter, the more
+// heat. From 150 degC the firmware's own last error rises with the block's
+// temperature, and the hot end runs to its maximum (lowered to 200 degC
+// here, so the run is short).
+TEST(Printer3dDrive, TheCountsPidHeatsHarderTheHotterItGets) {
+    BoardSpec spec = load_board_file(test::source_path("bench/boards/printer3d-drive-hotend-seed001.yaml"));
+    for (auto& part : spec.parts) {
+        if (part.name != "hotend") continue;
+        part.params.push_back({"initial", "150degC", part.location});
+        part.params.push_back({"max_temperature", "200degC", part.location});
+    }
+    Board board(std::move(spec), {{"drive", test::firmware("printer3d_drive_thesis_counts")}});
+    Mcu& drive = board.mcu("drive");
+    auto& plant = board.part_as<ThermalPlant>("hotend");
+    const auto error = [&] { return static_cast<std::int16_t>(drive.read_ram_u16("previousError")); };
+    std::vector<std::pair<double, int>> sensor_and_error;  // every 10 s
+    for (double t = 10; t <= 120 && board.findings().empty(); t += 10) {
+        board.run_until_seconds(t);
+        sensor_and_error.push_back({plant.sensor_degC(), error()});
+    }
+    ASSERT_GE(sensor_and_error.size(), 3u);
+    for (std::size_t i = 1; i < sensor_and_error.size(); ++i) {
+        EXPECT_GT(sensor_and_error[i].first, sensor_and_error[i - 1].first) << "sample " << i;
+        EXPECT_GE(sensor_and_error[i].second, sensor_and_error[i - 1].second) << "sample " << i;
+        EXPECT_GT(sensor_and_error[i].second, 0) << "sample " << i;
+    }
+    std::vector<Finding> overheat;
+    for (const Finding& f : board.findings()) {
+        if (f.kind == ThermalPlant::kOverheat) overheat.push_back(f);
+    }
+    ASSERT_EQ(overheat.size(), 1u);
+    EXPECT_NE(overheat[0].detail.find("above the plant's maximum of 200.0 degC"), std::string::npos) << overheat[0].detail;
+}
+
 }  // namespace
 }  // namespace avrbench
