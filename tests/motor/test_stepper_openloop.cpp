@@ -7,6 +7,10 @@
 // (../shared/seeds/digests/seed_003_stepper.md §7).
 #include <gtest/gtest.h>
 
+#include <sstream>
+
+#include <map>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -240,5 +244,57 @@ TEST(Sketch08, MinusFiftyIsAThousandStepsBackwardAtFiftyRpmThenARelease) {
     EXPECT_EQ(run.bytes().back() & 0xE1u, 0u);  // port 2's coil bits (0x20, 0x01, 0x80, 0x40) off
 }
 
+// §3.4's profile monitor (firmware/motor/profile_monitor): the quoted
+// AccelStepper recurrence from 30 steps/s, 3000 steps/s^2, 650 steps/s top,
+// 400 steps, printed as "n t_ms speed", against the thesis' "Arduino"
+// column (digest table 4.3), then run on stepper 2.
+TEST(ProfileMonitor, ReproducesSectionThreeFourAndRunsItInWholeMilliseconds) {
+    OpenLoopRun run("profile_monitor");
+    run.run_until_done(1, 5.0);
+    std::map<int, std::pair<double, double>> printed;  // n -> (t ms, speed steps/s)
+    std::istringstream lines(run.output());
+    int n = 0;
+    double t = 0, speed = 0;
+    while (lines >> n >> t >> speed) printed[n] = {t, speed};
+    ASSERT_EQ(printed.size(), 70u);
+    // The thesis' rows 1, 20 and 40 (t as printed, two decimals), row 10's
+    // "50" (50.55 printed); its speed column is the speed after the row's
+    // step, the next step's: 153 after step 1 (30 + 3000/30 = 130, then
+    // 130 + 3000/130 = 153.08).
+    EXPECT_DOUBLE_EQ(printed[1].first, 7.69);  // 1000 / 130
+    EXPECT_NEAR(printed[10].first, 50, 1);
+    EXPECT_DOUBLE_EQ(printed[20].first, 81.48);
+    EXPECT_NEAR(printed[40].first, 127, 0.015);  // 127.01 printed, "127" in the table
+    EXPECT_EQ(static_cast<int>(printed[2].second), 153);
+    EXPECT_EQ(static_cast<int>(printed[11].second), 281);
+    EXPECT_EQ(static_cast<int>(printed[21].second), 374);
+    EXPECT_EQ(static_cast<int>(printed[41].second), 511);
+    EXPECT_EQ(static_cast<int>(printed[54].second), 582);
+    // Rows "53" and "68" of the table give the times of steps 55 and 70
+    // (154.32 and 178.3 ms), and its "step 52 -> 53 interval" of 1.70 ms is
+    // step 55's (1000 / 587.85): two steps off in the thesis' transcription.
+    EXPECT_DOUBLE_EQ(printed[55].first, 154.32);
+    EXPECT_DOUBLE_EQ(printed[70].first, 178.30);
+    EXPECT_DOUBLE_EQ(printed[70].second, 650.0);
+    EXPECT_NEAR(printed[55].first - printed[54].first, 1.70, 0.01);
+    // The pulses: AccelStepper 1.1 keeps the interval in whole ms and steps
+    // once millis() passes the last step + it, so each step comes
+    // floor(1000 / speed) + 1 ms after the one before (a millisecond less
+    // where Arduino's millis() skips a value, every 42.7 ms): steps 2..68
+    // take 198 ms by that sum (worked over the recurrence above), not the
+    // 167.53 ms the monitor printed (175.22 - 7.69).
+    const auto intervals = run.intervals_us();
+    ASSERT_GE(intervals.size(), 399u);
+    const std::size_t first = intervals.size() - 399;  // interval before step 2
+    double steps_2_to_68_ms = 0;
+    for (std::size_t i = first; i < first + 67; ++i) steps_2_to_68_ms += intervals[i] / 1000.0;
+    EXPECT_GE(steps_2_to_68_ms, 198.0 - 5.0);
+    EXPECT_LE(steps_2_to_68_ms, 198.0 + 0.1);
+    run.motor.sync();
+    EXPECT_EQ(run.motor.lost_steps(), 0);  // at most 500 steps/s: 150 rpm, under the pull-out
+    EXPECT_EQ(run.position(), 400);
+}
+
 }  // namespace
 }  // namespace avrbench
+
