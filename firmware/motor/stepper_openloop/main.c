@@ -10,7 +10,10 @@
  *   A<n>  acceleration, steps/s^2       -> "ACCEL = <n>"
  *   D<n>  move to position n (absolute, as AccelStepper's moveTo)
  *                                        -> "DIST = <n>", then the move
- * and, beyond the thesis, M<n>: the step style 1 SINGLE (one phase on),
+ * and, beyond the thesis, B<n>: the deceleration alone, steps/s^2 (A sets
+ * both; §4.2's timed move decelerates harder than it accelerates)
+ *                                        -> "DECEL = <n>",
+ * and M<n>: the step style 1 SINGLE (one phase on),
  * 2 DOUBLE (two phases on, the default), 3 INTERLEAVE (half steps),
  * 4 MICROSTEP (16 per full step, PWM on the bridge enables) -> "STYLE = <n>".
  * A move needs S and A first ("ERROR: set S and A first"). "DONE <pos>"
@@ -44,7 +47,7 @@ static fw_avr446_t ramp;
 static volatile uint8_t moving;
 static uint8_t style = DOUBLE;
 static int8_t direction = 1;
-static uint16_t max_speed, accel; /* steps/s, steps/s^2 */
+static uint16_t max_speed, accel, decel; /* steps/s, steps/s^2 */
 
 volatile int32_t position;
 volatile uint16_t moves_done;
@@ -75,7 +78,7 @@ ISR(TIMER1_COMPA_vect)
 
 static void run_move(unsigned int steps)
 {
-    fw_avr446_plan(&ramp, steps, to_avr446(accel), to_avr446(accel), to_avr446(max_speed));
+    fw_avr446_plan(&ramp, steps, to_avr446(accel), to_avr446(decel), to_avr446(max_speed));
     moving = 1;
     OCR1A = 10;
     TCNT1 = 0;
@@ -92,7 +95,7 @@ static void delay_whole_ms(unsigned int ms)
 
 static void run_move(unsigned int steps)
 {
-    fw_avr446_plan(&ramp, steps, to_avr446(accel), to_avr446(accel), to_avr446(max_speed));
+    fw_avr446_plan(&ramp, steps, to_avr446(accel), to_avr446(decel), to_avr446(max_speed));
     while (fw_avr446_stepping(&ramp)) {
         step_once();
         const unsigned int c_ticks = ramp.step_delay;
@@ -113,7 +116,7 @@ static void put_field(const char *name, uint32_t value)
 
 static void move_to(uint16_t target)
 {
-    if (max_speed == 0 || accel == 0) {
+    if (max_speed == 0 || accel == 0 || decel == 0) {
         fw_uart_puts("ERROR: set S and A first\r\n");
         return;
     }
@@ -142,8 +145,12 @@ static void end_field(void)
             put_field("MAXSPEED", value);
             break;
         case 'A':
-            accel = value;
+            accel = decel = value;
             put_field("ACCEL", value);
+            break;
+        case 'B':
+            decel = value;
+            put_field("DECEL", value);
             break;
         case 'D':
             put_field("DIST", value);
@@ -170,7 +177,7 @@ static void on_byte(char c)
         return;
     }
     end_field();
-    field = (c == 'S' || c == 'A' || c == 'D' || c == 'M') ? c : 0;
+    field = (c == 'S' || c == 'A' || c == 'B' || c == 'D' || c == 'M') ? c : 0;
 }
 
 int main(void)
