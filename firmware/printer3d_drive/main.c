@@ -62,7 +62,7 @@ volatile uint16_t samples;
 volatile uint16_t chops;
 static uint8_t index_;
 static uint8_t channel;
-static uint8_t chopped; /* pairs switched off by their last sample */
+uint8_t chopped; /* pairs switched off by their last sample (not static: tests read it) */
 
 #ifdef THESIS_LITERAL
 ISR(INT0_vect, ISR_NOBLOCK)

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
 #include <vector>
 
 #include "boards/Board.hpp"
@@ -195,6 +197,45 @@ TEST(Printer3dDrive, TheListingsTempOkOnAColdHotEndIsReportedByTheRun) {
     EXPECT_EQ(ready[0].cycle, 1'600'000u);
     EXPECT_TRUE(hot_end_findings("printer3d_drive_thesis_triggered", ThermalPlant::kReadyWhileCold).empty());
     EXPECT_TRUE(hot_end_findings("printer3d_heater", ThermalPlant::kReadyWhileCold).empty());
+}
+
+// §9.7: the listing's INT0 routine is ISR_NOBLOCK, so the ADC routine can
+// run inside it, between its read of `chopped` and its write of PORTB: the
+// step then switches on a pair the chopper has just switched off, until
+// that pair's next sample (one in three conversions: 612 us). With the
+// conversions running and ADCH read as 0..255 (printer3d_drive_thesis_counts:
+// the chopper chops the standstill current, 12 V over the windings and the
+// 2.2 ohm sense resistor well above the limit of 100 counts), a coil pin
+// high while `chopped` holds its pair is the race, seen at the instant of
+// the PORTB write that made it. The fixed firmware's INT0 routine blocks
+// interrupts: never.
+struct ChopRace {
+    unsigned glitches = 0;
+    std::set<std::string> where;  // the PC of each glitch's PORTB write, by symbol
+};
+
+ChopRace chopped_pairs_switched_on(const std::string& firmware) {
+    DriveRun run(firmware);
+    ChopRace race;
+    for (const char* coil : {"PB0", "PB1", "PB2", "PB3"}) {
+        const unsigned bit = 1u << (coil[2] - '0');
+        run.mcu.pin(coil).on_change([&run, &race, bit](Cycle, bool level) {
+            if (!level || (run.mcu.read_ram_u8("chopped") & bit) == 0) return;
+            ++race.glitches;
+            race.where.insert(run.mcu.describe_pc(run.mcu.pc_bytes()));
+        });
+    }
+    // 3000 steps at about 500 steps/s, the gap varied by 1..7 x 13 us so the
+    // steps fall on every phase of the conversions' 204 us grid.
+    for (int i = 0; i < 3000; ++i) run.step(0.002 + 13e-6 * (1 + i % 7));
+    return race;
+}
+
+TEST(Printer3dDrive, TheListingsNonBlockingStepRoutineUndoesAChop) {
+    const ChopRace literal = chopped_pairs_switched_on("printer3d_drive_thesis_counts");
+    EXPECT_GT(literal.glitches, 0u);
+    for (const std::string& pc : literal.where) EXPECT_NE(pc.find("__vector_1"), std::string::npos) << pc;  // INT0_vect
+    EXPECT_EQ(chopped_pairs_switched_on("printer3d_drive").glitches, 0u);
 }
 
 // printer3d_drive_thesis_counts: the listing with §9.1-9.4 fixed (the
