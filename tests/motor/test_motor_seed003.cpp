@@ -124,6 +124,25 @@ TEST(MotorSeed003, StartFromRestAt196RpmLosesSteps) {
     EXPECT_TRUE(flagged);
 }
 
+// One-phase-on starts (the thesis: 100 rpm). One winding gives 1/sqrt(2) of
+// the two-phase torque, and a start from rest at a step rate w needs an
+// acceleration ~ w^2 per step angle, so the rate scales as sqrt(torque):
+// 170 rpm x 2^(-1/4) = 143 rpm is the most a one-phase start can reach from
+// the calibrated two-phase 170. The thesis' 100 starts; 145 must not.
+TEST(MotorSeed003, OnePhaseOnStartsAtTheThesisRateAndNotAboveTheTorqueBound) {
+    ShieldRun keeps("motor_start_single_100");
+    keeps.board.run_until_seconds(1.0);
+    ASSERT_EQ(keeps.uno.read_ram_u8("done"), 1);
+    EXPECT_EQ(keeps.uno.read_ram_u16("steps"), 200);
+    EXPECT_EQ(keeps.motor.lost_steps(), 0);
+    EXPECT_EQ(keeps.motor.stalls(), 0u);
+    ShieldRun loses("motor_start_single_145");
+    loses.board.run_until_seconds(1.0);
+    ASSERT_EQ(loses.uno.read_ram_u8("done"), 1);
+    EXPECT_GT(loses.motor.lost_steps(), 0);
+    EXPECT_EQ(loses.motor.lost_steps() % 4, 0);
+}
+
 TEST(MotorSeed003, Avr446RampTo200RpmLosesNoSteps) {
     // Seed 003 §4.2: 100 rad/s^2 to 200 rpm, a 400-step move; the thesis's
     // table reaches 200 rpm after 70 steps and ends the move at 0.7903 s.
