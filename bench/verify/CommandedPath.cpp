@@ -34,6 +34,9 @@ void CommandedPath::accept(std::string_view line, const std::string& quoted) {
     std::vector<double> g_words;
     const auto words = strict_gcode_words(line, &g_words);
     if (!words) return lose(quoted);
+    for (const auto& [letter, value] : *words) {
+        if (!std::isfinite(value)) return lose(quoted);  // 400 digits: strtod's infinity
+    }
     std::array<std::optional<double>, 3> axis_words;
     bool names_an_axis = false;
     for (std::size_t k = 0; k < 3; ++k) {

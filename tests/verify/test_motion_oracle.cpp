@@ -86,7 +86,8 @@ TEST(CommandedPath, HomingRenamingAndLinesThatLoseTheFrame) {
     EXPECT_EQ(r.renames[0].second, (AxisPositions{std::nullopt, 1.5, std::nullopt}));
     EXPECT_EQ(r.moves[2].from_mm, (AxisPositions{0.0, 1.5, 0.0}));
     // Lines every firmware does not read alike: nothing after them is judged.
-    for (const std::string line : {"X10", "G1 X1E3", "G54", "g1 x1", "$H", "G0 G1 X1", "G2 X1 Y1"}) {
+    for (const std::string& line : std::vector<std::string>{"X10", "G1 X1E3", "G54", "g1 x1", "$H", "G0 G1 X1",
+                                                            "G2 X1 Y1", "G1 X" + std::string(400, '9')}) {
         Recorded lost;
         CommandedPath p(lost);
         feed(p, {line, "G1 X5"});
