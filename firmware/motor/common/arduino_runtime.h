@@ -35,6 +35,16 @@ ISR(TIMER0_OVF_vect)
     timer0_overflow_count++;
 }
 
+/* millis(): timer0_millis read with interrupts off (Arduino's wiring.c) */
+static inline unsigned long __attribute__((unused)) millis(void)
+{
+    const uint8_t old_sreg = SREG;
+    cli();
+    const unsigned long m = timer0_millis;
+    SREG = old_sreg;
+    return m;
+}
+
 static inline unsigned long micros(void)
 {
     unsigned long m;

@@ -44,15 +44,6 @@ AVRBENCH_MCU_SECTION();
 volatile int32_t position;
 volatile uint16_t moves_done;
 
-static unsigned long millis(void)
-{
-    const uint8_t old_sreg = SREG;
-    cli();
-    const unsigned long m = timer0_millis;
-    SREG = old_sreg;
-    return m;
-}
-
 /* desiredSpeed(), `distance_to` steps from the target, at `speed` now. */
 static float desired_speed(float speed, long distance_to)
 {

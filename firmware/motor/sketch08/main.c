@@ -30,15 +30,6 @@ volatile uint16_t releases;
 static uint16_t revsteps = 200;
 static uint32_t usperstep, steppingcounter;
 
-static unsigned long millis(void)
-{
-    const uint8_t old_sreg = SREG;
-    cli();
-    const unsigned long m = timer0_millis;
-    SREG = old_sreg;
-    return m;
-}
-
 /* Stream::timedPeek with the default 1000 ms timeout: -1 when nothing came. */
 static int timed_peek(void)
 {
