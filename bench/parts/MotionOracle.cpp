@@ -95,6 +95,8 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
                                });
     }
     require_port<ToolContact>("tool", false, "the pen (a pen_lift's tool)", [this](ToolContact& t) { tool_ = &t; });
+    add_readout("moves_judged", [this] { return static_cast<double>(moves_judged_); });
+    add_readout("judging", [this] { return lost_ ? 0.0 : 1.0; });
 }
 
 void MotionOracle::start() {
