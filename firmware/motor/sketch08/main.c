@@ -19,6 +19,7 @@
 #define AFSTEPPER_ARDUINO_IO
 #include "afstepper.h"
 #include "arduino_runtime.h"
+#include "afstepper_timed.h"
 #include "avrbench_mcu.h"
 
 AVRBENCH_MCU_SECTION();
@@ -27,8 +28,6 @@ volatile int32_t position;
 volatile uint16_t moves_done;
 volatile uint16_t releases;
 
-static uint16_t revsteps = 200;
-static uint32_t usperstep, steppingcounter;
 
 /* Stream::timedPeek with the default 1000 ms timeout: -1 when nothing came. */
 static int timed_peek(void)
@@ -63,27 +62,6 @@ static long parse_int(void)
     return negative ? -value : value;
 }
 
-static void set_speed(uint16_t rpm)
-{
-    usperstep = 60000000 / ((uint32_t)revsteps * (uint32_t)rpm);
-    steppingcounter = 0;
-}
-
-static void step(uint16_t steps, uint8_t dir, uint8_t style)
-{
-    const uint32_t uspers = usperstep;
-    while (steps--) {
-        afstepper_onestep(dir, style);
-        position += dir == FORWARD ? 1 : -1;
-        delay(uspers / 1000);
-        steppingcounter += (uspers % 1000);
-        if (steppingcounter >= 1000) {
-            delay(1);
-            steppingcounter -= 1000;
-        }
-    }
-}
-
 int main(void)
 {
     arduino_init();
@@ -95,12 +73,12 @@ int main(void)
         if (!serial_available()) continue;
         const long spd = parse_int();
         if (spd > 0) {
-            set_speed((uint16_t)spd);
-            step(1000, FORWARD, DOUBLE);
+            afstepper_set_speed((uint16_t)spd);
+            afstepper_step(1000, FORWARD, DOUBLE, &position);
             moves_done++;
         } else if (spd < 0) {
-            set_speed((uint16_t)-spd);
-            step(1000, BACKWARD, DOUBLE);
+            afstepper_set_speed((uint16_t)-spd);
+            afstepper_step(1000, BACKWARD, DOUBLE, &position);
             moves_done++;
         } else {
             afstepper_release();

@@ -19,37 +19,13 @@
 #define AFSTEPPER_ARDUINO_IO
 #include "afstepper.h"
 #include "arduino_runtime.h"
+#include "afstepper_timed.h"
 #include "avrbench_mcu.h"
 
 AVRBENCH_MCU_SECTION();
 
 volatile int32_t position;
 volatile uint16_t moves_done;
-
-static uint16_t revsteps = 200;
-volatile uint32_t usperstep; /* AFMotor's; volatile so the /0 result stays in RAM for the tests */
-static uint32_t steppingcounter;
-
-static void __attribute__((noinline)) set_speed(uint16_t rpm) /* AFMotor.cpp, its own unit */
-{
-    usperstep = 60000000 / ((uint32_t)revsteps * (uint32_t)rpm);
-    steppingcounter = 0;
-}
-
-static void step(uint16_t steps, uint8_t dir, uint8_t style)
-{
-    const uint32_t uspers = usperstep;
-    while (steps--) {
-        afstepper_onestep(dir, style);
-        position += dir == FORWARD ? 1 : -1;
-        delay(uspers / 1000);
-        steppingcounter += (uspers % 1000);
-        if (steppingcounter >= 1000) {
-            delay(1);
-            steppingcounter -= 1000;
-        }
-    }
-}
 
 int main(void)
 {
@@ -65,10 +41,10 @@ int main(void)
             print_ulong(dir);
             println();
             if (dir == 90) {
-                set_speed(100);
-                step(2000, count == 0 ? FORWARD : BACKWARD, DOUBLE);
+                afstepper_set_speed(100);
+                afstepper_step(2000, count == 0 ? FORWARD : BACKWARD, DOUBLE, &position);
                 count = count == 0 ? 1 : 0;
-                set_speed(0);
+                afstepper_set_speed(0);
                 afstepper_release();
                 moves_done++;
             }
