@@ -283,11 +283,7 @@ void MotionOracle::observe(Tracked& m, const Eigen::Vector3d& p, Cycle now) {
         // again each time it grows by a micrometre.
         if (m.worst > path_tolerance_mm_ && m.worst > m.deviation_told + 1e-3) {
             m.deviation_told = m.worst;
-            if (!m.deviation_finding) {
-                m.deviation_finding = report(kPathDeviation, deviation_text(m));
-            } else {
-                revise_finding(*m.deviation_finding, deviation_text(m));
-            }
+            tell(m.deviation_finding, kPathDeviation, deviation_text(m));
         }
     }
     // Progress only runs on along the path: a point just behind the start of
@@ -349,27 +345,34 @@ void MotionOracle::check_tool(const Eigen::Vector3d& p, Cycle now) {
     cur.tool_off_mm += (p - last_position_).norm();
     if (cur.tool_off_mm > path_tolerance_mm_ && cur.tool_off_mm > cur.tool_told + 1e-2) {
         cur.tool_told = cur.tool_off_mm;
-        if (!cur.tool_finding) {
-            cur.tool_finding = report(kToolDownOffPath, tool_text(cur));
-        } else {
-            revise_finding(*cur.tool_finding, tool_text(cur));
-        }
+        tell(cur.tool_finding, kToolDownOffPath, tool_text(cur));
     }
+}
+
+void MotionOracle::tell(std::optional<std::size_t>& finding, FindingKind kind, std::string detail) {
+    if (finding) {
+        revise_finding(*finding, std::move(detail));
+    } else {
+        finding = report(kind, std::move(detail));
+    }
+}
+
+std::string MotionOracle::seconds_text(Cycle cycle) const {
+    char at[48];
+    std::snprintf(at, sizeof at, "%.6f s", static_cast<double>(cycle) / clock().frequency_hz());
+    return at;
 }
 
 std::string MotionOracle::deviation_text(const Tracked& m) const {
     const bool arc = m.kind == CommandedMove::Kind::ArcClockwise || m.kind == CommandedMove::Kind::ArcCounterClockwise;
-    char at[48];
-    std::snprintf(at, sizeof at, "%.6f s", static_cast<double>(m.worst_cycle) / clock().frequency_hz());
     return m.line + ": the tool strays " + mm_text(m.worst) + " mm from the commanded " + (arc ? "arc" : "line") +
-           " (tolerance " + mm_text(path_tolerance_mm_) + " mm), at " + firmware_text(m, m.worst_at) + " at " + at;
+           " (tolerance " + mm_text(path_tolerance_mm_) + " mm), at " + firmware_text(m, m.worst_at) + " at " +
+           seconds_text(m.worst_cycle);
 }
 
 std::string MotionOracle::tool_text(const Tracked& m) const {
-    char at[48];
-    std::snprintf(at, sizeof at, "%.6f s", static_cast<double>(m.tool_off_cycle) / clock().frequency_hz());
     return m.line + ": the pen was down for " + mm_text(m.tool_off_mm) + " mm of this move away from the drawing, from " +
-           firmware_text(m, m.tool_off_from) + " at " + at;
+           firmware_text(m, m.tool_off_from) + " at " + seconds_text(m.tool_off_cycle);
 }
 
 void MotionOracle::on_carriage() {

@@ -111,6 +111,9 @@ private:
     void advance(const Eigen::Vector3d& p);
     void observe(Tracked& m, const Eigen::Vector3d& p, Cycle now);
     void check_tool(const Eigen::Vector3d& p, Cycle now);
+    // Records a finding the first time, rewrites its text after.
+    void tell(std::optional<std::size_t>& finding, FindingKind kind, std::string detail);
+    std::string seconds_text(Cycle cycle) const;
     std::string deviation_text(const Tracked& m) const;
     std::string tool_text(const Tracked& m) const;
     void finish_front(Cycle now);
