@@ -32,6 +32,23 @@ Board::Board(BoardSpec spec, const std::map<std::string, std::string>& firmware)
     build_parts();
     build_nets();
     for (auto& m : mcus_) lockstep_.add(*m);
+    declare_influences();
+}
+
+// What one MCU can change that another sees: nets joining a pin or part on
+// one MCU's clock to a pin or part on another's (the TWI bus is two such
+// nets). Parts joined by ports share one clock (build_parts), so a path from
+// one MCU through parts to another always ends on such a net.
+void Board::declare_influences() {
+    for (const auto& net : nets_) {
+        for (const Terminal* from : net->terminals()) {
+            for (const Terminal* to : net->terminals()) {
+                Mcu* a = from->clock_mcu();
+                Mcu* b = to->clock_mcu();
+                if (a != nullptr && b != nullptr && a != b) lockstep_.add_influence(*a, *b, to->mcu_pin());
+            }
+        }
+    }
 }
 
 Board::~Board() = default;

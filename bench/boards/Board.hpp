@@ -100,6 +100,7 @@ private:
     void build_electrical_net(const NetDecl& decl);
     void build_analog_net(const NetDecl& decl, Part& source, std::size_t port, const std::vector<const Endpoint*>& pins);
     void build_twi_buses();
+    void declare_influences();
     Net* net_of(Mcu& mcu, const std::string& pin_name) const;
     McuPinTerminal& add_mcu_terminal(Mcu& mcu, Pin& pin, Net& net);
     Terminal& stimulus_for(const std::string& endpoint_or_label);

@@ -2,17 +2,13 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
+#include <stdexcept>
 
 namespace avrbench {
 namespace {
 
 __extension__ using u128 = unsigned __int128;  // exact products of 64-bit cycles and 32-bit clocks
-
-// a_cycle / a.f  <  b_cycle / b.f, exactly.
-bool earlier(const Mcu& a, Cycle a_cycle, const Mcu& b, Cycle b_cycle) {
-    if (a.frequency_hz() == b.frequency_hz()) return a_cycle < b_cycle;  // the usual board: no 128-bit products
-    return static_cast<u128>(a_cycle) * b.frequency_hz() < static_cast<u128>(b_cycle) * a.frequency_hz();
-}
 
 // The first cycle of `mcu` at or after `other_cycle` of `other`.
 Cycle cycle_at_time_of(const Mcu& mcu, const Mcu& other, Cycle other_cycle) {
@@ -40,10 +36,81 @@ Lockstep::~Lockstep() {
 
 void Lockstep::add(Mcu& mcu) {
     mcus_.push_back(&mcu);
+    influenced_by_.emplace_back();
+    influences_.emplace_back();
+    // Times are counted in units of 1 / lcm(clocks) seconds, so each MCU's
+    // cycle is a whole number of them.
+    std::uint64_t lcm = 1;
+    for (const Mcu* m : mcus_) lcm = std::lcm(lcm, static_cast<std::uint64_t>(m->frequency_hz()));
+    units_per_cycle_.clear();
+    for (const Mcu* m : mcus_) units_per_cycle_.push_back(lcm / m->frequency_hz());
     // One MCU needs no synchronising; with two, every MCU reports to us.
     if (mcus_.size() >= 2) {
         for (Mcu* m : mcus_) m->set_peer_sync(this);
     }
+    if (!influences_declared_) influence_everything();
+}
+
+std::size_t Lockstep::index_of(const Mcu& mcu) const {
+    for (std::size_t k = 0; k < mcus_.size(); ++k) {
+        if (mcus_[k] == &mcu) return k;
+    }
+    throw std::logic_error("lockstep: MCU '" + mcu.name() + "' was not added");
+}
+
+void Lockstep::influence_everything() {
+    for (std::size_t to = 0; to < mcus_.size(); ++to) {
+        influenced_by_[to].clear();
+        influences_[to].clear();
+        for (std::size_t from = 0; from < mcus_.size(); ++from) {
+            if (from == to) continue;
+            Influence i;
+            i.from = from;
+            i.any_change_may_wake = true;
+            influenced_by_[to].push_back(i);
+            influences_[to].push_back(from);  // symmetric
+        }
+    }
+}
+
+void Lockstep::add_influence(const Mcu& from, const Mcu& to, const Pin* through) {
+    if (&from == &to) return;
+    if (!influences_declared_) {
+        influences_declared_ = true;
+        for (auto& v : influenced_by_) v.clear();
+        for (auto& v : influences_) v.clear();
+    }
+    const std::size_t f = index_of(from), t = index_of(to);
+    Influence* edge = nullptr;
+    for (Influence& i : influenced_by_[t]) {
+        if (i.from == f) edge = &i;
+    }
+    if (edge == nullptr) {
+        influenced_by_[t].push_back(Influence{f, false, {}});
+        edge = &influenced_by_[t].back();
+        influences_[f].push_back(t);
+    }
+    if (through == nullptr || to.pin_feeds_a_peripheral(*through)) {
+        edge->any_change_may_wake = true;
+        edge->pins.clear();
+    } else if (!edge->any_change_may_wake &&
+               std::find(edge->pins.begin(), edge->pins.end(), through) == edge->pins.end()) {
+        edge->pins.push_back(through);
+    }
+}
+
+bool Lockstep::may_wake(const Influence& influence, const Mcu& influenced) const {
+    if (influence.any_change_may_wake) return true;
+    for (const Pin* p : influence.pins) {
+        if (influenced.pin_interrupt_enabled(*p)) return true;
+    }
+    return false;
+}
+
+Cycle Lockstep::cycle_of(std::size_t k, Time t) const {
+    if (t == kNever) return ~Cycle{0};
+    const Time c = (t + units_per_cycle_[k] - 1) / units_per_cycle_[k];
+    return c > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(c);
 }
 
 void Lockstep::couple(const Mcu& a, const Mcu& b) {
@@ -69,7 +136,7 @@ void Lockstep::reach(Mcu& mcu) {
     Mcu* const runner = running_;
     if (runner == nullptr || &mcu == runner) return;
     // Whatever changes now may wake `mcu` or change its outputs: every
-    // horizon is worked out again after the runner's instruction.
+    // bound is worked out again after the runner's instruction.
     runner->request_yield();
     if (mcu.halted() || mcu.in_run() || !mcu.dormant()) return;
     const Cycle target = cycle_at_time_of(mcu, *runner, runner->cycle());
@@ -81,36 +148,88 @@ void Lockstep::reach(Mcu& mcu) {
 }
 
 StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
+    const std::size_t n = mcus_.size();
     requested_stop_ = false;
-    end_cycles_.resize(mcus_.size());
-    for (std::size_t k = 0; k < mcus_.size(); ++k) end_cycles_[k] = cycle_at_ps(*mcus_[k], end_ps);
+    bool stopped = false;
+    end_cycles_.resize(n);
+    present_.resize(n);
+    earliest_action_.resize(n);
+    awake_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) end_cycles_[k] = cycle_at_ps(*mcus_[k], end_ps);
     for (;;) {
-        // The core furthest behind, and the earliest horizon of the others.
-        Mcu* behind = nullptr;
-        Cycle behind_end = 0;
-        for (std::size_t k = 0; k < mcus_.size(); ++k) {
-            Mcu* m = mcus_[k];
-            if (m->halted() || m->cycle() >= end_cycles_[k]) continue;
-            if (behind == nullptr || earlier(*m, m->cycle(), *behind, behind->cycle())) {
-                behind = m;
-                behind_end = end_cycles_[k];
+        for (std::size_t k = 0; k < n; ++k) {
+            const Mcu& m = *mcus_[k];
+            present_[k] = time_of(k, m.cycle());
+            awake_[k] = !m.halted() && !(lookahead_ && m.dormant());
+        }
+        // The MCU whose next step comes first: an awake one's present, a
+        // dormant one's next event (or the run's end).
+        std::size_t runner = n;
+        Time runner_at = kNever;
+        for (std::size_t k = 0; k < n; ++k) {
+            const Mcu& m = *mcus_[k];
+            if (m.halted() || m.cycle() >= end_cycles_[k]) continue;
+            const Time at = awake_[k] ? present_[k]
+                                      : std::min(time_of(k, m.next_event_cycle()), time_of(k, end_cycles_[k]));
+            if (runner == n || at < runner_at) {
+                runner = k;
+                runner_at = at;
             }
         }
-        if (behind == nullptr) break;
-        Cycle target = behind_end;
-        for (Mcu* m : mcus_) {
-            if (m == behind || m->halted()) continue;
-            const bool may_pass = lookahead_ && m->dormant() && !coupled(*behind, *m);
-            const Cycle horizon = may_pass ? m->next_event_cycle() : m->cycle();
-            target = std::min(target, cycle_at_time_of(*behind, *m, horizon));
+        if (runner == n) break;
+        // The earliest time each other MCU could act: its present when awake;
+        // asleep, its next cycle timer, or the earliest action of an MCU other
+        // than the runner that could wake it sooner. (When the runner wakes
+        // one, reach() makes it yield at once and the bounds are worked out
+        // again, so its own wake-ups never need to hold it back.)
+        for (std::size_t k = 0; k < n; ++k) {
+            const Mcu& m = *mcus_[k];
+            earliest_action_[k] = k == runner || m.halted() ? kNever
+                                  : awake_[k]                ? present_[k]
+                                                             : time_of(k, m.next_event_cycle());
+        }
+        if (lookahead_) {
+            for (bool changed = true; changed;) {
+                changed = false;
+                for (std::size_t k = 0; k < n; ++k) {
+                    if (k == runner || awake_[k] || mcus_[k]->halted()) continue;
+                    for (const Influence& i : influenced_by_[k]) {
+                        if (earliest_action_[i.from] < earliest_action_[k] && may_wake(i, *mcus_[k])) {
+                            earliest_action_[k] = earliest_action_[i.from];
+                            changed = true;
+                        }
+                    }
+                }
+            }
+        }
+        Mcu& behind = *mcus_[runner];
+        Time bound = kNever;
+        for (const Influence& i : influenced_by_[runner]) bound = std::min(bound, earliest_action_[i.from]);
+        for (const std::size_t x : influences_[runner]) {
+            if (awake_[x]) bound = std::min(bound, present_[x]);
+        }
+        if (!coupled_.empty()) {
+            for (std::size_t k = 0; k < n; ++k) {
+                if (k != runner && !mcus_[k]->halted() && coupled(behind, *mcus_[k])) bound = std::min(bound, present_[k]);
+            }
         }
         // At least one instruction, or two cores at the same time would never move.
-        target = std::max(target, behind->cycle() + 1);
-        running_ = behind;
-        const StopReason r = behind->run_until(target);
+        const Cycle target = std::max(std::min(end_cycles_[runner], cycle_of(runner, bound)), behind.cycle() + 1);
+        running_ = &behind;
+        const StopReason r = behind.run_until(target);
         running_ = nullptr;
-        if (r == StopReason::Requested || requested_stop_) return StopReason::Requested;
+        if ((r == StopReason::Requested || requested_stop_) && !stopped) {
+            // The run ends at the requesting instruction's time: every MCU
+            // still behind it (awake ones that did not need to wait, dormant
+            // ones left where they slept) is brought to it first, so whatever
+            // the caller does next happens at one time on the whole board.
+            stopped = true;
+            const Time stop_at = time_of(runner, behind.cycle());
+            for (std::size_t k = 0; k < n; ++k) end_cycles_[k] = std::min(end_cycles_[k], cycle_of(k, stop_at));
+        }
+        requested_stop_ = false;
     }
+    if (stopped) return StopReason::Requested;
     for (const Mcu* m : mcus_) {
         if (!m->halted()) return StopReason::ReachedTarget;
     }

@@ -1,23 +1,33 @@
 // Several MCUs on one board advanced in simulated-time order, exactly.
 //
-// The MCU furthest behind runs. It may run up to the horizon of every other
-// MCU: the time of one that is awake (so two awake cores stay within one
-// instruction of each other, as before), or the next cycle timer of one that
-// is dormant (asleep, no interrupt on its way: nothing about it changes
-// before that timer unless something outside wakes it). Everything outside
-// an MCU that can change what it sees - a net delivering a level, the TWI
-// bus - calls Mcu::before_external_change() first; the lockstep then brings
-// that MCU, if it is dormant and behind, up to the running MCU's time (an
-// exact jump: it has no event before its horizon) and makes the running MCU
-// yield after its instruction, so the horizons are worked out again. Boards
-// whose MCUs sleep between interrupts (seed 001's five) thus run each core
-// in long stretches instead of one instruction at a time.
+// The board tells the lockstep who can change what whom sees
+// (add_influence: a net joining a pin or part of one MCU's clock to a pin or
+// part of another's; the TWI bus is such a net). The MCU whose next step
+// comes first runs - an awake one at its present, a dormant one (asleep, no
+// interrupt on its way) at its next cycle timer - and may run up to the
+// earliest time at which any MCU that influences it could act: an awake
+// one's present, a dormant one's next cycle timer, or earlier when a change
+// another MCU can make would wake it (Mcu::pin_change_may_interrupt: a pin
+// with INTn/PCINTn enabled, a USART's RxD, the TWI bus...). It stops short
+// of the present of any awake MCU it influences, so a change it makes never
+// reaches an MCU that has already run past it. MCUs joined by nothing do not
+// wait for each other at all: seed 001's four drive boards, which wake
+// together for their current choppers, each run their burst alone while the
+// interpolator sleeps with no interrupt a drive can raise.
+//
+// Everything outside an MCU that can change what it sees - a net delivering
+// a level, the TWI bus - calls Mcu::before_external_change() first; the
+// lockstep then brings that MCU, if it is dormant and behind, up to the
+// running MCU's time (an exact jump: it has no event before then) and makes
+// the running MCU yield after its instruction, so the bounds are worked out
+// again. A dormant MCU is otherwise left where it is until its next event
+// comes or the run ends.
 //
 // Parts joined by ports call each other directly, so each such group of parts
 // has one clock (boards/Board.cpp); MCUs a group must share anyway (two MCUs
 // sampling one part's analog outputs) are coupled() and never run ahead of
-// each other. Clocks may differ (times compare as exact rationals
-// cycle/frequency).
+// each other. Clocks may differ (times compare as exact multiples of the
+// least common multiple of the clocks' periods).
 #pragma once
 
 #include <cstdint>
@@ -40,6 +50,12 @@ public:
     const std::vector<Mcu*>& mcus() const { return mcus_; }
     // `a` and `b` never run ahead of each other's present time.
     void couple(const Mcu& a, const Mcu& b);
+    // `from` can change what `to` sees, through `to`'s pin `through` (which
+    // wakes `to` only as Mcu::pin_change_may_interrupt says), or through a
+    // part on `to`'s clock or anything else (`through` nullptr: any change
+    // may wake it). A board that declares none has every MCU influence every
+    // other through anything (no MCU passes an awake one).
+    void add_influence(const Mcu& from, const Mcu& to, const Pin* through);
     // Off: every MCU's horizon is its present time (strict lockstep), for
     // tests that compare the two.
     void set_lookahead(bool on) { lookahead_ = on; }
@@ -67,9 +83,31 @@ public:
     std::uint64_t catch_ups() const { return catch_ups_; }
 
 private:
+    __extension__ using Time = unsigned __int128;  // cycles x (lcm of the clocks / the MCU's clock)
+    static constexpr Time kNever = ~Time{0};
+    struct Influence {
+        std::size_t from = 0;
+        bool any_change_may_wake = false;
+        std::vector<const Pin*> pins;  // pins of the influenced MCU that wake it only when enabled
+    };
+    std::size_t index_of(const Mcu& mcu) const;
     bool coupled(const Mcu& a, const Mcu& b) const;
+    bool may_wake(const Influence& influence, const Mcu& influenced) const;
+    Time time_of(std::size_t k, Cycle cycle) const {
+        return cycle == ~Cycle{0} ? kNever : static_cast<Time>(cycle) * units_per_cycle_[k];
+    }
+    Cycle cycle_of(std::size_t k, Time t) const;  // the first cycle of MCU k at or after t
+    void influence_everything();
+
     std::vector<Mcu*> mcus_;
+    std::vector<std::uint64_t> units_per_cycle_;
+    std::vector<std::vector<Influence>> influenced_by_;  // per MCU: who can change what it sees
+    std::vector<std::vector<std::size_t>> influences_;   // per MCU: whose view it can change
+    bool influences_declared_ = false;
     std::vector<Cycle> end_cycles_;  // run_until_ps's end, per MCU
+    // Per MCU, worked out for each step of run_until_ps.
+    std::vector<Time> present_, earliest_action_;
+    std::vector<char> awake_;
     std::set<std::pair<const Mcu*, const Mcu*>> coupled_;
     bool lookahead_ = true;
     Mcu* running_ = nullptr;

@@ -12,6 +12,8 @@
 #include <stdexcept>
 
 extern "C" {
+#include <avr_acomp.h>
+#include <avr_extint.h>
 #include <avr_ioport.h>
 #include <sim_avr.h>
 #include <sim_cycle_timers.h>
@@ -165,6 +167,8 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     adc_ = std::make_unique<Adc>(avr_, mcu_type_);
     twi_ = Twi::install(avr_, mcu_type_, *scheduler_, options_.name);
     if (twi_) twi_->set_sync([this] { before_external_change(); });
+    extint_ = reinterpret_cast<avr_extint_t*>(find_io_module(avr_, "extint"));
+    acomp_ = reinterpret_cast<avr_acomp_t*>(find_io_module(avr_, "ac"));
     if (options_.skip_idle_loops && !options_.reference_run_loop) skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
@@ -657,6 +661,33 @@ bool Mcu::set_periodic_output_sink(Pin& pin, PeriodicOutputSink* sink) {
 
 void Mcu::settle_periodic_outputs() {
     if (CompareOutputPins* pins = CompareOutputPins::of(avr_)) pins->stop_all_waves();
+}
+
+bool Mcu::pin_feeds_a_peripheral(const Pin& pin) const {
+    const std::string& name = pin.name();  // "PB5"
+    return !mcu_pinout_known(mcu_type_) || pin_may_feed_an_interrupt(mcu_type_, name[1], name[2] - '0');
+}
+
+bool Mcu::pin_interrupt_enabled(const Pin& pin) const {
+    // The comparator can take any ADC pin through its multiplexer (ACME):
+    // while its interrupt or its input capture trigger is on, every pin counts.
+    if (acomp_ != nullptr) {
+        if (acomp_->ac.enable.reg != 0 && avr_regbit_get(avr_, acomp_->ac.enable) != 0) return true;
+        if (acomp_->acic.reg != 0 && avr_regbit_get(avr_, acomp_->acic) != 0) return true;
+    }
+    const char port = pin.name()[1];
+    const auto bit = static_cast<std::uint8_t>(pin.name()[2] - '0');
+    if (extint_ != nullptr) {
+        for (const auto& line : extint_->eint) {
+            if (line.port_ioctl == static_cast<std::uint32_t>(AVR_IOCTL_IOPORT_GETIRQ(port)) && line.port_pin == bit &&
+                line.vector.enable.reg != 0 && avr_regbit_get(avr_, line.vector.enable) != 0) {
+                return true;
+            }
+        }
+    }
+    const avr_ioport_t* io = pin.port();
+    return io != nullptr && io->pcint.enable.reg != 0 && io->r_pcint != 0 &&
+           avr_regbit_get(avr_, io->pcint.enable) != 0 && (avr_->data[io->r_pcint] & pin.mask()) != 0;
 }
 
 Pin& Mcu::pin(std::string_view name) {

@@ -25,6 +25,8 @@
 
 struct avr_t;
 struct avr_io_t;
+struct avr_extint_t;
+struct avr_acomp_t;
 
 namespace avrbench {
 
@@ -145,6 +147,21 @@ public:
     // Asleep with no interrupt on its way: nothing changes until its next
     // cycle timer, unless something outside wakes it.
     bool dormant() const { return *state_ == kCpuSleeping && no_pending_interrupts(); }
+    // Whether a level change on `pin` can make an interrupt pending with the
+    // registers as they are now (INTn or PCINTn enabled for it, the analog
+    // comparator's interrupt or input capture on, or a peripheral input such
+    // as RxD, ICPn, Tn, SPI or TWI: McuPins' table). The lockstep lets other
+    // cores run past a dormant MCU's present when no change they can make
+    // would wake it. Conservative: true for an MCU type the table does not know.
+    bool pin_change_may_interrupt(const Pin& pin) const {
+        return pin_feeds_a_peripheral(pin) || pin_interrupt_enabled(pin);
+    }
+    // The part that does not depend on the registers: the pin is an input of
+    // a peripheral that can interrupt (or the MCU type's pins are not known).
+    bool pin_feeds_a_peripheral(const Pin& pin) const;
+    // The part that does: INTn or PCINTn enabled for the pin, or the analog
+    // comparator's interrupt or input capture trigger on.
+    bool pin_interrupt_enabled(const Pin& pin) const;
     // The first pending cycle timer (simavr's peripherals, the scheduler's
     // events), or the largest cycle when none is pending.
     Cycle next_event_cycle() const;
@@ -274,6 +291,8 @@ private:
     std::string mcu_type_;
     std::uint32_t frequency_hz_ = 0;
     avr_t* avr_ = nullptr;
+    avr_extint_t* extint_ = nullptr;  // simavr's INTn module, for pin_interrupt_enabled
+    avr_acomp_t* acomp_ = nullptr;    // simavr's analog comparator
     std::unique_ptr<SimavrFixes> fixes_;
     std::unique_ptr<Scheduler> scheduler_;
     std::unique_ptr<Adc> adc_;

@@ -59,4 +59,45 @@ std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index) {
     return it->second[static_cast<std::size_t>(index)];
 }
 
+bool pin_may_feed_an_interrupt(const std::string& mcu_type, char port, int bit) {
+    struct PortBit {
+        char port;
+        int bit;
+    };
+    using Pins = std::vector<PortBit>;
+    static const std::map<std::string, Pins> table = [] {
+        // ICP1 PB0, SS/MOSI/MISO/SCK PB2..PB5, TOSC1/2 PB6/PB7, SDA/SCL PC4/PC5,
+        // RXD PD0, XCK/T0 PD4, T1 PD5, AIN0/AIN1 PD6/PD7.
+        const Pins mega48_328 = {{'B', 0}, {'B', 2}, {'B', 3}, {'B', 4}, {'B', 5}, {'B', 6}, {'B', 7}, {'C', 4},
+                                 {'C', 5}, {'D', 0}, {'D', 4}, {'D', 5}, {'D', 6}, {'D', 7}};
+        // SS/SCK/MOSI/MISO PB0..PB3, SCL/SDA PD0/PD1, RXD1 PD2, ICP1 PD4, XCK1 PD5,
+        // T1 PD6, T0 PD7, RXD0 PE0, XCK0/AIN0 PE2, AIN1 PE3, T3 PE6, ICP3 PE7,
+        // TOSC2/TOSC1 PG3/PG4, RXD2 PH0, XCK2 PH2, T4 PH7, RXD3 PJ0, XCK3 PJ2,
+        // ICP4/ICP5/T5 PL0..PL2.
+        const Pins mega2560 = {{'B', 0}, {'B', 1}, {'B', 2}, {'B', 3}, {'D', 0}, {'D', 1}, {'D', 2}, {'D', 4},
+                               {'D', 5}, {'D', 6}, {'D', 7}, {'E', 0}, {'E', 2}, {'E', 3}, {'E', 6}, {'E', 7},
+                               {'G', 3}, {'G', 4}, {'H', 0}, {'H', 2}, {'H', 7}, {'J', 0}, {'J', 2}, {'L', 0},
+                               {'L', 1}, {'L', 2}};
+        // T0/XCK PB0, T1 PB1, AIN0 PB2, AIN1 PB3, SS/MOSI/MISO/SCK PB4..PB7,
+        // SCL/SDA PC0/PC1, TOSC1/2 PC6/PC7, RXD PD0, ICP1 PD6 (the 164..1284 add
+        // RXD1 PD2, XCK1 PD4, and on the 1284 ICP3/T3 on PB5/PB6, SPI pins anyway).
+        const Pins mega16_1284 = {{'B', 0}, {'B', 1}, {'B', 2}, {'B', 3}, {'B', 4}, {'B', 5}, {'B', 6},
+                                  {'B', 7}, {'C', 0}, {'C', 1}, {'C', 6}, {'C', 7}, {'D', 0}, {'D', 2},
+                                  {'D', 4}, {'D', 6}};
+        return std::map<std::string, Pins>{
+            {"atmega48", mega48_328},    {"atmega88", mega48_328},    {"atmega168", mega48_328},
+            {"atmega168p", mega48_328},  {"atmega328", mega48_328},   {"atmega328p", mega48_328},
+            {"atmega1280", mega2560},    {"atmega2560", mega2560},
+            {"atmega16", mega16_1284},   {"atmega32", mega16_1284},   {"atmega164", mega16_1284},
+            {"atmega324", mega16_1284},  {"atmega644", mega16_1284},  {"atmega1284", mega16_1284},
+        };
+    }();
+    auto it = table.find(mcu_type);
+    if (it == table.end()) return true;
+    for (const PortBit& p : it->second) {
+        if (p.port == port && p.bit == bit) return true;
+    }
+    return false;
+}
+
 }  // namespace avrbench

@@ -27,4 +27,14 @@ struct UsartPins {
 // std::nullopt for a USART or MCU type the table does not know.
 std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index);
 
+// True when a level change on P<port><bit> can start an interrupt through a
+// peripheral other than INTn, PCINTn and the analog comparator's multiplexer
+// (which Mcu::pin_change_may_interrupt reads from the MCU's registers): an
+// input capture pin, a timer's external clock, a USART's RxD or XCK, the SPI
+// slave's pins, TWI, the asynchronous timer's crystal, the comparator's
+// AIN0/AIN1. From the datasheets' alternate port function tables (ATmega328P
+// §14.3, ATmega2560 §13.3, ATmega32 "Alternate Port Functions", ATmega644/1284
+// §13.3). True for every pin of an MCU type the table does not know.
+bool pin_may_feed_an_interrupt(const std::string& mcu_type, char port, int bit);
+
 }  // namespace avrbench

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <sim_avr.h>
 
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -71,6 +73,91 @@ EndState run_printer(bool lookahead) {
 }
 
 TEST(LockstepLookahead, FiveMcuPrinterEndsAsInStrictLockstep) { expect_same(run_printer(false), run_printer(true)); }
+
+// A chain across four MCUs: `source` (sleep_idle) toggles PB5 every 10 ms;
+// `woken` relays it from its PCINT1 interrupt (pcint_relay_wake), `polled`
+// from a Timer0 overflow every 1.024 ms (pcint_relay_poll: no pin change
+// wakes it); `busy` (busy_poll) is joined to nothing and never sleeps. The
+// lookahead lets `polled` run past `woken` and everything run past `busy`;
+// `woken`'s bound is `source`'s next timer, and `polled`'s is `woken`'s next
+// action, which is `source`'s (a change of PB1 wakes `woken`).
+constexpr const char* kRelayChain = R"(
+board: relay-chain
+mcus:
+  source: {type: atmega328p, clock: 16MHz}
+  woken: {type: atmega328p, clock: 16MHz}
+  polled: {type: atmega328p, clock: 16MHz}
+  busy: {type: atmega328p, clock: 16MHz}
+nets:
+  first: [source.PB5, woken.PB1]
+  second: [woken.PC0, polled.PB1]
+labels:
+  relayed: polled.PC0
+)";
+
+std::unique_ptr<Bench> relay_chain(bool lookahead) {
+    auto bench = std::make_unique<Bench>(parse_board_text(kRelayChain, "relay-chain.yaml"),
+                                         std::map<std::string, std::string>{
+                                             {"source", test::firmware("sleep_idle")},
+                                             {"woken", test::firmware("pcint_relay_wake")},
+                                             {"polled", test::firmware("pcint_relay_poll")},
+                                             {"busy", test::firmware("busy_poll")}});
+    bench->board().lockstep().set_lookahead(lookahead);
+    bench->trace_board();
+    bench->run_for(0.105);  // ten toggles of the source, one every 10 ms
+    return bench;
+}
+
+TEST(LockstepLookahead, RelayChainEndsAsInStrictLockstep) {
+    auto strict = relay_chain(false);
+    auto fast = relay_chain(true);
+    expect_same(end_state(*strict), end_state(*fast));
+}
+
+// What the chain does, timed by the datasheet, not by the other run.
+TEST(LockstepLookahead, RelayChainFollowsTheSourceAtEachLinksLatency) {
+    auto bench = relay_chain(true);
+    Board& board = bench->board();
+    std::vector<double> source_s, woken_s, polled_s;
+    const Timeline& timeline = bench->timeline();
+    const auto edges_of = [&](const std::string& scope, const std::string& name, std::vector<double>& out) {
+        for (const auto& e : timeline.events()) {
+            const auto& signal = timeline.signals()[e.signal];
+            if (signal.scope == scope && signal.name == name && e.cycle != 0) {
+                out.push_back(static_cast<double>(e.cycle) / signal.clock_hz);
+            }
+        }
+    };
+    edges_of("source", "PB5", source_s);
+    edges_of("woken", "PC0", woken_s);
+    edges_of("polled", "PC0", polled_s);
+    ASSERT_EQ(source_s.size(), 10u) << "sleep_idle toggles PB5 every 10 ms";
+    ASSERT_EQ(woken_s.size(), source_s.size());
+    ASSERT_EQ(polled_s.size(), source_s.size());
+    for (std::size_t i = 0; i < source_s.size(); ++i) {
+        // Waking from IDLE (4 cycles, §10.1), the interrupt's entry (4) and
+        // jump, the ISR's prologue and the copy: well under 64 cycles.
+        EXPECT_GT(woken_s[i], source_s[i]);
+        EXPECT_LT(woken_s[i] - source_s[i], 64 / 16e6) << "edge " << i;
+        // The poll: the next Timer0 overflow, at most 16384 cycles later, plus the same.
+        EXPECT_GT(polled_s[i], woken_s[i]);
+        EXPECT_LT(polled_s[i] - woken_s[i], (16384 + 64) / 16e6) << "edge " << i;
+    }
+    EXPECT_EQ(board.mcu("polled").read_ram_u16("copies"), 102u);  // 0.105 s * 16 MHz / 16384, rounded down
+}
+
+// Which pins can wake a sleeping MCU, from its registers (Mcu::pin_change_may_interrupt).
+TEST(LockstepLookahead, APinWakesOnlyWithItsInterruptOrPeripheral) {
+    auto bench = relay_chain(true);
+    Mcu& woken = bench->board().mcu("woken");
+    Mcu& polled = bench->board().mcu("polled");
+    EXPECT_TRUE(woken.pin_change_may_interrupt(woken.pin("PB1")));    // PCMSK0.PCINT1 with PCICR.PCIE0
+    EXPECT_FALSE(polled.pin_change_may_interrupt(polled.pin("PB1")));  // PCINT off
+    EXPECT_FALSE(woken.pin_change_may_interrupt(woken.pin("PC1")));   // a plain pin
+    EXPECT_TRUE(woken.pin_change_may_interrupt(woken.pin("PB0")));    // ICP1 (328P §14.3.1)
+    EXPECT_TRUE(woken.pin_change_may_interrupt(woken.pin("PD0")));    // RXD
+    EXPECT_TRUE(woken.pin_change_may_interrupt(woken.pin("PC4")));    // SDA
+}
 
 }  // namespace
 }  // namespace avrbench
