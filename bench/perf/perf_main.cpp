@@ -269,6 +269,7 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
 void run_motor_overhead(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 void run_printer_lockstep(const std::string& firmware_dir, const std::string& source_dir, int repeats);
+void run_printer_part_once(const std::string& firmware_dir, const std::string& source_dir);
 void run_fast_forward(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 
 // The workloads of the side-by-side table: bare simavr and the bench on the same ELF.
@@ -408,12 +409,18 @@ int perf_main(int argc, char** argv) {
     bool only_fast_forward = false;
     app.add_flag("--fast-forward", only_fast_forward, "only idle fast-forward on boards (plain vs skipping, same end, same timeline)");
     bool only_printer = false;
-    app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lockstep with lookahead, strict, one MCU)");
+    app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lookahead, strict, one MCU, the CLI)");
+    bool printer_part_once = false;
+    app.add_flag("--printer-part-once", printer_part_once, "the printer's part job once, lookahead (for callgrind)");
     std::vector<double> rss_seconds;
     app.add_option("--rss", rss_seconds, "peak RSS of the CLI streaming a 1 M events/s VCD for these simulated seconds");
     CLI11_PARSE(app, argc, argv);
     if (only_fast_forward) {
         run_fast_forward(firmware_dir, AVRBENCH_SOURCE_DIR, repeats, scale);
+        return 0;
+    }
+    if (printer_part_once) {
+        run_printer_part_once(firmware_dir, AVRBENCH_SOURCE_DIR);
         return 0;
     }
     if (only_printer) {

@@ -109,24 +109,38 @@ public:
     long find(const std::string& scope, const std::string& name) const;
 
     // Streaming (VcdStream): hands over the events recorded since the last
-    // take and forgets them. events() then holds only what came after.
+    // take and forgets them - all but those of the signals keep_when_taken()
+    // names, which events() goes on holding (before the newer ones) for a
+    // reader at the end such as the HTML report. events() then holds only
+    // those and what came after.
     std::vector<TimelineEvent> take_events() {
-        taken_ += events_.size();
         std::vector<TimelineEvent> out;
-        out.swap(events_);
-        events_.reserve(out.size());
+        take_events_into(out);
         return out;
     }
-    // The same into `out` (its contents dropped), giving the timeline `out`'s
-    // storage to record into: a streaming consumer that keeps one buffer
-    // allocates nothing per take.
+    // The same into `out` (its contents dropped); without kept signals the
+    // timeline records into `out`'s storage afterwards, so a streaming
+    // consumer that keeps one buffer allocates nothing per take.
     void take_events_into(std::vector<TimelineEvent>& out) {
-        taken_ += events_.size();
-        out.clear();
-        out.swap(events_);
+        taken_ += events_.size() - kept_;
+        if (keep_.empty()) {
+            out.clear();
+            out.swap(events_);
+            return;
+        }
+        out.assign(events_.begin() + static_cast<std::ptrdiff_t>(kept_), events_.end());
+        std::size_t kept = kept_;
+        for (std::size_t i = kept_; i < events_.size(); ++i) {
+            if (events_[i].signal < keep_.size() && keep_[events_[i].signal]) events_[kept++] = events_[i];
+        }
+        events_.resize(kept);
+        kept_ = kept;
     }
+    // Signals whose events a take leaves in events() (by SignalId; ids past
+    // the end are not kept). Set before the first take.
+    void keep_when_taken(std::vector<bool> keep) { keep_ = std::move(keep); }
     // Every event recorded, taken or not.
-    std::uint64_t recorded_count() const { return taken_ + events_.size(); }
+    std::uint64_t recorded_count() const { return taken_ + events_.size() - kept_; }
 
     // Avoids reallocation on the hot path when the caller knows the run's size.
     void reserve_events(std::size_t count) { events_.reserve(count); }
@@ -136,6 +150,8 @@ private:
     std::vector<TimelineEvent> events_;
     std::vector<SignalAlias> aliases_;
     std::uint64_t taken_ = 0;
+    std::vector<bool> keep_;  // keep_when_taken
+    std::size_t kept_ = 0;    // events_[0, kept_) were taken and kept
     std::uint64_t dropped_ = 0;
     std::size_t max_held_ = kMaxHeldEvents;
     std::map<std::pair<std::string, std::string>, SignalId> index_;  // (scope, name) -> id

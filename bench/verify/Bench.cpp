@@ -407,6 +407,20 @@ RunReport Bench::make_report(const std::string& title) const {
     return r;
 }
 
+std::vector<bool> Bench::report_signal_mask() const {
+    std::vector<bool> keep(timeline_.signals().size(), false);
+    const auto mark = [&keep](long id) {
+        if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = true;
+    };
+    for (Part* p : board_->parts()) {
+        for (const PartSignalInfo& info : p->signals()) {
+            if (!info.role.empty()) mark(timeline_.find(p->name(), info.name));
+        }
+    }
+    for (Mcu* m : board_->mcus()) mark(timeline_.find(m->name(), "twi"));
+    return keep;
+}
+
 // The MCUs, the board, the simulated time and each MCU's I2C traffic.
 void Bench::report_facts(RunReport& r) const {
     for (Mcu* m : board_->mcus()) {

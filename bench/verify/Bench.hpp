@@ -125,6 +125,11 @@ public:
 
     // What the HTML report needs about this run (the timeline must be traced).
     RunReport make_report(const std::string& title) const;
+    // The signals whose events make_report reads (by SignalId): the parts'
+    // signals that declare a role (positions, temperatures, heater duty,
+    // servo angles) and each MCU's TWI bytes. A streamed run keeps only
+    // these in memory (Timeline::keep_when_taken) and still reports the same.
+    std::vector<bool> report_signal_mask() const;
 
 private:
     // make_report's parts.

@@ -272,9 +272,18 @@ IdleResult BoardRun::run() {
     Bench& bench = *bench_;
     std::vector<std::string> mcu_scopes;
     for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
-    WaveformFiles waveforms(bench.timeline(), options_.vcd, options_.report.empty(), options_.vcd_layout, mcu_scopes);
+    // The VCD is streamed; a report keeps in memory only the signals it reads.
+    WaveformFiles waveforms(bench.timeline(), options_.vcd, true, options_.vcd_layout, mcu_scopes);
     waveforms.start();
-    drain_ = [&waveforms](Picoseconds now_ps) { waveforms.drain(now_ps); };
+    std::vector<TimelineEvent> discarded;
+    if (!options_.report.empty()) bench.timeline().keep_when_taken(bench.report_signal_mask());
+    if (!options_.vcd.empty()) {
+        drain_ = [&waveforms](Picoseconds now_ps) { waveforms.drain(now_ps); };
+    } else if (!options_.report.empty()) {
+        drain_ = [&bench, &discarded](Picoseconds) { bench.timeline().take_events_into(discarded); };
+    } else {
+        drain_ = [](Picoseconds) {};
+    }
     const auto wall_start = std::chrono::steady_clock::now();
     Bench::RunSlices how;
     how.until_idle = host_ != nullptr;

@@ -13,6 +13,7 @@
 #include "report/HtmlReportTestSupport.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/TraceTestSupport.hpp"
+#include "printer3d/PrinterBench.hpp"
 
 namespace avrbench {
 namespace {
@@ -595,6 +596,38 @@ TEST(HtmlReport, ATimingProfileIsATablePerMcuAndNoProfileNoSection) {
                         "<td>28</td><td>28</td><td>5</td><td>5</td><td>5</td><td>5</td><td>1</td></tr>"),
               std::string::npos);
     EXPECT_NE(html.find("<li>cpu 0.83% executing</li>"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// `run --report` streams the VCD and keeps in memory only the signals the
+// report reads (Bench::report_signal_mask, Timeline::keep_when_taken). The
+// printer homes X, moves, heats and idles: positions, temperatures, heater
+// duty and TWI bytes all in play. A run that keeps everything and one that
+// hands its events away every 10 ms keeping only the report's signals give
+// the same report, byte for byte.
+std::string printer_report(bool keep_only_the_reports_signals) {
+    auto bench = test::printer_bench();
+    bench->trace_board();
+    if (keep_only_the_reports_signals) bench->timeline().keep_when_taken(bench->report_signal_mask());
+    bench->host().add_lines("G28 X\nG1 X2 Y1 F600\nM104 S60\nM105\n");
+    std::vector<TimelineEvent> handed_away;
+    for (int slice = 0; slice < 150; ++slice) {  // 1.5 s
+        bench->board().run_until_ps(static_cast<Picoseconds>(slice + 1) * 10 * kPsPerMs);
+        if (keep_only_the_reports_signals) bench->timeline().take_events_into(handed_away);
+    }
+    return format_html_report(bench->make_report("printer"));
+}
+
+TEST(HtmlReport, AStreamedRunThatKeepsOnlyTheReportsSignalsReportsTheSame) {
+    const std::string whole = printer_report(false), kept = printer_report(true);
+    EXPECT_NE(whole.find("id=\"toolpath\""), std::string::npos);
+    EXPECT_NE(whole.find("id=\"temperatures\""), std::string::npos);
+    EXPECT_TRUE(whole == kept) << whole.size() << " bytes against " << kept.size();
 }
 
 }  // namespace

@@ -79,3 +79,36 @@ TEST(TimelineLimit, EventsBeyondTheHeldLimitAreDroppedAndCounted) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// keep_when_taken: a take hands over every new event; the kept signals' stay
+// readable in events(), ahead of what is recorded after, and are not handed
+// over again.
+TEST(TimelineKeep, ATakeHandsOverEverythingAndLeavesTheKeptSignals) {
+    Timeline t;
+    const SignalId step = t.add_signal({"m", "PB0", SignalKind::Wire, 1, 16000000});
+    const SignalId pos = t.add_signal({"x", "position_mm", SignalKind::Real, 1, 16000000});
+    t.keep_when_taken({false, true});
+    t.record(step, 1, 1);
+    t.record_real(pos, 2, 0.5);
+    t.record(step, 3, 0);
+    std::vector<TimelineEvent> out;
+    t.take_events_into(out);
+    ASSERT_EQ(out.size(), 3u);
+    EXPECT_EQ(out[1].signal, pos);
+    ASSERT_EQ(t.events().size(), 1u);
+    EXPECT_EQ(t.events()[0].cycle, 2u);
+    t.record(step, 4, 1);
+    t.record_real(pos, 5, 0.6);
+    t.take_events_into(out);
+    ASSERT_EQ(out.size(), 2u);  // the kept event of cycle 2 is not handed over twice
+    EXPECT_EQ(out[0].cycle, 4u);
+    ASSERT_EQ(t.events().size(), 2u);
+    EXPECT_EQ(t.events()[1].cycle, 5u);
+    EXPECT_EQ(t.recorded_count(), 5u);
+}
+
+}  // namespace
+}  // namespace avrbench
