@@ -109,6 +109,7 @@ bool Lockstep::may_wake(const Influence& influence, const Mcu& influenced) const
 
 Cycle Lockstep::cycle_of(std::size_t k, Time t) const {
     if (t == kNever) return ~Cycle{0};
+    if (units_per_cycle_[k] == 1) return t > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(t);  // equal clocks: no division
     const Time c = (t + units_per_cycle_[k] - 1) / units_per_cycle_[k];
     return c > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(c);
 }
@@ -154,23 +155,24 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
     end_cycles_.resize(n);
     present_.resize(n);
     earliest_action_.resize(n);
+    next_.resize(n);
     awake_.resize(n);
+    halted_.resize(n);
     for (std::size_t k = 0; k < n; ++k) end_cycles_[k] = cycle_at_ps(*mcus_[k], end_ps);
     for (;;) {
-        for (std::size_t k = 0; k < n; ++k) {
-            const Mcu& m = *mcus_[k];
-            present_[k] = time_of(k, m.cycle());
-            awake_[k] = !m.halted() && !(lookahead_ && m.dormant());
-        }
-        // The MCU whose next step comes first: an awake one's present, a
-        // dormant one's next event (or the run's end).
+        // One look at each MCU per turn: present, next cycle timer, state.
         std::size_t runner = n;
         Time runner_at = kNever;
         for (std::size_t k = 0; k < n; ++k) {
             const Mcu& m = *mcus_[k];
-            if (m.halted() || m.cycle() >= end_cycles_[k]) continue;
-            const Time at = awake_[k] ? present_[k]
-                                      : std::min(time_of(k, m.next_event_cycle()), time_of(k, end_cycles_[k]));
+            halted_[k] = m.halted();
+            present_[k] = time_of(k, m.cycle());
+            awake_[k] = !halted_[k] && !(lookahead_ && m.dormant());
+            next_[k] = awake_[k] || halted_[k] ? kNever : time_of(k, m.next_event_cycle());
+            // The MCU whose next step comes first: an awake one's present, a
+            // dormant one's next event (or the run's end).
+            if (halted_[k] || m.cycle() >= end_cycles_[k]) continue;
+            const Time at = awake_[k] ? present_[k] : std::min(next_[k], time_of(k, end_cycles_[k]));
             if (runner == n || at < runner_at) {
                 runner = k;
                 runner_at = at;
@@ -183,16 +185,13 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
         // one, reach() makes it yield at once and the bounds are worked out
         // again, so its own wake-ups never need to hold it back.)
         for (std::size_t k = 0; k < n; ++k) {
-            const Mcu& m = *mcus_[k];
-            earliest_action_[k] = k == runner || m.halted() ? kNever
-                                  : awake_[k]                ? present_[k]
-                                                             : time_of(k, m.next_event_cycle());
+            earliest_action_[k] = k == runner || halted_[k] ? kNever : awake_[k] ? present_[k] : next_[k];
         }
         if (lookahead_) {
             for (bool changed = true; changed;) {
                 changed = false;
                 for (std::size_t k = 0; k < n; ++k) {
-                    if (k == runner || awake_[k] || mcus_[k]->halted()) continue;
+                    if (k == runner || awake_[k] || halted_[k]) continue;
                     for (const Influence& i : influenced_by_[k]) {
                         if (earliest_action_[i.from] < earliest_action_[k] && may_wake(i, *mcus_[k])) {
                             earliest_action_[k] = earliest_action_[i.from];

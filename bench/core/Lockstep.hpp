@@ -106,8 +106,8 @@ private:
     bool influences_declared_ = false;
     std::vector<Cycle> end_cycles_;  // run_until_ps's end, per MCU
     // Per MCU, worked out for each step of run_until_ps.
-    std::vector<Time> present_, earliest_action_;
-    std::vector<char> awake_;
+    std::vector<Time> present_, next_, earliest_action_;
+    std::vector<char> awake_, halted_;
     std::set<std::pair<const Mcu*, const Mcu*>> coupled_;
     bool lookahead_ = true;
     Mcu* running_ = nullptr;
