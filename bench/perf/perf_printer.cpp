@@ -52,6 +52,15 @@ struct Sample {
     std::uint64_t avr_instructions = 0;
 };
 
+// What a run cost since `start_cpu_s`, how far it went, and its MCUs' steps.
+Sample sample_of(avrbench::Bench& bench, double start_cpu_s) {
+    Sample s;
+    s.cpu_s = cpu_seconds() - start_cpu_s;
+    s.simulated_s = bench.now_seconds();
+    for (const avrbench::Mcu* m : bench.board().mcus()) s.avr_instructions += m->steps();
+    return s;
+}
+
 enum class Job { Demo, Part };
 
 std::string job_text(const std::string& src, Job job) {
@@ -71,11 +80,7 @@ Sample run_printer(const std::string& fw, const std::string& src, Job job, bool 
     bench.board().lockstep().set_lookahead(lookahead);
     bench.host().add_lines(job_text(src, job));
     bench.run_until_idle(200.0);
-    Sample s;
-    s.cpu_s = cpu_seconds() - start;
-    s.simulated_s = bench.now_seconds();
-    for (const avrbench::Mcu* m : bench.board().mcus()) s.avr_instructions += m->steps();
-    return s;
+    return sample_of(bench, start);
 }
 
 constexpr const char* kBareMega = R"(
@@ -95,11 +100,7 @@ Sample run_interp_alone(const std::string& fw, const std::string& src) {
                           {{"interp", fw + "/printer3d_interp.elf"}});
     bench.host().add_lines(read_job(src + "/examples/printer3d/seed001_part.gcode", true));
     bench.run_until_idle(60.0);
-    Sample s;
-    s.cpu_s = cpu_seconds() - start;
-    s.simulated_s = bench.now_seconds();
-    for (const avrbench::Mcu* m : bench.board().mcus()) s.avr_instructions += m->steps();
-    return s;
+    return sample_of(bench, start);
 }
 
 // `avrbench run` on the demo's job as `bash ci/demo` runs it, in a child.
