@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -49,6 +50,15 @@ public:
     // were told as the line went out): forget them. False when it cannot,
     // because the machine began one (the bench then loses the frame).
     virtual bool retract(std::size_t moves) = 0;
+    // Where the firmware's own position is at power-up, in its coordinates:
+    // 0 for firmware that counts from where the machine starts; a firmware
+    // with another modal default (seed 004's delta: Z -310) says so.
+    virtual AxisPositions power_up_mm() const { return {0.0, 0.0, 0.0}; }
+    // How the judge can tell that the firmware has answered every line the
+    // job sent (its host is done): moves still waiting then were, for the
+    // firmware, made or queued, so a machine at rest at the end has not made
+    // them. Given once by the bench that runs the job.
+    virtual void job_answered_by(std::function<bool()> all_answered) { (void)all_answered; }
 };
 
 }  // namespace avrbench

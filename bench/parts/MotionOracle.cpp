@@ -56,6 +56,9 @@ std::vector<ParamSpec> MotionOracle::param_specs() {
         {.name = "rapids", .type = PT::Choice, .default_value = "straight", .choices = {"straight", "any"},
          .source = "grbl, Marlin and Teacup move G0 on a straight line; a firmware that runs each axis at its own rate (seed 002) does not",
          .help = "whether a G0's path is judged (straight) or only its end (any)"},
+        {.name = "feeds", .type = PT::Choice, .default_value = "straight", .choices = {"straight", "any"},
+         .source = "a Cartesian machine moves G1-G3 on their paths; a delta whose firmware sets its servos' angles (seed 004) moves its joints, not its tool, in straight lines",
+         .help = "whether the paths of G1-G3 are judged (straight) or only their ends (any)"},
         {.name = "z_moves", .type = PT::Choice, .default_value = "with_xy", .choices = {"with_xy", "before_xy"},
          .source = "with_xy: a line moves all its axes together; seed 001 (digest §3) moves Z alone first",
          .help = "how a line that changes Z and X/Y moves"},
@@ -69,6 +72,9 @@ std::vector<ParamSpec> MotionOracle::param_specs() {
                          .source = "default: the carriage's position at power-up (firmware count from where they start)",
                          .help = "where the firmware's " + a + " = 0 is on the carriage (default: where it starts)",
                          .min = -10.0, .max = 10.0});
+        specs.push_back({.name = "start_" + a, .type = PT::Quantity, .dimension = D::Length, .default_value = "0mm",
+                         .source = "the firmware: the position it takes itself to be at before the first move (most: 0)",
+                         .help = "the firmware's own " + a + " at power-up, in its coordinates", .min = -10.0, .max = 10.0});
         specs.push_back({.name = "home_" + a, .type = PT::Quantity, .dimension = D::Length,
                          .source = "the board: where the firmware's homing puts its zero (a switch's trip point)",
                          .help = "where " + a + " = 0 is on the carriage after G28 (absent: G28 ends judging)",
@@ -81,12 +87,14 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
     path_tolerance_mm_ = params.quantity("path_tolerance") * 1e3;
     if (params.has("end_tolerance")) end_tolerance_mm_ = params.quantity("end_tolerance") * 1e3;
     rapids_straight_ = params.text("rapids") == "straight";
+    feeds_straight_ = params.text("feeds") == "straight";
     z_before_xy_ = params.text("z_moves") == "before_xy";
     rest_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(params.quantity("rest_time")));
     static constexpr const char* kAxes[3] = {"x", "y", "z"};
     for (std::size_t k = 0; k < 3; ++k) {
         const std::string a = kAxes[k];
         if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
+        start_mm_[k] = params.quantity("start_" + a) * 1e3;
         if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
         require_port<Carriage>(a, false, "the " + std::string(1, kAxisLetters[k]) + " axis' carriage",
                                [this, k](Carriage& c) {
@@ -94,25 +102,44 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
                                    c.on_move([this](double) { on_carriage(); });
                                });
     }
+    require_port<Effector>("effector", false, "a mechanism's tool point (a delta_robot's effector), for x, y and z",
+                           [this](Effector& e) {
+                               effector_ = &e;
+                               e.on_move([this](const Eigen::Vector3d&) { on_carriage(); });
+                           });
     require_port<ToolContact>("tool", false, "the pen (a pen_lift's tool)", [this](ToolContact& t) { tool_ = &t; });
     add_readout("moves_judged", [this] { return static_cast<double>(moves_judged_); });
     add_readout("judging", [this] { return lost_ ? 0.0 : 1.0; });
 }
 
 void MotionOracle::start() {
-    bool any = false;
+    const bool any_carriage = carriages_[0] != nullptr || carriages_[1] != nullptr || carriages_[2] != nullptr;
+    if (effector_ != nullptr && any_carriage) {
+        throw BadInput("part '" + name() + "': join either the effector or the x, y, z carriages, not both");
+    }
+    if (effector_ == nullptr && !any_carriage) {
+        throw BadInput("part '" + name() + "': join at least one of ports x, y, z to a linear axis' carriage, or effector to a mechanism's");
+    }
+    // An effector has no step to be exact to: the board says how close is there.
+    if (effector_ != nullptr && !end_tolerance_mm_) {
+        throw BadInput("part '" + name() + "': with an effector, give end_tolerance (how close the mechanism gets to a target)");
+    }
+    const Eigen::Vector3d power_up = tool_position();
     for (std::size_t k = 0; k < 3; ++k) {
         if (!connected(k)) continue;
-        any = true;
-        origin_mm_[k] = origin_given_mm_[k] ? *origin_given_mm_[k] : carriages_[k]->position_mm();
+        // A carriage's firmware zero: where it started, less where the
+        // firmware thinks it started; an effector's frame is the firmware's.
+        const double start_origin = effector_ != nullptr ? 0.0 : power_up[static_cast<Eigen::Index>(k)] - *start_mm_[k];
+        origin_mm_[k] = origin_given_mm_[k] ? *origin_given_mm_[k] : start_origin;
     }
-    if (!any) throw BadInput("part '" + name() + "': join at least one of ports x, y, z to a linear axis' carriage");
-    last_position_ = tool_position();
+    last_position_ = power_up;
     rest_anchor_ = last_position_;
     last_move_cycle_ = clock().cycle();
-    double finest_step = 1e300;
+    // Less than this is a rotor settling about its step, not motion; an
+    // effector driven by servos stands still when it stands.
+    double finest_step = effector_ != nullptr ? 2e-3 : 1e300;
     for (std::size_t k = 0; k < 3; ++k) {
-        if (connected(k)) finest_step = std::min(finest_step, carriages_[k]->step_mm());
+        if (carriages_[k] != nullptr) finest_step = std::min(finest_step, carriages_[k]->step_mm());
     }
     rest_jitter_mm_ = finest_step / 2;
 }
@@ -123,6 +150,7 @@ bool MotionOracle::Tracked::drawing() const {
 }
 
 Eigen::Vector3d MotionOracle::tool_position() const {
+    if (effector_ != nullptr) return effector_->effector_mm();
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (std::size_t k = 0; k < 3; ++k) {
         if (connected(k)) p[static_cast<Eigen::Index>(k)] = carriages_[k]->position_mm();
@@ -160,11 +188,11 @@ void MotionOracle::commanded(const CommandedMove& move) {
     t.line = move.line;
     t.command = commands_++;
     const bool home = move.kind == CommandedMove::Kind::Home;
-    t.free = home || (move.kind == CommandedMove::Kind::Rapid && !rapids_straight_);
+    t.free = home || (move.kind == CommandedMove::Kind::Rapid ? !rapids_straight_ : !feeds_straight_);
     for (std::size_t k = 0; k < 3; ++k) {
         if (!connected(k)) continue;
         const auto i = static_cast<Eigen::Index>(k);
-        const double step = end_tolerance_mm_ ? *end_tolerance_mm_ : carriages_[k]->step_mm();
+        const double step = end_tolerance_mm_ ? *end_tolerance_mm_ : carriages_[k]->step_mm();  // (an effector: given)
         t.end_tolerance[i] = step + 1e-9;
         if (!origin_mm_[k] || !move.from_mm[k]) return lose(move.line + " starts where the bench cannot know");
         t.from[i] = *move.from_mm[k] + *origin_mm_[k];
@@ -483,10 +511,32 @@ std::vector<Finding> MotionOracle::pending_findings() const {
     // settle time (Bench::run_until_idle ends 50 ms after the last STEP; a
     // motor's rotor settles a few ms after it).
     const Cycle settle = std::min(rest_cycles_, clock().cycles_from_seconds(0.025));
-    if (!rest_judged_ && now >= last_move_cycle_ + settle) {
-        if (auto f = rest_verdict(tool_position(), now)) out.push_back(*f);
+    if (now < last_move_cycle_ + settle) return out;
+    const Eigen::Vector3d p = tool_position();
+    if (!rest_judged_) {
+        if (auto f = rest_verdict(p, now)) out.push_back(*f);
+    }
+    if (job_answered_ && job_answered_()) {
+        if (auto f = unmade_verdict(p, now)) out.push_back(*f);
     }
     return out;
+}
+
+std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cycle now) const {
+    if (lost_ || moves_.empty() || moves_.front().barrier) return std::nullopt;
+    const Tracked& cur = moves_.front();
+    const bool begun = cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached;
+    // The move the tool is on counts when it never left its start; away
+    // from it, rest_verdict has judged it already.
+    std::size_t first = begun || ends_within(cur, p, cur.to) || !ends_within(cur, p, cur.from) ? 1 : 0;
+    std::size_t unmade = 0;
+    for (std::size_t i = first; i < moves_.size() && !moves_[i].barrier; ++i) ++unmade;
+    if (unmade == 0) return std::nullopt;
+    const Tracked& m = moves_[first];
+    std::string detail = m.line + ": every line was answered, and the run ended with the machine at rest at " +
+                         firmware_text(m, p) + " before this move to " + firmware_text(m, m.to) + " began";
+    if (unmade > 1) detail += " (nor did the " + std::to_string(unmade - 1) + " after it)";
+    return make_finding(kMoveEndMissed, now, detail);
 }
 
 std::string MotionOracle::summary() {

@@ -13,16 +13,21 @@
 //   homing) away from every drawing move, with the length it drew.
 //
 // Ports `x`, `y`, `z` take linear axes' carriages (any subset: the axes a
-// machine has); `tool` a pen's contact. Positions are the firmware's: the
+// machine has), or `effector` a mechanism's tool point (a delta robot's, in
+// its own frame); `tool` a pen's contact. Positions are the firmware's: the
 // carriage minus the axis' zero, which is where the carriage stood at
-// power-up (firmware count from there) unless `origin_x`... says otherwise,
-// moves by G92 as the firmware does, and after G28 is `home_x`... (where the
-// firmware's homing puts its zero; without it the oracle stops judging).
+// power-up (firmware count from there; less `start_x`... when the firmware
+// starts elsewhere) unless `origin_x`... says otherwise, moves by G92 as the
+// firmware does, and after G28 is `home_x`... (where the firmware's homing
+// puts its zero; without it the oracle stops judging). An effector's frame
+// is the firmware's unless `origin_x`... says otherwise.
 //
 // Moves are tracked with a cursor: the move the tool is on, advanced when
 // its end was reached and the next move is as close, or when a later move
 // (up to eight ahead) is closer by more than the tolerance. A G0 is a
-// straight line unless `rapids: any` (a firmware whose rapids are dog-legs).
+// straight line unless `rapids: any` (a firmware whose rapids are dog-legs);
+// a G1 likewise unless `feeds: any` (a mechanism that moves its joints, not
+// its tool, in straight lines: then only where each move ends is judged).
 // After a line the bench could not read (CommandedMoves::frame_lost) it stops
 // judging what follows the moves before it.
 #pragma once
@@ -37,6 +42,7 @@
 
 #include "parts/Carriage.hpp"
 #include "parts/CommandedMoves.hpp"
+#include "parts/Effector.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 #include "parts/ToolContact.hpp"
@@ -62,6 +68,8 @@ public:
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;
     void frame_lost(const std::string& line) override;
     bool retract(std::size_t moves) override;
+    AxisPositions power_up_mm() const override { return start_mm_; }
+    void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
 
     // For tests and front ends: moves judged so far, and whether judging stopped.
     std::size_t moves_judged() const { return moves_judged_; }
@@ -100,7 +108,7 @@ private:
         bool drawing() const;
     };
 
-    bool connected(std::size_t axis) const { return carriages_[axis] != nullptr; }
+    bool connected(std::size_t axis) const { return effector_ != nullptr || carriages_[axis] != nullptr; }
     Eigen::Vector3d tool_position() const;
     void on_carriage();
     void arm_rest_check();
@@ -120,16 +128,23 @@ private:
     // The findings a move earned when the tool left it.
     std::vector<Finding> verdict(const Tracked& m, Cycle now) const;
     std::optional<Finding> rest_verdict(const Eigen::Vector3d& p, Cycle now) const;
+    // At the end of a run whose job was all answered, with the machine at
+    // rest: the first move it never made (and how many more), if any.
+    std::optional<Finding> unmade_verdict(const Eigen::Vector3d& p, Cycle now) const;
     bool ends_within(const Tracked& m, const Eigen::Vector3d& p, const Eigen::Vector3d& target) const;
     Finding make_finding(FindingKind kind, Cycle cycle, std::string detail) const;
     std::string firmware_text(const Tracked& m, const Eigen::Vector3d& carriage_mm) const;
     void lose(const std::string& why);
 
     std::array<Carriage*, 3> carriages_{};
+    Effector* effector_ = nullptr;
+    std::function<bool()> job_answered_;
     ToolContact* tool_ = nullptr;
     double path_tolerance_mm_;
     std::optional<double> end_tolerance_mm_;
     bool rapids_straight_;
+    bool feeds_straight_;
+    AxisPositions start_mm_{0.0, 0.0, 0.0};
     bool z_before_xy_;
     Cycle rest_cycles_;
     std::array<std::optional<double>, 3> origin_given_mm_{};

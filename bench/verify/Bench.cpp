@@ -190,6 +190,9 @@ struct SentLineFeed {
             renamed = renamed || later.renamed;
         }
         if (renamed || !judge->retract(moves)) {
+            // The lines sent after it were read in a frame the firmware never
+            // took: take their moves back where the judge can, then stop.
+            if (renamed) (void)judge->retract(moves);
             path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
             return;
         }
@@ -202,10 +205,15 @@ struct SentLineFeed {
 
 }  // namespace
 
+void Bench::judge_job_by(const std::function<bool()>& all_answered) const {
+    for (CommandedMoves* judge : motion_judges()) judge->job_answered_by(all_answered);
+}
+
 void Bench::follow_sent_lines(UartHost& host) {
     auto feeds = std::make_shared<std::vector<SentLineFeed>>();
     for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge);
     if (feeds->empty()) return;
+    judge_job_by([&host] { return host.done(); });
     auto last_sent = std::make_shared<std::size_t>(0);
     host.on_line_sent([feeds, last_sent](const GcodeLine& line) {
         if (line.number <= *last_sent) return;  // a resend: read once

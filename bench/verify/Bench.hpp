@@ -118,6 +118,10 @@ public:
     // its moves up front, in order, as if each line had been accepted.
     // `source` names it in findings ("drawing.dxf's G-code").
     void command_program(const std::string& gcode, const std::string& source);
+    // How the motion judges tell that the job's every line or record was
+    // answered (a host's own job is wired by the bench; a record job's by
+    // its runner).
+    void judge_job_by(const std::function<bool()>& all_answered) const;
 
     // Board findings plus one HostProtocol finding per host error, alarm,
     // fatal answer or timeout.

@@ -195,7 +195,10 @@ void BoardRun::start_record_job() {
     plot_ = std::make_unique<RecordHost>(*port.mcu, port.link(), job.messages,
                                          RecordHost::Options{}, job.busy_seconds);
     plot_->start();
-    if (!job.gcode.empty()) bench_->command_program(job.gcode, job.source + "'s G-code");
+    if (!job.gcode.empty()) {
+        bench_->command_program(job.gcode, job.source + "'s G-code");
+        bench_->judge_job_by([this] { return plot_->finished(); });
+    }
 }
 
 void BoardRun::open_pty() {

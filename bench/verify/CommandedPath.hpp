@@ -23,7 +23,7 @@ namespace avrbench {
 
 class CommandedPath {
 public:
-    explicit CommandedPath(CommandedMoves& judge) : judge_(&judge) {}
+    explicit CommandedPath(CommandedMoves& judge) : judge_(&judge), position_mm_(judge.power_up_mm()) {}
     // A line the firmware takes (the bench hands it over as it is sent, so a
     // firmware that answers after the move is followed while it moves);
     // `quoted` names it in findings.
@@ -45,8 +45,8 @@ private:
     CommandedMoves* judge_;
     std::size_t moves_told_ = 0;
     std::size_t renames_told_ = 0;
-    // Where the firmware is after the lines so far (it starts at 0).
-    AxisPositions position_mm_{0.0, 0.0, 0.0};
+    // Where the firmware is after the lines so far (from the judge's power_up_mm).
+    AxisPositions position_mm_;
     bool relative_ = false;
     double mm_per_unit_ = 1.0;
     bool xy_plane_ = true;

@@ -21,6 +21,7 @@
 #include "cam/Records.hpp"
 #include "parts/Axis.hpp"
 #include "parts/HybridStepper.hpp"
+#include "parts/MotionOracle.hpp"
 #include "support/Paths.hpp"
 #include "verify/BoardRun.hpp"
 
@@ -127,9 +128,14 @@ TEST(PlotterTorqueBudget, TheFirmwaresUnrampedRapidSlipsTheLoadAndAFeedMoveDoesN
         EXPECT_GE(count(findings, HybridStepper::kMotorStall, "y_motor"), 1u);
         // Slipped within the first steps and never caught up (the same
         // energy argument holds from any later rest): the carriages stay
-        // near the origin, 30 mm and 20 mm short. (The motion oracle does not
-        // say so: the machine never left the rapid's start, which it cannot
-        // tell from a move not yet begun; docs/CNC.md.)
+        // near the origin, 30 mm and 20 mm short, and with every record
+        // acknowledged the motion oracle reports the rapid never made.
+        bool unmade = false;
+        for (const Finding& f : findings) {
+            unmade = unmade || (f.kind == MotionOracle::kMoveEndMissed &&
+                                f.detail.find("line 2 'G00 X30.000 Y20.000': every line was answered") != std::string::npos);
+        }
+        EXPECT_TRUE(unmade);
         EXPECT_GT(bench.board().part_as<HybridStepper>("x_motor").lost_steps(), 100);
         EXPECT_LT(bench.axis("x").position_mm(), 5.0);
         EXPECT_LT(bench.axis("y").position_mm(), 5.0);
