@@ -388,6 +388,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     if (!failed_ && !outstanding_.empty()) arm_line_timeout();
 
     const FirmwareFamily family = options_.family;
+    bool answered = false;  // a line acknowledged: the next may go out
     if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) {
         if (family != FirmwareFamily::Generic) {
             // Everything before the welcome is discarded by the firmware's own
@@ -414,7 +415,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         uart_.send(line.text + "\n");
     } else if (starts_with(text, "ok")) {
         ++oks_;
-        acknowledge();
+        answered = acknowledge();
     } else if (is_fatal(text)) {
         ++fatals_;
         HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
@@ -426,7 +427,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         e.message = e.line ? "line " + std::to_string(e.line->number) + " " + quoted_line(e.line->text) + " got '" + text + "'"
                            : "'" + text + "' with no line outstanding";
         stop_or_record(options_.stop_on_error, std::move(e));
-        if (options_.error_acknowledges) acknowledge();
+        if (options_.error_acknowledges) answered = acknowledge();
     } else if (starts_with(text, "ALARM")) {
         ++alarms_;
         HostEvent e = event_at_oldest_line(HostEventKind::Alarm, cycle, text);
@@ -435,7 +436,13 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     }
     // Anything else (echo:, [MSG:...], banners, reports) is transcript only.
 
+    // Listeners hear the answer before the next line goes out: a motion
+    // judge takes back a refused line's moves before it reads the next.
     for (auto& fn : line_listeners_) fn(entry);
+    if (answered) {
+        pump();
+        check_finished();
+    }
 }
 
 HostEvent UartHost::event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const {
@@ -459,24 +466,23 @@ void UartHost::stop_or_record(bool stop, HostEvent event) {
     }
 }
 
-void UartHost::acknowledge() {
+bool UartHost::acknowledge() {
     if (outstanding_.empty()) {
         ++unsolicited_acks_;
-        return;
+        return false;
     }
     outstanding_bytes_ -= outstanding_.front().bytes;
     outstanding_.pop_front();
     ++acknowledged_;
     resends_of_oldest_ = 0;
-    if (failed_) return;
+    if (failed_) return false;
     // Progress: the next unanswered line (if any) gets a fresh timeout.
     if (!outstanding_.empty()) {
         arm_line_timeout();
     } else {
         ++timeout_generation_;  // nothing outstanding: no timeout pending
     }
-    pump();
-    check_finished();
+    return true;
 }
 
 // --- sending -------------------------------------------------------------------

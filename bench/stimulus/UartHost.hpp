@@ -298,7 +298,9 @@ private:
 
     void on_byte(Cycle cycle, std::uint8_t byte);
     void on_line(Cycle cycle, std::string text);
-    void acknowledge();
+    // Frees the oldest line; true when the next may go out (on_line pumps
+    // after its listeners).
+    bool acknowledge();
     void become_ready();
     void pump();
     void send_line(std::size_t index);

@@ -35,10 +35,18 @@
  *
  * Commands (9600 baud, one per line, any byte stops the program after the
  * current row): "G1 X<mm> Y<mm> Z<mm>" moves the effector there (modal:
- * missing words keep the last target) -> "ok", or "error: unreachable" when
- * an arm cannot reach it or its servo index leaves the table; "M3" / "M5"
+ * missing words keep the last target; F taken and ignored) -> "ok", or
+ * "error: unreachable" when an arm cannot reach it or its servo index leaves
+ * the table, "error: bad word" for any other word or number form; "M3" / "M5"
  * switch the magnet on / off -> "ok"; anything else -> "error: unknown
  * command". A line longer than 47 characters -> "error: line too long".
+ * A G1's "ok" comes once the servos have had time to get there: the largest
+ * angle change at the SM-S4315M's 0.21 s / 60 deg (285 deg/s), plus two
+ * 20 ms frames (the new width starts with the next frame). Answering at
+ * once would let the next command turn the servos before they arrive: the
+ * effector cuts the corner and never reaches the target it was told
+ * (the motion oracle reports it, docs/DELTA.md). The thesis' program has
+ * its dwells instead; both builds wait alike, this is our command loop.
  */
 #include <avr/interrupt.h>
 #include <avr/io.h>
@@ -252,11 +260,15 @@ static int8_t plan(float x_cm, float y_cm, float z_cm, int angle[3])
 #endif
 }
 
+/* The arm angles last written (0: horizontal), for the time the servos need. */
+static int written_angle[3];
+
 static void move_servos(const int angle[3])
 {
     servo_write_us(0, servo1[offset[0] - angle[0]]);
     servo_write_us(1, servo2[offset[1] - angle[1]]);
     servo_write_us(2, servo3[offset[2] - angle[2]]);
+    for (uint8_t n = 0; n < 3; ++n) written_angle[n] = angle[n];
 }
 
 static void servos_horizontal(void)
@@ -264,6 +276,29 @@ static void servos_horizontal(void)
     servo_write_us(0, servo1[offset[0]]);
     servo_write_us(1, servo2[offset[1]]);
     servo_write_us(2, servo3[offset[2]]);
+    for (uint8_t n = 0; n < 3; ++n) written_angle[n] = 0;
+}
+
+/* How long the servos take from the angles last written to `angle`, in ms:
+ * 285 deg/s (SM-S4315M: 0.21 s / 60 deg) plus two 20 ms frames; a change
+ * beyond a servo's 180 deg of travel (the literal build's unchecked index)
+ * counts as 180. */
+static uint16_t servo_travel_ms(const int angle[3])
+{
+    int largest = 0;
+    for (uint8_t n = 0; n < 3; ++n) {
+        const long change = labs((long)angle[n] - written_angle[n]);
+        const int deg = change > 180 ? 180 : (int)change;
+        if (deg > largest) largest = deg;
+    }
+    return (uint16_t)(((uint32_t)largest * 1000 + 284) / 285 + 40);
+}
+
+/* Waits `n` ms asleep between interrupts; bytes wait in the receive ring. */
+static void settle_ms(uint16_t n)
+{
+    const uint32_t start = millis();
+    while (millis() - start < n) fw_uart_idle();
 }
 
 static void magnet(uint8_t on)
@@ -389,30 +424,53 @@ static void run_program(void)
 /* "G1 X.. Y.. Z.." in mm (modal), "M3", "M5". */
 static float target_mm[3] = {0, 0, -310};
 
-static const char *word(const char *text, char letter)
+/* The words of a G0/G1 line after its code: X, Y, Z (mm) and F (taken and
+ * ignored: the servos run at their own speed), each at most once, each a
+ * plain decimal number ([+-]digits[.digits]), spaces between. 0 for
+ * anything else: an exponent, another letter (G20, a second G), a word
+ * twice - lines a G-code reader would take differently from atof (fuzzing
+ * found "G1 Z-34G20": Z -34 mm here, -863.6 mm to a reader that honours
+ * G20). */
+static int8_t read_move_words(const char *p, float next[3])
 {
-    for (const char *p = text; *p; ++p) {
-        if (*p == letter) return p + 1;
+    uint8_t seen = 0;
+    for (;;) {
+        while (*p == ' ') ++p;
+        if (*p == '\0') return 1;
+        const char letter = *p++;
+        const uint8_t axis = letter == 'X' ? 0 : letter == 'Y' ? 1 : letter == 'Z' ? 2 : letter == 'F' ? 3 : 4;
+        if (axis == 4 || (seen & (1u << axis))) return 0;
+        seen |= (uint8_t)(1u << axis);
+        const char *number = p;
+        if (*p == '+' || *p == '-') ++p;
+        uint8_t digits = 0;
+        for (; *p >= '0' && *p <= '9'; ++p) ++digits;
+        if (*p == '.') {
+            for (++p; *p >= '0' && *p <= '9'; ++p) ++digits;
+        }
+        if (digits == 0) return 0;
+        if (axis < 3) next[axis] = (float)atof(number);
     }
-    return 0;
 }
 
 static void execute(const char *text)
 {
-    const char *p;
     while (*text == ' ') ++text;
     if (text[0] == 'G' && (text[1] == '0' || text[1] == '1') && (text[2] == ' ' || text[2] == '\0')) {
         float next[3] = {target_mm[0], target_mm[1], target_mm[2]};
-        if ((p = word(text + 2, 'X'))) next[0] = (float)atof(p);
-        if ((p = word(text + 2, 'Y'))) next[1] = (float)atof(p);
-        if ((p = word(text + 2, 'Z'))) next[2] = (float)atof(p);
+        if (!read_move_words(text + 2, next)) {
+            fw_uart_puts("error: bad word\r\n");
+            return;
+        }
         int angle[3];
         if (plan(next[0] / 10, next[1] / 10, next[2] / 10, angle) != 0) {
             fw_uart_puts("error: unreachable\r\n");
             return;
         }
         for (uint8_t n = 0; n < 3; ++n) target_mm[n] = next[n];
+        const uint16_t travel_ms = servo_travel_ms(angle);
         move_servos(angle);
+        settle_ms(travel_ms);
         fw_uart_puts("ok\r\n");
     } else if (text[0] == 'M' && (text[1] == '3' || text[1] == '5') && text[2] == '\0') {
         magnet(text[1] == '3');
