@@ -70,7 +70,9 @@ static void parse_Gcode_command(const char *command)
                 /* L = 0: the DDA's loop (Code 4.1-4.3, "while
                  * number_of_executions < L") runs no tick at all. */
                 if (gc.x != 0 || gc.y != 0) {
-                    queue_line(AXIS_X, gc.x, AXIS_Y, gc.y, dtc_half_us, gc.command_number == 1);
+                    /* G00 leaves the extruder as G01 or M03 left it: on,
+                     * it extrudes along the rapid (digest §9.8). */
+                    queue_line(AXIS_X, gc.x, AXIS_Y, gc.y, dtc_half_us, extruder);
                     plan_position[AXIS_X] += gc.x;
                     plan_position[AXIS_Y] += gc.y;
                 }

@@ -182,6 +182,22 @@ TEST(Printer3dThesisParser, AZOnlyLineMovesZAloneAndAZeroLengthLineIsAnswered) {
     EXPECT_EQ(test::drive_position(*bench, "drive_y"), 0);
 }
 
+// Code 4.11's G00 never switches the extruder off, so after a G01 (or M03)
+// a rapid extrudes too (digest §9.8): SP = 1 step per 8 ticks (§4.7, the
+// build's default), 200 ticks of G00 X0.2 at the listing's 1000 BLU/mm.
+// The fixed parser's G0 extrudes nothing (Printer3dJob.ExtruderFollows...).
+TEST(Printer3dThesisParser, ARapidAfterAFeedMoveExtrudes) {
+    auto bench = test::powered_printer("printer3d_interp_thesis_parser");
+    Mcu& interp = bench->mcu("interp");
+    test::PinLog x(interp, "PA0"), e(interp, "PA3");
+    bench->run_for(0.2);
+    EXPECT_EQ(send_line(*bench, "G01 X0.1 F10"), "ok\n");
+    EXPECT_EQ(send_line(*bench, "G00 X0.2 F10"), "ok\n");
+    ASSERT_EQ(x.rises().size(), 300u);  // 100 ticks of G01, 200 of G00
+    const Cycle g0_from = x.rises()[100], g0_to = x.rises()[299];
+    EXPECT_GE(count_between(e.rises(), g0_from, g0_to), 200u / 8 - 1);
+}
+
 // strcpy into char s[50]: a longer line runs over the parser's stack frame
 // and its return address; the bench reports the crash with PC and cycle.
 TEST(Printer3dThesisParser, ALineLongerThan50BytesCrashesTheInterpolator) {
