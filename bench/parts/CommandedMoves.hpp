@@ -54,6 +54,8 @@ public:
     // 0 for firmware that counts from where the machine starts; a firmware
     // with another modal default (seed 004's delta: Z -310) says so.
     virtual AxisPositions power_up_mm() const { return {0.0, 0.0, 0.0}; }
+    // The firmware waits here (G4) before the moves that follow.
+    virtual void dwell() {}
     // How the judge can tell that the firmware has answered every line the
     // job sent (its host is done): moves still waiting then were, for the
     // firmware, made or queued, so a machine at rest at the end has not made

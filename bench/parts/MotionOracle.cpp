@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "core/Errors.hpp"
 
@@ -187,6 +188,7 @@ void MotionOracle::commanded(const CommandedMove& move) {
     t.kind = move.kind;
     t.line = move.line;
     t.command = commands_++;
+    t.after_dwell = std::exchange(dwell_pending_, false);
     const bool home = move.kind == CommandedMove::Kind::Home;
     t.free = home || (move.kind == CommandedMove::Kind::Rapid ? !rapids_straight_ : !feeds_straight_);
     for (std::size_t k = 0; k < 3; ++k) {
@@ -529,8 +531,10 @@ std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cy
     // The move the tool is on counts when it never left its start; away
     // from it, rest_verdict has judged it already.
     std::size_t first = begun || ends_within(cur, p, cur.to) || !ends_within(cur, p, cur.from) ? 1 : 0;
+    // A move behind a dwell may still be waiting it out (a run ends 50 ms
+    // after the last step): only the moves before the first dwell count.
     std::size_t unmade = 0;
-    for (std::size_t i = first; i < moves_.size() && !moves_[i].barrier; ++i) ++unmade;
+    for (std::size_t i = first; i < moves_.size() && !moves_[i].barrier && !moves_[i].after_dwell; ++i) ++unmade;
     if (unmade == 0) return std::nullopt;
     const Tracked& m = moves_[first];
     std::string detail = m.line + ": every line was answered, and the run ended with the machine at rest at " +

@@ -70,6 +70,7 @@ public:
     bool retract(std::size_t moves) override;
     AxisPositions power_up_mm() const override { return start_mm_; }
     void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
+    void dwell() override { dwell_pending_ = true; }
 
     // For tests and front ends: moves judged so far, and whether judging stopped.
     std::size_t moves_judged() const { return moves_judged_; }
@@ -102,6 +103,7 @@ private:
         Eigen::Vector3d tool_off_from = Eigen::Vector3d::Zero();
         Cycle tool_off_cycle = 0;
         bool rest_reported = false;
+        bool after_dwell = false;  // a G4 came before it: it may still be waiting when a run ends
         // Findings recorded when the fault began, revised as it grows.
         std::optional<std::size_t> deviation_finding, tool_finding;
         double deviation_told = 0, tool_told = 0;
@@ -139,6 +141,7 @@ private:
     std::array<Carriage*, 3> carriages_{};
     Effector* effector_ = nullptr;
     std::function<bool()> job_answered_;
+    bool dwell_pending_ = false;  // a G4 since the last move commanded
     ToolContact* tool_ = nullptr;
     double path_tolerance_mm_;
     std::optional<double> end_tolerance_mm_;

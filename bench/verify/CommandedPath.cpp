@@ -50,7 +50,7 @@ void CommandedPath::accept(std::string_view line, const std::string& quoted) {
         if (g != std::floor(g) || g < 0 || g > 1000) return lose(quoted);
         const int code = static_cast<int>(g);
         switch (code) {
-            case 4:
+            case 4: judge_->dwell(); break;
             case 94: break;
             case 17: xy_plane_ = true; break;
             case 18:

@@ -11,10 +11,12 @@
 #include "cam/Chain.hpp"
 #include "cam/DxfReader.hpp"
 #include "cam/Records.hpp"
+#include "boards/BoardFile.hpp"
 #include "parts/Axis.hpp"
 #include "parts/MotionOracle.hpp"
 #include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
+#include "verify/Bench.hpp"
 #include "verify/BoardRun.hpp"
 #include "verify/CommandedPath.hpp"
 
@@ -231,6 +233,53 @@ TEST(MotionOracle, ARefusedLineIsTakenBack) {
     const auto& oracle = bench->board().part_as<MotionOracle>("motion");
     EXPECT_TRUE(oracle.judging());
     EXPECT_EQ(oracle.moves_judged(), 1u);  // X10 left behind, X20 where it rests
+}
+
+// A machine that never makes an accepted move: once the job's every line is
+// answered and the machine rests at the end, the first move it never began
+// is a finding, unless a dwell (G4) stands before it - the firmware may
+// still be waiting it out when the run ends. The oracle is told by hand:
+// an X carriage that nothing drives (its driver's STEP is not wired).
+std::vector<Finding> unmade(bool dwell_first) {
+    Bench bench(parse_board_text(R"(
+mcus:
+  uno: {type: atmega328p, clock: 16MHz}
+parts:
+  x_driver: {type: step_dir_driver, preset: a4988, microsteps: 16}
+  x: {type: linear_axis, steps_per_mm: 80, travel: 200mm, start_position: 10mm}
+  motion: {type: motion_oracle}
+nets:
+  x_motion: [x_driver.steps, x.drive]
+  x_carriage: [x.carriage, motion.x]
+)",
+                                 "unmade.yaml"),
+                {{"uno", test::firmware("sleep_idle")}});
+    auto& oracle = bench.board().part_as<MotionOracle>("motion");
+    bench.run_for(0.01);
+    if (dwell_first) oracle.dwell();
+    CommandedMove move;
+    move.kind = CommandedMove::Kind::Feed;
+    move.from_mm = {0.0, 0.0, 0.0};
+    move.to_mm = {5.0, 0.0, 0.0};
+    move.line = "line 1 'G1 X5'";
+    oracle.commanded(move);
+    oracle.job_answered_by([] { return true; });
+    bench.run_for(0.5);
+    std::vector<Finding> out;
+    for (const Finding& f : bench.findings()) {
+        if (f.kind == MotionOracle::kMoveEndMissed) out.push_back(f);
+    }
+    return out;
+}
+
+TEST(MotionOracle, AMoveNeverMadeIsAFindingUnlessADwellStandsBeforeIt) {
+    const auto found = unmade(false);
+    ASSERT_EQ(found.size(), 1u);
+    EXPECT_NE(found[0].detail.find("line 1 'G1 X5': every line was answered, and the run ended with the machine at rest "
+                                   "at X0.000 before this move to X5.000 began"),
+              std::string::npos)
+        << found[0].detail;
+    EXPECT_TRUE(unmade(true).empty());
 }
 
 }  // namespace
