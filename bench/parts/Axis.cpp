@@ -38,6 +38,11 @@ std::vector<ParamSpec> Axis::param_specs() {
          .help = "length of travel (linear), from 0"},
         {.name = "start_position", .type = PT::Quantity, .dimension = Dimension::Length, .default_value = "0mm",
          .source = "assumed: the carriage starts at 0", .help = "carriage position at power-on"},
+        {.name = "trace_deadband", .type = PT::Quantity, .dimension = Dimension::Length, .default_value = "0mm",
+         .source = "0: every change traced; a board whose rotors dither under a chopper sets a fraction of a step",
+         .help = "a reversal of the carriage up to this far is not traced in position_mm (linear); switches and "
+                 "judges still follow every 1/256 step",
+         .min = 0, .max = 1e-3},
     };
 }
 
@@ -66,6 +71,7 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
         steps_per_unit_ = steps_per_mm * 1e3;
         travel_m_ = params.quantity("travel");
         start_m_ = params.quantity("start_position");
+        trace_deadband_m_ = params.quantity("trace_deadband");
         if (start_m_ < 0 || start_m_ > travel_m_) {
             throw BadInput("part '" + this->name() + "': start_position outside 0..travel");
         }
@@ -85,6 +91,8 @@ void Axis::connect_drive(ShaftMotion& driver) {
         metres_per_256_ = microsteps / 256.0 / steps_per_unit_;
         travel_256_ = static_cast<std::int64_t>(std::floor(travel_m_ / metres_per_256_ + 1e-9));
         carriage_256_ = std::llround(start_m_ / metres_per_256_);
+        traced_256_ = carriage_256_;
+        deadband_256_ = static_cast<std::int64_t>(std::floor(trace_deadband_m_ / metres_per_256_ + 1e-9));
     }
     // STEP pulses the driver took, and the net position in steps (signed).
     add_readout("steps", [this] { return driver_ != nullptr ? static_cast<double>(driver_->steps_taken()) : 0.0; });
@@ -135,9 +143,25 @@ void Axis::on_step(int delta_256) {
         in_crash_ = false;
         carriage_256_ = wanted;
     }
-    publish(sig_position_, position_mm());
+    trace_position();
     const double position_m = static_cast<double>(carriage_256_) * metres_per_256_;
     for (auto& fn : move_listeners_) fn(position_m);
+}
+
+// The traced position follows the carriage on and on in the direction it
+// last went; a turn back is traced once it passes the dead band, so a rotor
+// dithering between two 1/256 steps under a chopper is one change, not
+// thousands a second (the published value is then at most the dead band off).
+void Axis::trace_position() {
+    const std::int64_t change = carriage_256_ - traced_256_;
+    if (deadband_256_ > 0) {
+        if (change == 0) return;
+        const int direction = change > 0 ? 1 : -1;
+        if (direction != traced_direction_ && (change > 0 ? change : -change) <= deadband_256_) return;
+        traced_direction_ = direction;
+    }
+    traced_256_ = carriage_256_;
+    publish(sig_position_, position_mm());
 }
 
 }  // namespace avrbench

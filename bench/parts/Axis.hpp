@@ -43,6 +43,7 @@ public:
 private:
     void connect_drive(ShaftMotion& driver);
     void on_step(int delta_256);
+    void trace_position();
 
     ShaftMotion* driver_ = nullptr;
     bool rotary_;
@@ -55,6 +56,11 @@ private:
     // so millions of steps do not accumulate rounding.
     std::int64_t carriage_256_ = 0;
     std::int64_t travel_256_ = 0;
+    // What position_mm shows (trace_deadband: reversals up to deadband_256_ are not traced).
+    double trace_deadband_m_ = 0;
+    std::int64_t deadband_256_ = 0;
+    std::int64_t traced_256_ = 0;
+    int traced_direction_ = 0;
     double angle_rad_ = 0;
     bool in_crash_ = false;
     unsigned crashes_ = 0;
