@@ -323,6 +323,83 @@ void run_external_elf(const std::string& external_elf, const std::string& extern
     std::filesystem::remove(vcd_path);
 }
 
+// Peak resident memory of the CLI run with `args` in `dir` (a child process,
+// getrusage of the child), in MiB; -1 if it failed to run. Exit codes in
+// `accepted_exits` count as having run (a failed check exits 1).
+double cli_run_peak_rss_mib(const std::vector<std::string>& args, const std::string& dir, std::initializer_list<int> accepted_exits) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int null_fd = open("/dev/null", O_WRONLY);
+        dup2(null_fd, STDOUT_FILENO);
+        if (chdir(dir.c_str()) != 0) _exit(127);
+        std::vector<char*> argv{const_cast<char*>(AVRBENCH_CLI)};
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(AVRBENCH_CLI, argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    rusage usage{};
+    if (wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status)) return -1;
+    if (std::find(accepted_exits.begin(), accepted_exits.end(), WEXITSTATUS(status)) == accepted_exits.end()) return -1;
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+// --check-rss: `avrbench check` of a scenario whose golden holds `edges`
+// edges of one wire (toggle_1mhz's PB0, 1 M edges per simulated second):
+// plain (the run streamed into the comparison), failing at the first edge
+// (the diff's context read back from the held changes), and with --vcd-dir
+// (the run held whole for the waveform files), beside `golden update`.
+void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("avrbench_perf_check_" + std::to_string(getpid()));
+    const std::string firmware = fs::absolute(firmware_dir).string();  // the scenarios are read from `dir`
+    fs::create_directories(dir / "golden");
+    std::FILE* board = std::fopen((dir / "board.yaml").c_str(), "w");
+    std::fputs("board: toggle-board\ndescription: an ATmega328P whose PB0 is labelled, so traced\n"
+               "mcus:\n  uno: {type: atmega328p, clock: 16MHz}\nlabels:\n  toggle: uno.PB0\n", board);
+    std::fclose(board);
+    const double seconds = static_cast<double>(edges) / 1e6;
+    auto scenario = [&](const std::string& name, const std::string& golden) {
+        std::FILE* f = std::fopen((dir / (name + ".yaml")).c_str(), "w");
+        std::fprintf(f, "name: %s\nboard: board.yaml\nfirmware: {uno: %s/toggle_1mhz.elf}\ntime_limit: %.6fs\n"
+                        "steps:\n  - delay: %.6fs\ngolden: golden/%s.timeline\n",
+                     name.c_str(), firmware.c_str(), seconds + 1, seconds, golden.c_str());
+        std::fclose(f);
+    };
+    scenario("toggle", "toggle");
+    scenario("shifted", "shifted");
+    std::printf("%-58s %12s %14s\n", "avrbench on toggle_1mhz's PB0", "edges", "peak RSS MiB");
+    const double update = cli_run_peak_rss_mib({"golden", "update", "toggle.yaml"}, dir.string(), {0});
+    std::printf("%-58s %12zu %14.1f\n", "golden update", edges, update);
+    // The shifted golden: its first rising edge one cycle early.
+    {
+        std::FILE* in = std::fopen((dir / "golden" / "toggle.timeline").c_str(), "r");
+        std::FILE* out = std::fopen((dir / "golden" / "shifted.timeline").c_str(), "w");
+        char line[512];
+        bool shifted = false;
+        while (in != nullptr && out != nullptr && std::fgets(line, sizeof line, in) != nullptr) {
+            unsigned long long delta = 0;
+            if (!shifted && std::sscanf(line, "+%llu 1\n", &delta) == 1 && delta > 1) {
+                std::fprintf(out, "+%llu 1\n", delta - 1);
+                shifted = true;
+                continue;
+            }
+            std::fputs(line, out);
+        }
+        if (in != nullptr) std::fclose(in);
+        if (out != nullptr) std::fclose(out);
+    }
+    const double check = cli_run_peak_rss_mib({"check", "toggle.yaml"}, dir.string(), {0});
+    std::printf("%-58s %12zu %14.1f\n", "check (passes; the run streamed into the comparison)", edges, check);
+    const double fails = cli_run_peak_rss_mib({"check", "shifted.yaml"}, dir.string(), {1});
+    std::printf("%-58s %12zu %14.1f\n", "check (differs at the first rising edge)", edges, fails);
+    const double held = cli_run_peak_rss_mib({"check", "toggle.yaml", "--vcd-dir", "vcd"}, dir.string(), {0});
+    std::printf("%-58s %12zu %14.1f\n", "check --vcd-dir (the run held whole for the VCD)", edges, held);
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+}
+
 // --rss: the CLI's peak memory streaming a VCD of 1 M events per simulated second.
 void run_rss_rows(const std::vector<double>& rss_seconds, const std::string& firmware_dir, const std::string& vcd_path) {
     std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace-only PB0 --vcd", "sim s", "peak RSS MiB");
@@ -412,6 +489,8 @@ int perf_main(int argc, char** argv) {
     app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lookahead, strict, one MCU, the CLI)");
     bool printer_part_once = false;
     app.add_flag("--printer-part-once", printer_part_once, "the printer's part job once, lookahead (for callgrind)");
+    std::size_t check_rss_edges = 0;
+    app.add_option("--check-rss", check_rss_edges, "peak RSS of avrbench check and golden update on a run of this many edges");
     std::vector<double> rss_seconds;
     app.add_option("--rss", rss_seconds, "peak RSS of the CLI streaming a 1 M events/s VCD for these simulated seconds");
     CLI11_PARSE(app, argc, argv);
@@ -436,6 +515,10 @@ int perf_main(int argc, char** argv) {
     }
     if (compare_edges > 0) {
         run_compare_rows(compare_edges);
+        return 0;
+    }
+    if (check_rss_edges > 0) {
+        run_check_rss(check_rss_edges, firmware_dir);
         return 0;
     }
     if (!rss_seconds.empty()) {

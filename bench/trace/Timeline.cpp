@@ -63,6 +63,30 @@ long Timeline::find(const std::string& scope, const std::string& name) const {
     return it == index_.end() ? -1 : static_cast<long>(it->second);
 }
 
+void Timeline::stream_to(EventSink sink, std::size_t batch_events) {
+    if (!keep_.empty()) throw std::invalid_argument("a timeline that keeps signals when taken cannot stream to a sink");
+    sink_ = std::move(sink);
+    sink_batch_ = std::max<std::size_t>(1, batch_events);
+    limit_ = sink_ ? sink_batch_ : max_held_;
+    flush_stream();
+}
+
+void Timeline::flush_stream() {
+    if (!sink_ || events_.empty()) return;
+    sink_(events_);
+    taken_ += events_.size();
+    events_.clear();
+}
+
+bool Timeline::make_room() {
+    if (!sink_) {
+        ++dropped_;
+        return false;
+    }
+    flush_stream();
+    return true;
+}
+
 std::string Timeline::overflow_message() const {
     return "the run recorded more than " + std::to_string(max_held_) +
            " signal changes, the most a comparison or report keeps in memory; " + std::to_string(dropped_) +

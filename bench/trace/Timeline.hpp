@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -70,19 +71,13 @@ public:
     static constexpr std::size_t kMaxHeldEvents = 50'000'000;
 
     void record(SignalId id, Cycle cycle, std::uint64_t bits) {
-        if (events_.size() >= max_held_) {
-            ++dropped_;
-            return;
-        }
+        if (events_.size() >= limit_ && !make_room()) [[unlikely]] return;
         TimelineEvent e{cycle, id, {}};
         e.value.bits = bits;
         events_.push_back(e);
     }
     void record_real(SignalId id, Cycle cycle, double value) {
-        if (events_.size() >= max_held_) {
-            ++dropped_;
-            return;
-        }
+        if (events_.size() >= limit_ && !make_room()) [[unlikely]] return;
         TimelineEvent e{cycle, id, {}};
         e.value.real = value;
         events_.push_back(e);
@@ -92,7 +87,18 @@ public:
     bool overflowed() const { return dropped_ != 0; }
     // "the run recorded more than ... events ..." (one line), for callers to report.
     std::string overflow_message() const;
-    void set_max_held_events(std::size_t n) { max_held_ = n; }
+    void set_max_held_events(std::size_t n) {
+        max_held_ = n;
+        limit_ = sink_ ? sink_batch_ : max_held_;
+    }
+
+    // Streaming to a consumer that keeps what it needs (check's comparison):
+    // every `batch_events` events recorded are handed to `sink` in record
+    // order and forgotten, so the timeline holds at most that many; no cap
+    // applies. flush_stream() hands over the rest. Not with keep_when_taken.
+    using EventSink = std::function<void(const std::vector<TimelineEvent>&)>;
+    void stream_to(EventSink sink, std::size_t batch_events = std::size_t{1} << 16);
+    void flush_stream();
 
     const std::vector<SignalInfo>& signals() const { return signals_; }
     // Events in the order they were recorded. Within one clock domain this is
@@ -154,6 +160,11 @@ private:
     std::size_t kept_ = 0;    // events_[0, kept_) were taken and kept
     std::uint64_t dropped_ = 0;
     std::size_t max_held_ = kMaxHeldEvents;
+    std::size_t limit_ = kMaxHeldEvents;  // max_held_, or the sink's batch when streaming
+    EventSink sink_;
+    std::size_t sink_batch_ = 0;
+    // At limit_: hands the events to the sink (true: record on), or counts a drop.
+    bool make_room();
     std::map<std::pair<std::string, std::string>, SignalId> index_;  // (scope, name) -> id
 };
 

@@ -7,6 +7,8 @@
 #include <limits>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <string_view>
 #include <fstream>
 #include <sstream>
 
@@ -39,11 +41,19 @@ bool same_value(const SignalInfo& info, const TimelineEvent& a, const TimelineEv
     return info.kind == SignalKind::Real ? a.value.real == b.value.real : a.value.bits == b.value.bits;
 }
 
+// A change after the first: cycles since the previous one, and its value
+// (a real's as its bits: equal bits, equal shortest decimal).
 struct Pair {
     Cycle delta;
-    std::string value;
+    std::uint64_t value;
     bool operator==(const Pair& o) const { return delta == o.delta && value == o.value; }
 };
+
+std::string format_bits(const SignalInfo& info, std::uint64_t bits) {
+    TimelineEvent e{0, 0, {}};
+    e.value.bits = bits;
+    return format_value(info, e);
+}
 
 std::string full_name(const SignalInfo& s) { return s.scope + "." + s.name; }
 
@@ -85,41 +95,27 @@ std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id) {
     return dedupe(std::move(events), timeline.signals()[id]);
 }
 
-std::vector<std::vector<TimelineEvent>> changes_by_signal(const Timeline& timeline) {
-    std::vector<std::vector<TimelineEvent>> per_signal(timeline.signals().size());
-    std::vector<std::size_t> counts(per_signal.size(), 0);
-    for (const auto& e : timeline.events()) {
-        if (e.signal < counts.size()) ++counts[e.signal];
-    }
-    for (std::size_t id = 0; id < per_signal.size(); ++id) per_signal[id].reserve(counts[id]);
-    for (const auto& e : timeline.events()) {
-        if (e.signal < per_signal.size()) per_signal[e.signal].push_back(e);
-    }
-    for (SignalId id = 0; id < per_signal.size(); ++id) {
-        per_signal[id] = dedupe(std::move(per_signal[id]), timeline.signals()[id]);
-    }
-    return per_signal;
-}
-
 namespace {
 
-// The exact form: a block of 1 or 2 pairs repeated 3 or more times becomes one line.
-void append_exact(std::string& out, const std::vector<Pair>& pairs) {
+// The exact form: a block of 1 or 2 pairs repeated 3 or more times becomes
+// one line. `pair(i)` gives the i-th of `count` pairs.
+template <class PairAt>
+void append_exact(std::string& out, const SignalInfo& info, std::size_t count, PairAt pair) {
     std::size_t i = 0;
-    while (i < pairs.size()) {
+    while (i < count) {
         bool emitted = false;
         for (std::size_t block = 1; block <= 2 && !emitted; ++block) {
             std::size_t repeats = 1;
-            while (i + (repeats + 1) * block <= pairs.size()) {
+            while (i + (repeats + 1) * block <= count) {
                 bool same = true;
-                for (std::size_t k = 0; k < block; ++k) same = same && pairs[i + repeats * block + k] == pairs[i + k];
+                for (std::size_t k = 0; k < block; ++k) same = same && pair(i + repeats * block + k) == pair(i + k);
                 if (!same) break;
                 ++repeats;
             }
             if (repeats >= 3) {
                 out += "*" + std::to_string(repeats);
                 for (std::size_t k = 0; k < block; ++k) {
-                    out += " +" + std::to_string(pairs[i + k].delta) + " " + pairs[i + k].value;
+                    out += " +" + std::to_string(pair(i + k).delta) + " " + format_bits(info, pair(i + k).value);
                 }
                 out += "\n";
                 i += repeats * block;
@@ -127,10 +123,14 @@ void append_exact(std::string& out, const std::vector<Pair>& pairs) {
             }
         }
         if (!emitted) {
-            out += "+" + std::to_string(pairs[i].delta) + " " + pairs[i].value + "\n";
+            out += "+" + std::to_string(pair(i).delta) + " " + format_bits(info, pair(i).value) + "\n";
             ++i;
         }
     }
+}
+
+void append_exact(std::string& out, const SignalInfo& info, const std::vector<Pair>& pairs) {
+    append_exact(out, info, pairs.size(), [&pairs](std::size_t i) { return pairs[i]; });
 }
 
 // A run of `repeats` blocks of `block` events from changes[i] on, each event
@@ -142,13 +142,13 @@ struct NominalBlock {
     std::vector<Cycle> offsets;  // of each event in the block from the block's start, the last = period
 };
 
-NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::string>& values, std::size_t i,
-                       std::size_t block, Cycle prev, Cycle jitter) {
-    const std::size_t n = cycles.size();
+NominalBlock fit_block(const SignalChanges& changes, std::size_t i, std::size_t block, Cycle prev, Cycle jitter) {
+    const std::size_t n = changes.size();
+    const auto cycles = [&changes](std::size_t k) { return changes.cycle(k); };
     std::size_t repeats = 0;
     while (i + (repeats + 1) * block <= n) {
         bool same = true;
-        for (std::size_t j = 0; j < block; ++j) same = same && values[i + repeats * block + j] == values[i + j];
+        for (std::size_t j = 0; j < block; ++j) same = same && changes.bits(i + repeats * block + j) == changes.bits(i + j);
         if (!same) break;
         ++repeats;
     }
@@ -156,7 +156,7 @@ NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::
     for (int attempt = 0; attempt < 24 && repeats >= 3; ++attempt) {
         NominalBlock fit;
         fit.repeats = repeats;
-        const Cycle last = cycles[i + repeats * block - 1];
+        const Cycle last = cycles(i + repeats * block - 1);
         if (last <= prev) return {};
         fit.period = (last - prev + repeats / 2) / repeats;
         if (fit.period == 0) return {};
@@ -168,7 +168,7 @@ NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::
             // The mean offset of event j from its block's nominal start.
             long double sum = 0;
             for (std::size_t k = 0; k < repeats; ++k) {
-                sum += static_cast<long double>(cycles[i + k * block + j]) - static_cast<long double>(prev + k * fit.period);
+                sum += static_cast<long double>(cycles(i + k * block + j)) - static_cast<long double>(prev + k * fit.period);
             }
             const long double mean = sum / static_cast<long double>(repeats);
             if (mean < 1) return {};
@@ -181,7 +181,7 @@ NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::
         for (std::size_t k = 0; k < repeats && fits == repeats; ++k) {
             for (std::size_t j = 0; j < block; ++j) {
                 const Cycle nominal = prev + k * fit.period + fit.offsets[j];
-                const Cycle actual = cycles[i + k * block + j];
+                const Cycle actual = cycles(i + k * block + j);
                 if ((actual > nominal ? actual - nominal : nominal - actual) > jitter) {
                     fits = k;
                     break;
@@ -190,89 +190,90 @@ NominalBlock fit_block(const std::vector<Cycle>& cycles, const std::vector<std::
         }
         // The next event must come after the block's nominal end (deltas are never negative).
         const std::size_t after = i + repeats * block;
-        if (fits == repeats && after < n && cycles[after] < prev + repeats * fit.period) fits = repeats - 1;
+        if (fits == repeats && after < n && cycles(after) < prev + repeats * fit.period) fits = repeats - 1;
         if (fits == repeats) return fit;
         repeats = fits;
     }
     return {};
 }
 
-void append_nominal(std::string& out, const std::vector<TimelineEvent>& changes, const SignalInfo& info, Cycle jitter) {
-    std::vector<Cycle> cycles;
-    std::vector<std::string> values;
-    for (const auto& e : changes) {
-        cycles.push_back(e.cycle);
-        values.push_back(format_value(info, e));
-    }
-    Cycle prev = cycles[0];
+void append_nominal(std::string& out, const SignalChanges& changes, const SignalInfo& info, Cycle jitter) {
+    Cycle prev = changes.cycle(0);
     std::size_t i = 1;
     std::vector<Pair> pending;  // exact pairs between blocks
-    while (i < cycles.size()) {
+    while (i < changes.size()) {
         NominalBlock best;
         std::size_t best_block = 0;
         for (std::size_t block = 1; block <= 2; ++block) {
-            NominalBlock fit = fit_block(cycles, values, i, block, prev, jitter);
+            NominalBlock fit = fit_block(changes, i, block, prev, jitter);
             if (fit.repeats * block > best.repeats * best_block) {
                 best = std::move(fit);
                 best_block = block;
             }
         }
         if (best.repeats < 3) {
-            pending.push_back({cycles[i] - prev, values[i]});
-            prev = cycles[i];
+            pending.push_back({changes.cycle(i) - prev, changes.bits(i)});
+            prev = changes.cycle(i);
             ++i;
             continue;
         }
-        append_exact(out, pending);
+        append_exact(out, info, pending);
         pending.clear();
         out += "*" + std::to_string(best.repeats);
         Cycle at = 0;
         for (std::size_t j = 0; j < best_block; ++j) {
-            out += " +" + std::to_string(best.offsets[j] - at) + " " + values[i + j];
+            out += " +" + std::to_string(best.offsets[j] - at) + " " + format_bits(info, changes.bits(i + j));
             at = best.offsets[j];
         }
         out += "\n";
         prev += best.repeats * best.period;
         i += best.repeats * best_block;
     }
-    append_exact(out, pending);
+    append_exact(out, info, pending);
 }
 
 }  // namespace
 
-std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header,
+std::string format_timeline_text(const TimelineChanges& timeline, const TimelineHeader& header,
                                  const std::map<std::string, Cycle>& jitter_cycles) {
     std::string out = "avrbench-timeline 1\n";
     out += "bench " + header.bench_version + "\n";
     for (const auto& in : header.inputs) out += "input " + in.role + " " + in.sha256 + " " + in.path + "\n";
     out += "end " + std::to_string(header.end_cycle) + " " + std::to_string(header.end_clock_hz) + "\n";
-    const auto& signals = timeline.signals();
+    const auto& signals = timeline.signals;
     for (const auto& s : signals) {
         out += "signal " + full_name(s) + " " + kind_name(s.kind) + " " +
                std::to_string(s.kind == SignalKind::Real ? 64u : s.width) + " " + std::to_string(s.clock_hz) + "\n";
     }
-    const auto all_changes = changes_by_signal(timeline);
     for (SignalId id = 0; id < signals.size(); ++id) {
         const SignalInfo& info = signals[id];
         out += "\n@" + full_name(info) + "\n";
-        const auto& changes = all_changes[id];
+        const SignalChanges& changes = timeline.changes[id];
         if (changes.empty()) continue;
-        out += std::to_string(changes[0].cycle) + " " + format_value(info, changes[0]) + "\n";
+        out += std::to_string(changes.cycle(0)) + " " + format_bits(info, changes.bits(0)) + "\n";
         const auto jitter = jitter_cycles.find(full_name(info));
         if (jitter != jitter_cycles.end() && jitter->second > 0) {
             append_nominal(out, changes, info, jitter->second);
             continue;
         }
-        std::vector<Pair> pairs;
-        for (std::size_t i = 1; i < changes.size(); ++i) {
-            pairs.push_back({changes[i].cycle - changes[i - 1].cycle, format_value(info, changes[i])});
-        }
-        append_exact(out, pairs);
+        append_exact(out, info, changes.size() - 1, [&changes](std::size_t i) {
+            return Pair{changes.cycle(i + 1) - changes.cycle(i), changes.bits(i + 1)};
+        });
     }
     return out;
 }
 
+std::string format_timeline_text(const Timeline& timeline, const TimelineHeader& header,
+                                 const std::map<std::string, Cycle>& jitter_cycles) {
+    return format_timeline_text(timeline_changes(timeline), header, jitter_cycles);
+}
+
 void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path,
+                         const std::map<std::string, Cycle>& jitter_cycles) {
+    write_output_file(path, format_timeline_text(timeline, header, jitter_cycles), "golden timeline");
+}
+
+void write_timeline_text(const TimelineChanges& timeline, const TimelineHeader& header, const std::string& path,
                          const std::map<std::string, Cycle>& jitter_cycles) {
     write_output_file(path, format_timeline_text(timeline, header, jitter_cycles), "golden timeline");
 }
@@ -288,8 +289,10 @@ namespace {
 // of a line is read or the line is refused; errors name source:line.
 class TimelineTextParser {
 public:
-    TimelineTextParser(const std::string& text, const std::string& source, double stop_after_s)
-        : in_(text), source_(source), stop_after_s_(stop_after_s) {}
+    // With `into`, events go there (each signal's changes) instead of the
+    // parsed timeline, which then holds only the signals.
+    TimelineTextParser(std::string_view text, const std::string& source, double stop_after_s, TimelineChanges* into = nullptr)
+        : text_(text), source_(source), stop_after_s_(stop_after_s), into_(into) {}
 
     ParsedTimeline parse() {
         if (!next_line() || line_ != "avrbench-timeline 1") fail("not an avrbench timeline (expected 'avrbench-timeline 1')");
@@ -323,6 +326,9 @@ public:
                 record(word[0] == '+' ? last_cycle_ + parse_cycles(word.substr(1)) : parse_cycles(word), value);
             }
         }
+        if (into_ != nullptr) {
+            for (auto& c : into_->changes) c.finish();
+        }
         return std::move(parsed_);
     }
 
@@ -335,7 +341,10 @@ private:
         if (words >> extra) fail("'" + extra + "' after " + what + " (one item per line)");
     }
     bool next_line() {
-        if (!std::getline(in_, line_)) return false;
+        if (pos_ >= text_.size()) return false;
+        const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
+        line_.assign(text_.substr(pos_, end - pos_));
+        pos_ = end + 1;
         ++line_no_;
         if (!line_.empty() && line_.back() == '\r') line_.pop_back();
         return true;
@@ -390,6 +399,10 @@ private:
             parsed_.timeline.add_signal(info);
         } catch (const std::invalid_argument& e) {
             fail(e.what());
+        }
+        if (into_ != nullptr) {
+            into_->signals.push_back(info);
+            into_->changes.emplace_back(info.kind);
         }
     }
 
@@ -460,16 +473,26 @@ private:
             double v = 0;
             auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
             if (ec != std::errc() || end != value.data() + value.size()) fail("'" + value + "' is not a number");
-            parsed_.timeline.record_real(static_cast<SignalId>(current_), cycle, v);
+            if (into_ != nullptr) {
+                std::uint64_t bits = 0;
+                std::memcpy(&bits, &v, sizeof bits);
+                into_->changes[static_cast<std::size_t>(current_)].add(cycle, bits);
+            } else {
+                parsed_.timeline.record_real(static_cast<SignalId>(current_), cycle, v);
+            }
+        } else if (into_ != nullptr) {
+            into_->changes[static_cast<std::size_t>(current_)].add(cycle, parse_u64(value));
         } else {
             parsed_.timeline.record(static_cast<SignalId>(current_), cycle, parse_u64(value));
         }
         last_cycle_ = cycle;
     }
 
-    std::istringstream in_;
+    std::string_view text_;
+    std::size_t pos_ = 0;  // where the next line starts
     const std::string& source_;
     const double stop_after_s_;
+    TimelineChanges* into_;
     ParsedTimeline parsed_;
     std::string line_;
     int line_no_ = 0;
@@ -492,6 +515,13 @@ ParsedTimeline parse_timeline_text(const std::string& text, const std::string& s
 
 ParsedTimeline read_timeline_text(const std::string& path, double stop_after_s) {
     return parse_timeline_text(read_input_file(path, "golden timeline", kMaxGoldenFileBytes), path, stop_after_s);
+}
+
+ParsedChanges read_timeline_changes(const std::string& path, double stop_after_s) {
+    ParsedChanges out;
+    const std::string text = read_input_file(path, "golden timeline", kMaxGoldenFileBytes);
+    out.header = TimelineTextParser(text, path, stop_after_s, &out.changes).parse().header;
+    return out;
 }
 
 }  // namespace avrbench

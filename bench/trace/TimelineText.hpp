@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "trace/SignalChanges.hpp"
 #include "trace/Timeline.hpp"
 
 namespace avrbench {
@@ -60,6 +61,11 @@ std::string format_timeline_text(const Timeline& timeline, const TimelineHeader&
                                  const std::map<std::string, Cycle>& jitter_cycles = {});
 void write_timeline_text(const Timeline& timeline, const TimelineHeader& header, const std::string& path,
                          const std::map<std::string, Cycle>& jitter_cycles = {});
+// The same from a timeline held as its signals' changes (a streamed run).
+std::string format_timeline_text(const TimelineChanges& timeline, const TimelineHeader& header,
+                                 const std::map<std::string, Cycle>& jitter_cycles = {});
+void write_timeline_text(const TimelineChanges& timeline, const TimelineHeader& header, const std::string& path,
+                         const std::map<std::string, Cycle>& jitter_cycles = {});
 
 struct ParsedTimeline {
     TimelineHeader header;
@@ -74,9 +80,15 @@ struct ParsedTimeline {
 ParsedTimeline parse_timeline_text(const std::string& text, const std::string& source, double stop_after_s = 0);
 ParsedTimeline read_timeline_text(const std::string& path, double stop_after_s = 0);
 
+// The same, the events held as each signal's changes (SignalChanges: 8 bytes
+// a wire change), for comparing a long run without a Timeline of each side.
+struct ParsedChanges {
+    TimelineHeader header;
+    TimelineChanges changes;
+};
+ParsedChanges read_timeline_changes(const std::string& path, double stop_after_s = 0);
+
 // Events of one signal with unchanged values removed, in time order.
 std::vector<TimelineEvent> changes_of(const Timeline& timeline, SignalId id);
-// The same for every signal, indexed by SignalId, from one pass over the events.
-std::vector<std::vector<TimelineEvent>> changes_by_signal(const Timeline& timeline);
 
 }  // namespace avrbench

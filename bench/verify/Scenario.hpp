@@ -110,6 +110,9 @@ struct ScenarioResult {
     double wall_s = 0;
     std::string report_path;   // HTML report, if written
     std::string vcd_path;      // VCD (with a .gtkw beside it), if written
+    // The comparison (or golden update) took the run's changes as they were recorded, the
+    // timeline holding none (no report, VCD or debugger needed it whole).
+    bool streamed = false;
     std::string text() const;  // the human-readable outcome (failures, then the diff report)
 };
 

@@ -26,19 +26,23 @@ namespace fs = std::filesystem;
 namespace avrbench {
 namespace {
 
+// Whether the golden holds a signal: those its globs name, or without
+// globs every signal but the real-valued ones.
+bool in_golden(const SignalInfo& s, const std::vector<std::string>& globs) {
+    if (globs.empty()) return s.kind != SignalKind::Real;
+    for (const auto& g : globs) {
+        if (glob_match(g, s.scope + "." + s.name)) return true;
+    }
+    return false;
+}
+
 // The part of the run's timeline that the golden holds.
 Timeline golden_view(const Timeline& all, const std::vector<std::string>& globs) {
     Timeline out;
     std::vector<long> map(all.signals().size(), -1);
     for (SignalId id = 0; id < all.signals().size(); ++id) {
         const SignalInfo& s = all.signals()[id];
-        bool keep = false;
-        if (globs.empty()) {
-            keep = s.kind != SignalKind::Real;
-        } else {
-            for (const auto& g : globs) keep = keep || glob_match(g, s.scope + "." + s.name);
-        }
-        if (keep) map[id] = static_cast<long>(out.add_signal(s));
+        if (in_golden(s, globs)) map[id] = static_cast<long>(out.add_signal(s));
     }
     for (const auto& e : all.events()) {
         if (map[e.signal] < 0) continue;
@@ -81,6 +85,54 @@ std::vector<std::vector<std::string>> wire_names(const BoardSpec& spec) {
     }
     return wires;
 }
+
+// The golden's part of a run kept as it is recorded, for a comparison that
+// needs nothing else of the timeline (no report, no VCD, no debugger): the
+// timeline streams its events here and holds none itself, so a long run costs
+// 8 bytes a wire change instead of a timeline's 24 and its copies.
+class StreamedGoldenView {
+public:
+    StreamedGoldenView(Timeline& timeline, const std::vector<std::string>& globs) : timeline_(timeline), globs_(globs) {
+        timeline_.stream_to([this](const std::vector<TimelineEvent>& events) { take(events); });
+    }
+    StreamedGoldenView(const StreamedGoldenView&) = delete;
+    StreamedGoldenView& operator=(const StreamedGoldenView&) = delete;
+    ~StreamedGoldenView() { timeline_.stream_to(nullptr); }
+
+    // The run's changes of the golden's signals, once the run is over.
+    TimelineChanges finish() {
+        timeline_.flush_stream();
+        map_signals();
+        for (auto& c : view_.changes) c.finish();
+        return std::move(view_);
+    }
+
+private:
+    // Signals registered since the last batch (a board may add them as it runs).
+    void map_signals() {
+        const auto& signals = timeline_.signals();
+        for (SignalId id = static_cast<SignalId>(map_.size()); id < signals.size(); ++id) {
+            if (!in_golden(signals[id], globs_)) {
+                map_.push_back(-1);
+                continue;
+            }
+            map_.push_back(static_cast<long>(view_.signals.size()));
+            view_.signals.push_back(signals[id]);
+            view_.changes.emplace_back(signals[id].kind);
+        }
+    }
+    void take(const std::vector<TimelineEvent>& events) {
+        map_signals();
+        for (const TimelineEvent& e : events) {
+            if (e.signal < map_.size() && map_[e.signal] >= 0) view_.changes[static_cast<std::size_t>(map_[e.signal])].add(e);
+        }
+    }
+
+    Timeline& timeline_;
+    const std::vector<std::string>& globs_;
+    std::vector<long> map_;  // timeline SignalId -> index in view_, or -1
+    TimelineChanges view_;
+};
 
 class StepRunner {
 public:
@@ -351,12 +403,17 @@ void check_golden_writable(const ScenarioSpec& spec) {
 
 // Compares the run with the golden timeline (or writes it), adding what
 // differs to result.failures; returns the golden for the report.
+// With `streamed`, the run's golden signals came through it and the
+// timeline holds none: the golden is read as changes and not returned.
 std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, const ScenarioRunOptions& options,
-                                                  Bench& bench, ScenarioResult& result) {
+                                                  Bench& bench, ScenarioResult& result, StreamedGoldenView* streamed) {
     if (spec.golden_path.empty()) return std::nullopt;
     const TimelineHeader header = golden_header(spec, bench.mcu());
-    const Timeline actual = golden_view(bench.timeline(), spec.golden_signals);
+    const auto run_changes = [&] {
+        return streamed != nullptr ? streamed->finish() : timeline_changes(golden_view(bench.timeline(), spec.golden_signals));
+    };
     if (options.update_golden) {
+        const TimelineChanges actual = run_changes();
         if (!result.expectation_failures.empty() && !options.force) {
             result.failures.push_back("golden: not updated, because the run failed its steps or expectations "
                                       "(use --force to write it anyway)");
@@ -367,7 +424,7 @@ std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, cons
             rules.rules = spec.tolerances;
             rules.wires = wire_names(bench.board().spec());
             std::map<std::string, Cycle> jitter;
-            for (const SignalInfo& s : actual.signals()) {
+            for (const SignalInfo& s : actual.signals) {
                 const std::string name = s.scope + "." + s.name;
                 const ChannelRule rule = rule_for_signal(name, rules);
                 if (rule.kind == RuleKind::Steps && rule.tolerance_cycles >= 1) {
@@ -383,14 +440,22 @@ std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, cons
                                   " (create it with: avrbench golden update " + spec.path + ")");
         return std::nullopt;
     }
-    // Read no further than this run went: a golden claiming more costs no more than the run.
-    ParsedTimeline golden = read_timeline_text(spec.golden_path, bench.now_seconds());
     CompareOptions compare;
     compare.rules = spec.tolerances;
     compare.wires = wire_names(bench.board().spec());
-    compare.golden_end_cycle = golden.header.end_cycle;
     compare.actual_end_cycle = header.end_cycle;
-    result.comparison = compare_timelines(golden.timeline, actual, compare);
+    // Read no further than this run went: a golden claiming more costs no more than the run.
+    std::optional<ParsedTimeline> golden;
+    if (streamed != nullptr) {
+        const TimelineChanges actual = run_changes();
+        const ParsedChanges golden_changes = read_timeline_changes(spec.golden_path, bench.now_seconds());
+        compare.golden_end_cycle = golden_changes.header.end_cycle;
+        result.comparison = compare_changes(golden_changes.changes, actual, compare);
+    } else {
+        golden = read_timeline_text(spec.golden_path, bench.now_seconds());
+        compare.golden_end_cycle = golden->header.end_cycle;
+        result.comparison = compare_timelines(golden->timeline, golden_view(bench.timeline(), spec.golden_signals), compare);
+    }
     if (!result.comparison->passed) {
         const ChannelResult* d = result.comparison->first_divergence();
         char at[96] = "";
@@ -448,6 +513,12 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         bench.host("", o);
     }
     bench.trace_board();
+    // Only the comparison (or the golden written) reads the run's timeline: it streams.
+    std::optional<StreamedGoldenView> streamed;
+    if (!spec.golden_path.empty() && options.report_dir.empty() && options.vcd_dir.empty() && !options.prepared) {
+        streamed.emplace(bench.timeline(), spec.golden_signals);
+        result.streamed = true;
+    }
     // Timing bounds need the profile of the MCUs they name.
     for (const auto& e : spec.expectations) {
         std::visit(
@@ -482,7 +553,8 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         if (!why.empty()) fail("expect " + e.kind + " (" + e.location + "): " + why);
     }
 
-    const std::optional<ParsedTimeline> golden = compare_with_golden(spec, options, bench, result);
+    const std::optional<ParsedTimeline> golden =
+        compare_with_golden(spec, options, bench, result, streamed ? &*streamed : nullptr);
     result.simulated_s = bench.now_seconds();
     result.passed = result.failures.empty();
     if (!options.report_dir.empty()) result.report_path = write_scenario_report(spec, options.report_dir, bench, result, golden);

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <map>
 
-#include "trace/TimelineText.hpp"
+#include "trace/SignalChanges.hpp"
 
 namespace avrbench {
 namespace {
@@ -48,8 +48,8 @@ bool equal_value(const SignalInfo& info, const TimelineEvent& a, const TimelineE
     return info.kind == SignalKind::Real ? a.value.real == b.value.real : a.value.bits == b.value.bits;
 }
 
-void add_context(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
-                 const std::vector<TimelineEvent>& a, std::size_t index, std::size_t around) {
+void add_context(ChannelResult& r, const SignalInfo& info, const SignalChanges& g,
+                 const SignalChanges& a, std::size_t index, std::size_t around) {
     const std::size_t from = index > around ? index - around : 0;
     const std::size_t to = std::min(std::max(g.size(), a.size()), index + around + 1);
     for (std::size_t i = from; i < to; ++i) {
@@ -61,8 +61,8 @@ void add_context(ChannelResult& r, const SignalInfo& info, const std::vector<Tim
     }
 }
 
-void diverge_at(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
-                const std::vector<TimelineEvent>& a, std::size_t index, std::size_t around, const std::string& detail) {
+void diverge_at(ChannelResult& r, const SignalInfo& info, const SignalChanges& g,
+                const SignalChanges& a, std::size_t index, std::size_t around, const std::string& detail) {
     r.passed = false;
     r.verdict = "differs";
     r.diverges = true;
@@ -76,10 +76,11 @@ void diverge_at(ChannelResult& r, const SignalInfo& info, const std::vector<Time
     add_context(r, info, g, a, index, around);
 }
 
-std::vector<TimelineEvent> rising(const std::vector<TimelineEvent>& changes) {
-    std::vector<TimelineEvent> out;
+// A wire's rising edges (not a high level at cycle 0), each with value 1.
+SignalChanges rising(const SignalChanges& changes) {
+    SignalChanges out(SignalKind::Wire);
     for (std::size_t i = 0; i < changes.size(); ++i) {
-        if (changes[i].value.bits != 0 && (i > 0 || changes[i].cycle > 0)) out.push_back(changes[i]);
+        if (changes.bits(i) != 0 && (i > 0 || changes.cycle(i) > 0)) out.add(changes.cycle(i), 1);
     }
     return out;
 }
@@ -89,7 +90,7 @@ std::vector<TimelineEvent> rising(const std::vector<TimelineEvent>& changes) {
 // O(events + windows), not their product.
 class Cursor {
 public:
-    Cursor(const std::vector<TimelineEvent>& changes, const SignalInfo& info) : c_(changes), info_(info) {}
+    Cursor(const SignalChanges& changes, const SignalInfo& info) : c_(changes), info_(info) {}
 
     // The value at `cycle` (0 before the first change); `cycle` must not decrease between calls.
     double value_at(Cycle cycle) {
@@ -125,7 +126,7 @@ public:
     }
 
 private:
-    const std::vector<TimelineEvent>& c_;
+    const SignalChanges& c_;
     const SignalInfo& info_;
     std::size_t i_ = 0, k_ = 0;
     double value_ = 0;
@@ -133,8 +134,8 @@ private:
 };
 
 // Exact: every change at the same cycle with the same value.
-void compare_exact(ChannelResult& r, const SignalInfo& info, const std::vector<TimelineEvent>& g,
-                   const std::vector<TimelineEvent>& a, std::size_t around) {
+void compare_exact(ChannelResult& r, const SignalInfo& info, const SignalChanges& g,
+                   const SignalChanges& a, std::size_t around) {
     char buf[200];
     for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
         if (i < g.size() && i < a.size() && g[i].cycle == a[i].cycle && equal_value(info, g[i], a[i])) continue;
@@ -146,8 +147,8 @@ void compare_exact(ChannelResult& r, const SignalInfo& info, const std::vector<T
 
 // Timing: the same values, each edge within the tolerance of its place or
 // its interval within the tolerance of its length.
-void compare_timing(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
-                   const std::vector<TimelineEvent>& a, std::size_t around) {
+void compare_timing(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const SignalChanges& g,
+                   const SignalChanges& a, std::size_t around) {
     char buf[200];
     double worst = 0;
     for (std::size_t i = 0; i < std::max(g.size(), a.size()); ++i) {
@@ -180,8 +181,8 @@ void compare_timing(ChannelResult& r, const SignalInfo& info, const ChannelRule&
 }
 
 // Steps: the rising edges, each within the tolerance, and as many.
-void compare_steps(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
-                   const std::vector<TimelineEvent>& a, std::size_t around) {
+void compare_steps(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const SignalChanges& g,
+                   const SignalChanges& a, std::size_t around) {
     char buf[200];
     const auto gs = rising(g), as = rising(a);
     double worst = 0;
@@ -206,8 +207,8 @@ void compare_steps(ChannelResult& r, const SignalInfo& info, const ChannelRule& 
 }
 
 // Band: both signals' values at every change of either, within the band.
-void compare_band(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
-                  const std::vector<TimelineEvent>& a) {
+void compare_band(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const SignalChanges& g,
+                  const SignalChanges& a) {
     char buf[200];
     // Both signals at every time either changes, in time order (a merge of two sorted lists).
     Cursor cg(g, info), ca(a, info);
@@ -239,8 +240,8 @@ void compare_band(ChannelResult& r, const SignalInfo& info, const ChannelRule& r
 }
 
 // PwmDuty and StepRate: window by window up to the earlier run's end.
-void compare_windows(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const std::vector<TimelineEvent>& g,
-                     const std::vector<TimelineEvent>& a, Cycle end) {
+void compare_windows(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule, const SignalChanges& g,
+                     const SignalChanges& a, Cycle end) {
     char buf[200];
     const Cycle window = std::max<Cycle>(1, static_cast<Cycle>(std::llround(rule.window_s * info.clock_hz)));
     const auto gs = rising(g), as = rising(a);
@@ -282,7 +283,7 @@ void compare_windows(ChannelResult& r, const SignalInfo& info, const ChannelRule
 }
 
 void compare_channel(ChannelResult& r, const SignalInfo& info, const ChannelRule& rule,
-                     const std::vector<TimelineEvent>& g, const std::vector<TimelineEvent>& a,
+                     const SignalChanges& g, const SignalChanges& a,
                      const CompareOptions& options) {
     const std::size_t around = options.context_events;
     switch (rule.kind) {
@@ -376,19 +377,22 @@ ChannelRule rule_for_signal(const std::string& signal, const CompareOptions& opt
 }
 
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options) {
+    return compare_changes(timeline_changes(golden), timeline_changes(actual), options);
+}
+
+CompareResult compare_changes(const TimelineChanges& golden, const TimelineChanges& actual, const CompareOptions& options) {
     CompareResult result;
     std::map<std::string, const std::vector<std::string>*> wire_of;
     for (const auto& wire : options.wires) {
         for (const auto& name : wire) wire_of[name] = &wire;
     }
-    // Each timeline's events grouped by signal in one pass.
-    const auto golden_changes = changes_by_signal(golden);
-    const auto actual_changes = changes_by_signal(actual);
+    const auto& golden_changes = golden.changes;
+    const auto& actual_changes = actual.changes;
     std::map<std::string, SignalId> actual_ids;
-    for (SignalId id = 0; id < actual.signals().size(); ++id) actual_ids[full_name(actual.signals()[id])] = id;
+    for (SignalId id = 0; id < actual.signals.size(); ++id) actual_ids[full_name(actual.signals[id])] = id;
     std::map<std::string, bool> seen;
-    for (SignalId gid = 0; gid < golden.signals().size(); ++gid) {
-        const SignalInfo& info = golden.signals()[gid];
+    for (SignalId gid = 0; gid < golden.signals.size(); ++gid) {
+        const SignalInfo& info = golden.signals[gid];
         ChannelResult r;
         r.signal = full_name(info);
         r.clock_hz = info.clock_hz;
@@ -432,7 +436,7 @@ CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, 
         r.detail = "recorded now, not in the golden timeline (avrbench golden update adds it)";
         const auto& a = actual_changes[id];
         r.actual_changes = a.size();
-        r.clock_hz = actual.signals()[id].clock_hz;
+        r.clock_hz = actual.signals[id].clock_hz;
         if (!a.empty()) {
             r.diverges = true;
             r.divergence_cycle = a.front().cycle;

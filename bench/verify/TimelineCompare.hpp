@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "trace/SignalChanges.hpp"
 #include "trace/Timeline.hpp"
 
 namespace avrbench {
@@ -75,6 +76,8 @@ struct CompareResult {
 };
 
 CompareResult compare_timelines(const Timeline& golden, const Timeline& actual, const CompareOptions& options);
+// The same on timelines held as their signals' changes (a streamed run, a golden read as changes).
+CompareResult compare_changes(const TimelineChanges& golden, const TimelineChanges& actual, const CompareOptions& options);
 
 bool glob_match(const std::string& pattern, const std::string& text);
 // The rule `options` apply to `signal`: the first whose pattern matches it

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "trace/Timeline.hpp"
@@ -108,6 +109,60 @@ TEST(TimelineKeep, ATakeHandsOverEverythingAndLeavesTheKeptSignals) {
     ASSERT_EQ(t.events().size(), 2u);
     EXPECT_EQ(t.events()[1].cycle, 5u);
     EXPECT_EQ(t.recorded_count(), 5u);
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// stream_to: every event reaches the sink once, in record order, in batches
+// of the size asked for; the timeline never holds more than a batch, and no
+// held-events cap drops anything while a sink takes them.
+TEST(TimelineStream, TheSinkGetsEveryEventInOrderAndTheTimelineHoldsAtMostABatch) {
+    Timeline t;
+    const SignalId a = t.add_signal({"m", "PB0", SignalKind::Wire, 1, 16000000});
+    const SignalId r = t.add_signal({"p", "degC", SignalKind::Real, 1, 16000000});
+    t.set_max_held_events(5);  // a cap well below the 1000 events recorded
+    std::vector<TimelineEvent> got;
+    std::size_t largest_batch = 0, most_held = 0;
+    t.stream_to(
+        [&](const std::vector<TimelineEvent>& batch) {
+            largest_batch = std::max(largest_batch, batch.size());
+            got.insert(got.end(), batch.begin(), batch.end());
+        },
+        7);
+    for (Cycle c = 0; c < 1000; ++c) {
+        if (c % 3 == 0) {
+            t.record_real(r, c, 0.5 * static_cast<double>(c));
+        } else {
+            t.record(a, c, c % 2);
+        }
+        most_held = std::max(most_held, t.events().size());
+    }
+    EXPECT_LE(most_held, 7u);
+    EXPECT_EQ(largest_batch, 7u);
+    t.flush_stream();
+    EXPECT_TRUE(t.events().empty());
+    EXPECT_FALSE(t.overflowed());
+    EXPECT_EQ(t.recorded_count(), 1000u);
+    ASSERT_EQ(got.size(), 1000u);
+    for (Cycle c = 0; c < 1000; ++c) {
+        EXPECT_EQ(got[c].cycle, c);
+        if (c % 3 == 0) {
+            EXPECT_EQ(got[c].signal, r);
+            EXPECT_EQ(got[c].value.real, 0.5 * static_cast<double>(c));
+        } else {
+            EXPECT_EQ(got[c].signal, a);
+            EXPECT_EQ(got[c].value.bits, c % 2);
+        }
+    }
+    // Without the sink the cap applies again.
+    t.stream_to(nullptr);
+    for (Cycle c = 1000; c < 1010; ++c) t.record(a, c, c % 2);
+    EXPECT_EQ(t.events().size(), 5u);
+    EXPECT_EQ(t.dropped(), 5u);
 }
 
 }  // namespace

@@ -85,6 +85,58 @@ TEST(Scenarios, ShiftedTimerFailsNamingTheChannelAndFirstEdgeThenGoldenUpdateAcc
     EXPECT_NE(again.find("PASS blink"), std::string::npos) << again;
 }
 
+// A plain check streams the run into its comparison; with a VCD folder the
+// run is held whole. Both must judge alike, passing and failing, to the
+// letter of the report.
+TEST(Scenarios, AStreamedCheckJudgesAsTheRunHeldWhole) {
+    const auto dir = test::scratch_dir("scenario-streamed");
+    fs::copy_file(test::source_path("golden/blink_timer1.timeline"), dir / "blink.timeline");
+    for (const std::string firmware : {"blink_timer1", "blink_timer1_ocr250"}) {
+        const fs::path path = write_blink_scenario(dir, "blink", firmware);
+        const ScenarioSpec spec = load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+        const ScenarioResult streamed = run_scenario(spec, ScenarioRunOptions{});
+        ScenarioRunOptions held_options;
+        held_options.vcd_dir = (dir / "vcd").string();
+        fs::create_directories(held_options.vcd_dir);
+        const ScenarioResult held = run_scenario(spec, held_options);
+        EXPECT_TRUE(streamed.streamed);
+        EXPECT_FALSE(held.streamed);
+        // The committed golden is this firmware's; OCR1A = 250 moves every edge.
+        EXPECT_EQ(streamed.passed, firmware == "blink_timer1") << streamed.text();
+        EXPECT_EQ(held.passed, streamed.passed);
+        ASSERT_TRUE(streamed.comparison.has_value());
+        ASSERT_TRUE(held.comparison.has_value());
+        EXPECT_EQ(streamed.comparison->report(), held.comparison->report());
+        EXPECT_EQ(streamed.failures, held.failures);
+        ASSERT_EQ(streamed.comparison->channels.size(), held.comparison->channels.size());
+        for (std::size_t i = 0; i < held.comparison->channels.size(); ++i) {
+            EXPECT_EQ(streamed.comparison->channels[i].actual_changes, held.comparison->channels[i].actual_changes)
+                << held.comparison->channels[i].signal;
+        }
+    }
+}
+
+// `golden update` streams the same way: the file written from the streamed
+// run is the one written from the run held whole, byte for byte.
+TEST(Scenarios, AStreamedGoldenUpdateWritesTheSameFileAsTheRunHeldWhole) {
+    const auto dir = test::scratch_dir("scenario-streamed-update");
+    const fs::path path = write_blink_scenario(dir, "blink", "blink_timer1");
+    const ScenarioSpec spec = load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+    ScenarioRunOptions update;
+    update.update_golden = true;
+    const ScenarioResult streamed = run_scenario(spec, update);
+    EXPECT_TRUE(streamed.streamed);
+    const std::string from_stream = test::slurp(dir / "blink.timeline");
+    update.vcd_dir = (dir / "vcd").string();
+    fs::create_directories(update.vcd_dir);
+    const ScenarioResult held = run_scenario(spec, update);
+    EXPECT_FALSE(held.streamed);
+    const std::string from_held = test::slurp(dir / "blink.timeline");
+    EXPECT_EQ(from_stream, from_held);
+    // Not empty: Timer1's OC1A on PB1 every (249 + 1) * 64 = 16000 cycles.
+    EXPECT_NE(from_stream.find("+16000 0 +16000 1"), std::string::npos) << from_stream;
+}
+
 TEST(Scenarios, CheckNeverWritesAGolden) {
     const auto dir = test::scratch_dir("scenario-no-golden");
     const fs::path scenario = write_blink_scenario(dir, "fresh", "blink_timer1");
