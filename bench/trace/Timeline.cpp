@@ -67,7 +67,7 @@ void Timeline::stream_to(EventSink sink, std::size_t batch_events) {
     if (!keep_.empty()) throw std::invalid_argument("a timeline that keeps signals when taken cannot stream to a sink");
     sink_ = std::move(sink);
     sink_batch_ = std::max<std::size_t>(1, batch_events);
-    limit_ = sink_ ? sink_batch_ : max_held_;
+    limit_ = sink_ ? sink_limit() : max_held_;
     flush_stream();
 }
 
@@ -76,10 +76,11 @@ void Timeline::flush_stream() {
     sink_(events_);
     taken_ += events_.size();
     events_.clear();
+    limit_ = sink_limit();
 }
 
 bool Timeline::make_room() {
-    if (!sink_) {
+    if (!sink_ || taken_ + events_.size() >= max_held_) {
         ++dropped_;
         return false;
     }

@@ -5,6 +5,7 @@
 // across clock domains, formatting) happens when a writer reads the timeline.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -89,13 +90,15 @@ public:
     std::string overflow_message() const;
     void set_max_held_events(std::size_t n) {
         max_held_ = n;
-        limit_ = sink_ ? sink_batch_ : max_held_;
+        limit_ = sink_ ? sink_limit() : max_held_;
     }
 
     // Streaming to a consumer that keeps what it needs (check's comparison):
     // every `batch_events` events recorded are handed to `sink` in record
-    // order and forgotten, so the timeline holds at most that many; no cap
-    // applies. flush_stream() hands over the rest. Not with keep_when_taken.
+    // order and forgotten, so the timeline holds at most that many.
+    // flush_stream() hands over the rest. The held-events cap counts what
+    // was handed over (the consumer holds it): past it events are dropped
+    // and counted as without a sink. Not with keep_when_taken.
     using EventSink = std::function<void(const std::vector<TimelineEvent>&)>;
     void stream_to(EventSink sink, std::size_t batch_events = std::size_t{1} << 16);
     void flush_stream();
@@ -160,7 +163,9 @@ private:
     std::size_t kept_ = 0;    // events_[0, kept_) were taken and kept
     std::uint64_t dropped_ = 0;
     std::size_t max_held_ = kMaxHeldEvents;
-    std::size_t limit_ = kMaxHeldEvents;  // max_held_, or the sink's batch when streaming
+    std::size_t limit_ = kMaxHeldEvents;  // max_held_, or sink_limit() when streaming
+    // The sink's batch, or less where it would pass the cap.
+    std::size_t sink_limit() const { return taken_ >= max_held_ ? 0 : std::min<std::uint64_t>(sink_batch_, max_held_ - taken_); }
     EventSink sink_;
     std::size_t sink_batch_ = 0;
     // At limit_: hands the events to the sink (true: record on), or counts a drop.

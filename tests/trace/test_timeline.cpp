@@ -118,13 +118,12 @@ namespace avrbench {
 namespace {
 
 // stream_to: every event reaches the sink once, in record order, in batches
-// of the size asked for; the timeline never holds more than a batch, and no
-// held-events cap drops anything while a sink takes them.
+// of the size asked for; the timeline never holds more than a batch, and the
+// held-events cap counts what the sink was handed.
 TEST(TimelineStream, TheSinkGetsEveryEventInOrderAndTheTimelineHoldsAtMostABatch) {
     Timeline t;
     const SignalId a = t.add_signal({"m", "PB0", SignalKind::Wire, 1, 16000000});
     const SignalId r = t.add_signal({"p", "degC", SignalKind::Real, 1, 16000000});
-    t.set_max_held_events(5);  // a cap well below the 1000 events recorded
     std::vector<TimelineEvent> got;
     std::size_t largest_batch = 0, most_held = 0;
     t.stream_to(
@@ -158,11 +157,23 @@ TEST(TimelineStream, TheSinkGetsEveryEventInOrderAndTheTimelineHoldsAtMostABatch
             EXPECT_EQ(got[c].value.bits, c % 2);
         }
     }
-    // Without the sink the cap applies again.
-    t.stream_to(nullptr);
-    for (Cycle c = 1000; c < 1010; ++c) t.record(a, c, c % 2);
-    EXPECT_EQ(t.events().size(), 5u);
-    EXPECT_EQ(t.dropped(), 5u);
+    // A cap of 1003 events handed over: 3 more, then every event is dropped.
+    t.set_max_held_events(1003);
+    for (Cycle c = 1000; c < 1020; ++c) t.record(a, c, c % 2);
+    t.flush_stream();
+    EXPECT_EQ(got.size(), 1003u);
+    EXPECT_EQ(got.back().cycle, 1002u);
+    EXPECT_EQ(t.dropped(), 17u);
+    EXPECT_TRUE(t.overflowed());
+    // Without the sink the cap applies to what the timeline holds.
+    Timeline u;
+    const SignalId b = u.add_signal({"m", "PB0", SignalKind::Wire, 1, 16000000});
+    u.stream_to([](const std::vector<TimelineEvent>&) {}, 4);
+    u.stream_to(nullptr);
+    u.set_max_held_events(5);
+    for (Cycle c = 0; c < 10; ++c) u.record(b, c, c % 2);
+    EXPECT_EQ(u.events().size(), 5u);
+    EXPECT_EQ(u.dropped(), 5u);
 }
 
 }  // namespace
