@@ -348,8 +348,9 @@ double cli_run_peak_rss_mib(const std::vector<std::string>& args, const std::str
 // --check-rss: `avrbench check` of a scenario whose golden holds `edges`
 // edges of one wire (toggle_1mhz's PB0, 1 M edges per simulated second):
 // plain (the run streamed into the comparison), failing at the first edge
-// (the diff's context read back from the held changes), and with --vcd-dir
-// (the run held whole for the waveform files), beside `golden update`.
+// (the diff's context read back from the held changes), with --vcd-dir
+// (streamed too) and with --report-dir (the run held whole for the report),
+// beside `golden update`.
 void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
     namespace fs = std::filesystem;
     const fs::path dir = fs::temp_directory_path() / ("avrbench_perf_check_" + std::to_string(getpid()));
@@ -394,8 +395,10 @@ void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
     std::printf("%-58s %12zu %14.1f\n", "check (passes; the run streamed into the comparison)", edges, check);
     const double fails = cli_run_peak_rss_mib({"check", "shifted.yaml"}, dir.string(), {1});
     std::printf("%-58s %12zu %14.1f\n", "check (differs at the first rising edge)", edges, fails);
-    const double held = cli_run_peak_rss_mib({"check", "toggle.yaml", "--vcd-dir", "vcd"}, dir.string(), {0});
-    std::printf("%-58s %12zu %14.1f\n", "check --vcd-dir (the run held whole for the VCD)", edges, held);
+    const double vcd = cli_run_peak_rss_mib({"check", "toggle.yaml", "--vcd-dir", "vcd"}, dir.string(), {0});
+    std::printf("%-58s %12zu %14.1f\n", "check --vcd-dir (the VCD written as the run goes)", edges, vcd);
+    const double held = cli_run_peak_rss_mib({"check", "toggle.yaml", "--report-dir", "report"}, dir.string(), {0});
+    std::printf("%-58s %12zu %14.1f\n", "check --report-dir (the run held whole for the report)", edges, held);
     std::error_code ec;
     fs::remove_all(dir, ec);
 }

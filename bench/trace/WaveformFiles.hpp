@@ -5,7 +5,7 @@
 //
 // The VCD is written as the run goes (VcdStream: memory does not grow with
 // the run's length) when `stream` is set, else at the end from the timeline
-// in memory (a report or a comparison needs the whole timeline anyway).
+// in memory (when a report needs the whole timeline anyway).
 #pragma once
 
 #include <memory>

@@ -86,52 +86,90 @@ std::vector<std::vector<std::string>> wire_names(const BoardSpec& spec) {
     return wires;
 }
 
-// The golden's part of a run kept as it is recorded, for a comparison that
-// needs nothing else of the timeline (no report, no VCD, no debugger): the
-// timeline streams its events here and holds none itself, so a long run costs
-// 8 bytes a wire change instead of a timeline's 24 and its copies.
-class StreamedGoldenView {
+// A run whose timeline nothing needs whole (no report, no debugger): the
+// timeline streams its events here and holds none itself. The golden's
+// signals are kept as each signal's changes for the comparison (8 bytes a
+// wire change instead of a timeline's 24 and its copies), and the VCD of
+// `--vcd-dir` is written as the run goes.
+class StreamedRun {
 public:
-    StreamedGoldenView(Timeline& timeline, const std::vector<std::string>& globs) : timeline_(timeline), globs_(globs) {
+    // `golden_globs`: the golden's signals, or nullptr without a golden;
+    // `vcd_path`: "" for no waveform files.
+    StreamedRun(Bench& bench, const std::vector<std::string>* golden_globs, const std::string& vcd_path)
+        : bench_(bench), timeline_(bench.timeline()), golden_globs_(golden_globs) {
+        if (!vcd_path.empty()) {
+            // The VCD's own timeline: the run's signals and names, fed from the stream.
+            vcd_timeline_ = std::make_unique<Timeline>(timeline_);
+            vcd_timeline_->take_events();
+            std::vector<std::string> mcu_scopes;
+            for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());
+            files_ = std::make_unique<WaveformFiles>(*vcd_timeline_, vcd_path, true, VcdOptions{}, mcu_scopes);
+            files_->start();
+        }
         timeline_.stream_to([this](const std::vector<TimelineEvent>& events) { take(events); });
     }
-    StreamedGoldenView(const StreamedGoldenView&) = delete;
-    StreamedGoldenView& operator=(const StreamedGoldenView&) = delete;
-    ~StreamedGoldenView() { timeline_.stream_to(nullptr); }
+    StreamedRun(const StreamedRun&) = delete;
+    StreamedRun& operator=(const StreamedRun&) = delete;
+    ~StreamedRun() { timeline_.stream_to(nullptr); }
+
+    bool keeps_golden() const { return golden_globs_ != nullptr; }
 
     // The run's changes of the golden's signals, once the run is over.
-    TimelineChanges finish() {
+    TimelineChanges golden_changes() {
         timeline_.flush_stream();
         map_signals();
-        for (auto& c : view_.changes) c.finish();
-        return std::move(view_);
+        for (auto& c : golden_.changes) c.finish();
+        return std::move(golden_);
+    }
+    // Ends the VCD (and writes its save file) once the run is over; its path.
+    std::string finish_vcd() {
+        timeline_.flush_stream();
+        const std::string path = files_->vcd_path();
+        files_->finish(bench_.mcu().cycle(), bench_.mcu().frequency_hz());
+        return path;
     }
 
 private:
     // Signals registered since the last batch (a board may add them as it runs).
     void map_signals() {
+        if (golden_globs_ == nullptr) return;
         const auto& signals = timeline_.signals();
         for (SignalId id = static_cast<SignalId>(map_.size()); id < signals.size(); ++id) {
-            if (!in_golden(signals[id], globs_)) {
+            if (!in_golden(signals[id], *golden_globs_)) {
                 map_.push_back(-1);
                 continue;
             }
-            map_.push_back(static_cast<long>(view_.signals.size()));
-            view_.signals.push_back(signals[id]);
-            view_.changes.emplace_back(signals[id].kind);
+            map_.push_back(static_cast<long>(golden_.signals.size()));
+            golden_.signals.push_back(signals[id]);
+            golden_.changes.emplace_back(signals[id].kind);
         }
     }
     void take(const std::vector<TimelineEvent>& events) {
         map_signals();
-        for (const TimelineEvent& e : events) {
-            if (e.signal < map_.size() && map_[e.signal] >= 0) view_.changes[static_cast<std::size_t>(map_[e.signal])].add(e);
+        if (golden_globs_ != nullptr) {
+            for (const TimelineEvent& e : events) {
+                if (e.signal < map_.size() && map_[e.signal] >= 0) golden_.changes[static_cast<std::size_t>(map_[e.signal])].add(e);
+            }
+        }
+        if (files_) {
+            for (const TimelineEvent& e : events) {
+                if (timeline_.signals()[e.signal].kind == SignalKind::Real) {
+                    vcd_timeline_->record_real(e.signal, e.cycle, e.value.real);
+                } else {
+                    vcd_timeline_->record(e.signal, e.cycle, e.value.bits);
+                }
+            }
+            files_->drain(bench_.now_ps());
         }
     }
 
+    Bench& bench_;
     Timeline& timeline_;
-    const std::vector<std::string>& globs_;
-    std::vector<long> map_;  // timeline SignalId -> index in view_, or -1
-    TimelineChanges view_;
+    const std::vector<std::string>* golden_globs_;
+    std::vector<long> map_;  // timeline SignalId -> index in golden_, or -1
+    TimelineChanges golden_;
+    std::unique_ptr<Timeline> vcd_timeline_;
+    std::unique_ptr<WaveformFiles> files_;
 };
 
 class StepRunner {
@@ -406,11 +444,12 @@ void check_golden_writable(const ScenarioSpec& spec) {
 // With `streamed`, the run's golden signals came through it and the
 // timeline holds none: the golden is read as changes and not returned.
 std::optional<ParsedTimeline> compare_with_golden(const ScenarioSpec& spec, const ScenarioRunOptions& options,
-                                                  Bench& bench, ScenarioResult& result, StreamedGoldenView* streamed) {
+                                                  Bench& bench, ScenarioResult& result, StreamedRun* streamed) {
     if (spec.golden_path.empty()) return std::nullopt;
     const TimelineHeader header = golden_header(spec, bench.mcu());
     const auto run_changes = [&] {
-        return streamed != nullptr ? streamed->finish() : timeline_changes(golden_view(bench.timeline(), spec.golden_signals));
+        return streamed != nullptr ? streamed->golden_changes()
+                                   : timeline_changes(golden_view(bench.timeline(), spec.golden_signals));
     };
     if (options.update_golden) {
         const TimelineChanges actual = run_changes();
@@ -513,10 +552,13 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         bench.host("", o);
     }
     bench.trace_board();
-    // Only the comparison (or the golden written) reads the run's timeline: it streams.
-    std::optional<StreamedGoldenView> streamed;
-    if (!spec.golden_path.empty() && options.report_dir.empty() && options.vcd_dir.empty() && !options.prepared) {
-        streamed.emplace(bench.timeline(), spec.golden_signals);
+    // Unless a report or a debugger reads the run's timeline, it streams:
+    // into the comparison (or the golden written) and the VCD.
+    std::optional<StreamedRun> streamed;
+    if ((!spec.golden_path.empty() || !options.vcd_dir.empty()) && options.report_dir.empty() && !options.prepared) {
+        // The name was checked when the file loaded: the files stay inside vcd_dir.
+        streamed.emplace(bench, spec.golden_path.empty() ? nullptr : &spec.golden_signals,
+                         options.vcd_dir.empty() ? "" : (fs::path(options.vcd_dir) / (spec.name + ".vcd")).string());
         result.streamed = true;
     }
     // Timing bounds need the profile of the MCUs they name.
@@ -554,11 +596,13 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     }
 
     const std::optional<ParsedTimeline> golden =
-        compare_with_golden(spec, options, bench, result, streamed ? &*streamed : nullptr);
+        compare_with_golden(spec, options, bench, result, streamed && streamed->keeps_golden() ? &*streamed : nullptr);
     result.simulated_s = bench.now_seconds();
     result.passed = result.failures.empty();
     if (!options.report_dir.empty()) result.report_path = write_scenario_report(spec, options.report_dir, bench, result, golden);
-    if (!options.vcd_dir.empty()) {
+    if (!options.vcd_dir.empty() && streamed) {
+        result.vcd_path = streamed->finish_vcd();
+    } else if (!options.vcd_dir.empty()) {
         // The name was checked when the file loaded: the files stay inside vcd_dir.
         std::vector<std::string> mcu_scopes;
         for (Mcu* m : bench.board().mcus()) mcu_scopes.push_back(m->name());

@@ -85,20 +85,30 @@ TEST(Scenarios, ShiftedTimerFailsNamingTheChannelAndFirstEdgeThenGoldenUpdateAcc
     EXPECT_NE(again.find("PASS blink"), std::string::npos) << again;
 }
 
-// A plain check streams the run into its comparison; with a VCD folder the
-// run is held whole. Both must judge alike, passing and failing, to the
-// letter of the report.
+// A plain check streams the run into its comparison (and its VCD); with a
+// report folder the run is held whole. Both must judge alike, passing and
+// failing, to the letter of the report, and write the same VCD.
 TEST(Scenarios, AStreamedCheckJudgesAsTheRunHeldWhole) {
     const auto dir = test::scratch_dir("scenario-streamed");
     fs::copy_file(test::source_path("golden/blink_timer1.timeline"), dir / "blink.timeline");
     for (const std::string firmware : {"blink_timer1", "blink_timer1_ocr250"}) {
         const fs::path path = write_blink_scenario(dir, "blink", firmware);
         const ScenarioSpec spec = load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
-        const ScenarioResult streamed = run_scenario(spec, ScenarioRunOptions{});
+        ScenarioRunOptions streamed_options;
+        streamed_options.vcd_dir = (dir / "streamed").string();
+        fs::create_directories(streamed_options.vcd_dir);
+        const ScenarioResult streamed = run_scenario(spec, streamed_options);
         ScenarioRunOptions held_options;
-        held_options.vcd_dir = (dir / "vcd").string();
+        held_options.vcd_dir = (dir / "held").string();
+        held_options.report_dir = (dir / "held").string();
         fs::create_directories(held_options.vcd_dir);
         const ScenarioResult held = run_scenario(spec, held_options);
+        const std::string vcd = test::slurp(dir / "streamed" / "blink.vcd");
+        EXPECT_EQ(vcd, test::slurp(dir / "held" / "blink.vcd"));
+        EXPECT_EQ(test::slurp(dir / "streamed" / "blink.gtkw"), test::slurp(dir / "held" / "blink.gtkw"));
+        // Not empty: the LED's pin and the UART are declared, and PB1 toggles.
+        EXPECT_NE(vcd.find("$var wire 1 "), std::string::npos);
+        EXPECT_NE(vcd.find("PB1"), std::string::npos);
         EXPECT_TRUE(streamed.streamed);
         EXPECT_FALSE(held.streamed);
         // The committed golden is this firmware's; OCR1A = 250 moves every edge.
@@ -127,8 +137,8 @@ TEST(Scenarios, AStreamedGoldenUpdateWritesTheSameFileAsTheRunHeldWhole) {
     const ScenarioResult streamed = run_scenario(spec, update);
     EXPECT_TRUE(streamed.streamed);
     const std::string from_stream = test::slurp(dir / "blink.timeline");
-    update.vcd_dir = (dir / "vcd").string();
-    fs::create_directories(update.vcd_dir);
+    update.report_dir = (dir / "reports").string();
+    fs::create_directories(update.report_dir);
     const ScenarioResult held = run_scenario(spec, update);
     EXPECT_FALSE(held.streamed);
     const std::string from_held = test::slurp(dir / "blink.timeline");
