@@ -114,11 +114,13 @@ public:
 
     bool keeps_golden() const { return golden_globs_ != nullptr; }
 
-    // The run's changes of the golden's signals, once the run is over.
+    // The run's changes of the golden's signals, once the run is over (once:
+    // what is recorded later is not kept).
     TimelineChanges golden_changes() {
         timeline_.flush_stream();
         map_signals();
         for (auto& c : golden_.changes) c.finish();
+        golden_globs_ = nullptr;
         return std::move(golden_);
     }
     // Ends the VCD (and writes its save file) once the run is over; its path.
