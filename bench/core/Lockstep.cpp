@@ -5,10 +5,25 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <simavr/sim_avr.h>
+#include <simavr/sim_interrupts.h>
+
 namespace avrbench {
 namespace {
 
 __extension__ using u128 = unsigned __int128;  // exact products of 64-bit cycles and 32-bit clocks
+
+// Mcu::dormant() and Mcu::next_event_cycle(), read in place: every turn
+// looks at every MCU, and the calls into Mcu.cpp and simavr were a tenth of
+// a turn's cost.
+// (avr_has_pending_interrupts is "the pending FIFO is not empty", sim_interrupts.c.)
+bool dormant_now(const avr_t* avr) {
+    return avr->state == cpu_Sleeping && avr->interrupts.pending.read == avr->interrupts.pending.write;
+}
+Cycle next_event_now(const avr_t* avr) {
+    const avr_cycle_timer_slot_p head = avr->cycle_timers.timer;
+    return head == nullptr ? ~Cycle{0} : head->when;
+}
 
 // The first cycle of `mcu` at or after `other_cycle` of `other`.
 Cycle cycle_at_time_of(const Mcu& mcu, const Mcu& other, Cycle other_cycle) {
@@ -165,13 +180,14 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
         Time runner_at = kNever;
         for (std::size_t k = 0; k < n; ++k) {
             const Mcu& m = *mcus_[k];
+            avr_t* const avr = m.avr();
             halted_[k] = m.halted();
-            present_[k] = time_of(k, m.cycle());
-            awake_[k] = !halted_[k] && !(lookahead_ && m.dormant());
-            next_[k] = awake_[k] || halted_[k] ? kNever : time_of(k, m.next_event_cycle());
+            present_[k] = time_of(k, avr->cycle);
+            awake_[k] = !halted_[k] && !(lookahead_ && dormant_now(avr));
+            next_[k] = awake_[k] || halted_[k] ? kNever : time_of(k, next_event_now(avr));
             // The MCU whose next step comes first: an awake one's present, a
             // dormant one's next event (or the run's end).
-            if (halted_[k] || m.cycle() >= end_cycles_[k]) continue;
+            if (halted_[k] || avr->cycle >= end_cycles_[k]) continue;
             const Time at = awake_[k] ? present_[k] : std::min(next_[k], time_of(k, end_cycles_[k]));
             if (runner == n || at < runner_at) {
                 runner = k;
@@ -193,7 +209,8 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
                 for (std::size_t k = 0; k < n; ++k) {
                     if (k == runner || awake_[k] || halted_[k]) continue;
                     for (const Influence& i : influenced_by_[k]) {
-                        if (earliest_action_[i.from] < earliest_action_[k] && may_wake(i, *mcus_[k])) {
+                        if (earliest_action_[i.from] < earliest_action_[k] &&
+                            (i.any_change_may_wake || may_wake(i, *mcus_[k]))) {
                             earliest_action_[k] = earliest_action_[i.from];
                             changed = true;
                         }

@@ -56,8 +56,9 @@ double HybridStepperModel::motor_torque() const {
 
 HybridStepperModel::Modes HybridStepperModel::choose_modes(const State& x) const {
     Modes modes{};
-    const double e = params_.rotor_teeth * x[kMaxWindings + 1];
-    const double g[2] = {-std::sin(e), std::cos(e)};
+    double s = 0, c = 0;
+    sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
+    const double g[2] = {-s, c};
     for (std::size_t k = 0; k < windings_.size(); ++k) {
         const WindingDrive& d = drive_[k];
         const double i = x[static_cast<Eigen::Index>(k)];
@@ -78,8 +79,8 @@ HybridStepperModel::Modes HybridStepperModel::choose_modes(const State& x) const
 HybridStepperModel::State HybridStepperModel::derivative(const State& x, const Modes& modes) const {
     State dx = State::Zero();
     const double omega = x[kMaxWindings];
-    const double e = params_.rotor_teeth * x[kMaxWindings + 1];
-    const double s = std::sin(e), c = std::cos(e);
+    double s = 0, c = 0;
+    sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
     const double g[2] = {-s, c};
     const double r = params_.resistance_ohm;
     double torque_sum = 0;
@@ -128,16 +129,18 @@ HybridStepperModel::State HybridStepperModel::rk4(const State& x, double h, cons
 double HybridStepperModel::event_value(const State& x, std::size_t k, Mode mode) const {
     const auto ki = static_cast<Eigen::Index>(k);
     if (mode != Mode::Held) return x[ki];
-    const double e = params_.rotor_teeth * x[kMaxWindings + 1];
-    const double g = windings_[k].phase == 0 ? -std::sin(e) : std::cos(e);
+    double s = 0, c = 0;
+    sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
+    const double g = windings_[k].phase == 0 ? -s : c;
     const double emf = windings_[k].sign * params_.torque_constant_nm_per_a * x[kMaxWindings] * g;
     return std::max(drive_[k].v_pos - emf, emf - drive_[k].v_neg);
 }
 
 // The direction a blocked winding starts to conduct in, at state x.
 HybridStepperModel::Mode HybridStepperModel::conducting_mode(const State& x, std::size_t k) const {
-    const double e = params_.rotor_teeth * x[kMaxWindings + 1];
-    const double g = windings_[k].phase == 0 ? -std::sin(e) : std::cos(e);
+    double s = 0, c = 0;
+    sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
+    const double g = windings_[k].phase == 0 ? -s : c;
     const double emf = windings_[k].sign * params_.torque_constant_nm_per_a * x[kMaxWindings] * g;
     return drive_[k].v_pos - emf > emf - drive_[k].v_neg ? Mode::Positive : Mode::Negative;
 }

@@ -33,6 +33,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 #include <vector>
 
@@ -107,6 +109,21 @@ private:
     // a winding current reached zero).
     double step(double h);
     void check_settled();
+    // sin and cos of the electrical angle `e`, remembered for the last angle:
+    // a step's mode choice and first RK4 stage, and the settled check after
+    // it, all ask at the same state (the same values as computing them anew).
+    void sin_cos(double e, double& s, double& c) const {
+        if (e != trig_angle_) {
+            s = std::sin(e);
+            c = std::cos(e);
+            trig_angle_ = e;
+            trig_sin_ = s;
+            trig_cos_ = c;
+            return;
+        }
+        s = trig_sin_;
+        c = trig_cos_;
+    }
 
     Params params_;
     std::vector<Winding> windings_;
@@ -116,6 +133,7 @@ private:
     bool settled_ = false;
     std::uint64_t rk4_steps_ = 0;
     std::uint64_t zero_crossings_ = 0;
+    mutable double trig_angle_ = std::numeric_limits<double>::quiet_NaN(), trig_sin_ = 0, trig_cos_ = 0;  // sin_cos
 };
 
 }  // namespace avrbench
