@@ -266,6 +266,12 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 
 }  // namespace
 
+namespace avrbench_perf {
+// perf_qemu.cpp
+std::string qemu_version();
+double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::uint32_t to_addr, std::string& why);
+}  // namespace avrbench_perf
+
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
 void run_motor_overhead(const std::string& firmware_dir, const std::string& source_dir, int repeats, double scale);
 void run_printer_lockstep(const std::string& firmware_dir, const std::string& source_dir, int repeats);
@@ -403,6 +409,66 @@ void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
     fs::remove_all(dir, ec);
 }
 
+// --mips: MIPS on the same ELF, busy_poll_passes (busy_poll's loop for a
+// fixed 20 M passes, then power-down with interrupts off at busy_poll_done):
+// the bench as (b) runs it (every pin traced, the VCD streamed), bare simavr
+// as (a), and qemu-system-avr (perf_qemu.cpp: from main to busy_poll_done,
+// QEMU's TCG, not cycle-exact). The instructions are the bench's count to
+// the end (all three run the same program to the same place); CPU seconds,
+// median of `repeats` interleaved runs of each.
+void run_mips(const std::string& firmware_dir, int repeats, const std::string& vcd_path) {
+    const std::string path = firmware_dir + "/busy_poll_passes.elf";
+    const auto elf = avrbench::ElfImage::load(path);
+    const auto main_addr = elf.symbol_address("main"), done_addr = elf.symbol_address("busy_poll_done");
+    if (!main_addr || !done_addr) {
+        std::fprintf(stderr, "avrbench_perf: %s has no main or busy_poll_done\n", path.c_str());
+        return;
+    }
+    // The work: instructions and cycles to the end (the core halts at the SLEEP).
+    std::uint64_t instructions = 0;
+    avr_cycle_count_t cycles = 0;
+    {
+        avrbench::Mcu mcu(elf);
+        while (mcu.run_until(mcu.cycle() + mcu.frequency_hz()) != avrbench::StopReason::Halted) {
+        }
+        instructions = mcu.steps();
+        cycles = mcu.cycle();
+    }
+    const std::string qemu = avrbench_perf::qemu_version();
+    std::vector<double> bare, bench, emu;
+    std::string why;
+    std::uint64_t events = 0;
+    for (int i = 0; i < repeats; ++i) {
+        bench.push_back(run_avrbench(elf, cycles, vcd_path, &events));
+        bare.push_back(run_bare_simavr(elf, cycles));
+        if (!qemu.empty() && why.empty()) {
+            const double s = avrbench_perf::qemu_cpu_seconds(path, *main_addr, *done_addr, why);
+            if (s > 0) emu.push_back(s);
+        }
+    }
+    std::filesystem::remove(vcd_path);
+    std::printf("busy_poll_passes: %.1f M AVR instructions, %.1f M cycles (%.2f s at 16 MHz); CPU seconds, median of %d "
+                "interleaved runs\n",
+                static_cast<double>(instructions) / 1e6, static_cast<double>(cycles) / 1e6, static_cast<double>(cycles) / 16e6,
+                repeats);
+    std::printf("%-56s %9s %9s %12s\n", "side", "CPU s", "MIPS", "CPU / bench");
+    const double b = median(bench);
+    const auto row = [&](const std::string& name, double cpu) {
+        std::printf("%-56s %9.3f %9.1f %12.3f\n", name.c_str(), cpu, static_cast<double>(instructions) / cpu / 1e6,
+                    cpu / b);
+    };
+    row("avrbench (every pin and USART0 traced, VCD streamed)", b);
+    row("bare simavr (run_avr's loop)", median(bare));
+    if (qemu.empty()) {
+        std::printf("%-56s (not installed: bash ci/setup --perf)\n", "qemu-system-avr");
+    } else if (emu.empty()) {
+        std::printf("%-56s (failed: %s)\n", "qemu-system-avr", why.c_str());
+    } else {
+        row(qemu + " (TCG, not cycle-exact)", median(emu));
+    }
+    std::printf("(CPU / bench: the row's CPU time over the bench's; below 1 the row is faster than the bench)\n");
+}
+
 // --rss: the CLI's peak memory streaming a VCD of 1 M events per simulated second.
 void run_rss_rows(const std::vector<double>& rss_seconds, const std::string& firmware_dir, const std::string& vcd_path) {
     std::printf("%-44s %9s %14s\n", "avrbench run toggle_1mhz --trace-only PB0 --vcd", "sim s", "peak RSS MiB");
@@ -492,6 +558,8 @@ int perf_main(int argc, char** argv) {
     app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lookahead, strict, one MCU, the CLI)");
     bool printer_part_once = false;
     app.add_flag("--printer-part-once", printer_part_once, "the printer's part job once, lookahead (for callgrind)");
+    bool only_mips = false;
+    app.add_flag("--mips", only_mips, "only MIPS on busy_poll_passes: the bench, bare simavr and qemu-system-avr");
     std::size_t check_rss_edges = 0;
     app.add_option("--check-rss", check_rss_edges, "peak RSS of avrbench check and golden update on a run of this many edges");
     std::vector<double> rss_seconds;
@@ -518,6 +586,10 @@ int perf_main(int argc, char** argv) {
     }
     if (compare_edges > 0) {
         run_compare_rows(compare_edges);
+        return 0;
+    }
+    if (only_mips) {
+        run_mips(firmware_dir, repeats, vcd_path);
         return 0;
     }
     if (check_rss_edges > 0) {

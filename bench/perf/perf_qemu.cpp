@@ -1,0 +1,157 @@
+// qemu-system-avr on the same ELF as the bench, for `avrbench_perf --mips`:
+// QEMU's TCG (a JIT, not cycle-exact) runs the program until the PC leaves
+// its work loop for the end label; QEMU's own CPU time (utime + stime from
+// /proc/<pid>/stat) from its start to then is the measure.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace avrbench_perf {
+namespace {
+
+pid_t spawn(const std::vector<std::string>& argv, const std::string& out_path) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int out = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int null_in = open("/dev/null", O_RDONLY);
+        dup2(null_in, STDIN_FILENO);
+        dup2(out, STDOUT_FILENO);
+        dup2(out, STDERR_FILENO);
+        std::vector<char*> args;
+        for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+        args.push_back(nullptr);
+        execvp(args[0], args.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+// "qemu-system-avr <version>" from `qemu-system-avr --version`, or "" when it does not run.
+std::string qemu_version() {
+    const auto out = (std::filesystem::temp_directory_path() / ("avrbench_perf_qemu_version_" + std::to_string(getpid()))).string();
+    const pid_t pid = spawn({"qemu-system-avr", "--version"}, out);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    std::string text = slurp(out);
+    std::filesystem::remove(out);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return "";
+    // "QEMU emulator version 7.2.22 (Debian ...)" -> "qemu-system-avr 7.2.22"
+    std::istringstream words(text.substr(0, text.find('\n')));
+    std::string word, version;
+    while (words >> word) {
+        if (word == "version") words >> version;
+    }
+    return "qemu-system-avr " + (version.empty() ? std::string("?") : version);
+}
+
+// QEMU's CPU seconds (utime + stime of its process) from its start to the
+// PC leaving [from_addr, to_addr) once seen inside (flash byte addresses:
+// the program's main and its end label) on an Arduino UNO machine, polled
+// through QEMU's monitor every 5 ms; -1 with `why` set when it cannot.
+// (A debugger's breakpoints would mark the two places exactly, but with
+// QEMU's gdb stub attached its TCG ran the same loop 4x slower: measured
+// 3.2 s against 0.8 s on busy_poll_passes.) The poll can add up to 5 ms and
+// a clock tick (10 ms) to QEMU's time: about 2 % of a 0.8 s run.
+double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::uint32_t to_addr, std::string& why) {
+    int to_qemu[2], from_qemu[2];
+    if (pipe(to_qemu) != 0 || pipe(from_qemu) != 0) {
+        why = "no pipes";
+        return -1;
+    }
+    const pid_t qemu = fork();
+    if (qemu == 0) {
+        dup2(to_qemu[0], STDIN_FILENO);
+        dup2(from_qemu[1], STDOUT_FILENO);
+        dup2(from_qemu[1], STDERR_FILENO);
+        close(to_qemu[1]);
+        close(from_qemu[0]);
+        // Paused (-S) until `cont`, so its time is counted from the start of the program.
+        execlp("qemu-system-avr", "qemu-system-avr", "-M", "uno", "-bios", elf.c_str(), "-display", "none", "-serial",
+               "none", "-monitor", "stdio", "-S", static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    close(to_qemu[0]);
+    close(from_qemu[1]);
+    fcntl(from_qemu[0], F_SETFL, O_NONBLOCK);
+    const std::string stat = "/proc/" + std::to_string(qemu) + "/stat";
+    const auto ticks = [&stat]() -> long long {
+        const std::string text = slurp(stat);
+        // Fields 14 and 15: utime and stime in clock ticks, after the command
+        // name in parentheses (which may hold spaces).
+        const auto close_paren = text.rfind(')');
+        if (close_paren == std::string::npos) return -1;
+        std::istringstream fields(text.substr(close_paren + 2));
+        std::string f;
+        long long sum = 0;
+        for (int field = 3; fields >> f && field <= 15; ++field) {
+            if (field >= 14) sum += std::stoll(f);
+        }
+        return sum;
+    };
+    const auto say = [&](const char* command) { return write(to_qemu[1], command, std::strlen(command)) > 0; };
+    std::string out;
+    const auto read_some = [&] {
+        char buf[4096];
+        for (ssize_t n; (n = read(from_qemu[0], buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
+    };
+    // The PC in the latest `info registers` answer ("PC:    00009c"), or -1.
+    const auto last_pc = [&out]() -> long {
+        const auto at = out.rfind("PC:");
+        if (at == std::string::npos) return -1;
+        return std::strtol(out.c_str() + at + 3, nullptr, 16);
+    };
+    double seconds = -1;
+    bool started = false;  // the PC seen inside the work (the start-up code runs before it)
+    const long long start = ticks();
+    if (start >= 0 && say("cont\n")) {
+        for (int poll = 0; poll < 60 * 200; ++poll) {  // at most a minute of wall time
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            const long long now = ticks();
+            out.clear();
+            if (!say("info registers\n")) break;
+            for (int wait = 0; wait < 200 && last_pc() < 0; ++wait) {
+                std::this_thread::sleep_for(std::chrono::microseconds(250));
+                read_some();
+            }
+            const long pc = last_pc();
+            if (pc < 0) break;
+            const bool inside = pc >= static_cast<long>(from_addr) && pc < static_cast<long>(to_addr);
+            if (inside) started = true;
+            if (started && !inside) {
+                seconds = static_cast<double>(now - start) / static_cast<double>(sysconf(_SC_CLK_TCK));
+                break;
+            }
+        }
+    }
+    if (seconds < 0) why = "qemu-system-avr did not run from main past busy_poll_done's loop";
+    kill(qemu, SIGKILL);
+    int status = 0;
+    waitpid(qemu, &status, 0);
+    close(to_qemu[1]);
+    close(from_qemu[0]);
+    return seconds;
+}
+
+}  // namespace avrbench_perf
