@@ -170,6 +170,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     extint_ = reinterpret_cast<avr_extint_t*>(find_io_module(avr_, "extint"));
     acomp_ = reinterpret_cast<avr_acomp_t*>(find_io_module(avr_, "ac"));
     if (options_.skip_idle_loops && !options_.reference_run_loop) skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
+    if (options_.predecoded_core && !options_.reference_run_loop) predecoded_ = std::make_unique<PredecodedCore>(avr_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
@@ -303,7 +304,7 @@ Cycle Mcu::cycles_from_seconds(double seconds) const {
 bool Mcu::step() {
     if (halted_) return false;
     const std::uint32_t pc_before = avr_->pc;
-    SimavrStepper stepper(avr_);
+    SimavrStepper stepper(avr_, predecoded_.get());
     const int state = options_.reference_run_loop ? stepper.reference_step() : stepper.step();
     ++steps_;
     check_after_step(state, pc_before);
@@ -376,7 +377,7 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     if (avr->cycle < target_cycle) avr_cycle_timer_register(avr, target_cycle - avr->cycle, &horizon_timer, this);
     run_target_ = target_cycle;
     const bool reference = options_.reference_run_loop;
-    SimavrStepper stepper(avr);
+    SimavrStepper stepper(avr, predecoded_.get());
     // One unsigned comparison covers PC = 0 (a reset) and PC past the program.
     const std::uint32_t code_end_minus_one = code_end_bytes_ - 1;
     // The crash oracles after an instruction; findings that halt also
@@ -432,14 +433,42 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         const std::uint8_t* const data = avr->data;
         const std::uint16_t stack_floor = stack_floor_;
         const std::uint32_t bad_interrupt_pc = bad_interrupt_pc_;
+        PredecodedCore* const core = predecoded_.get();
         while (countdown > 1) {  // at 1 the general step ticks the skipper
             // In front of SLEEP: the general step above stops there.
             if constexpr (kStopAtSleep) {
                 if (opcode_at(avr, avr->pc) == kSleepOpcode) break;
             }
+            if (core != nullptr) {
+                // The predecoded core's run of instructions it executes
+                // itself: the checks below, made inside its loop. It stops
+                // in front of one for avr_run_one, which the step below takes.
+                const PredecodedCore::BatchLimits limits{avr->cycle_timers.timer->when, countdown - 1, code_end_minus_one,
+                                                         bad_interrupt_pc, stack_floor};
+                const PredecodedCore::Batch batch = core->run_batch<kCover>(avr, limits, edges);
+                countdown -= batch.steps;
+                if (batch.ended == PredecodedCore::Ended::TimerDue) {
+                    const std::uint32_t fast_pc_before = avr->pc;
+                    check(stepper.finish(batch.new_pc), fast_pc_before);
+                    if constexpr (kCover) edges->hit(avr->pc);
+                    break;
+                }
+                if (batch.ended == PredecodedCore::Ended::CheckPc) {
+                    const std::uint32_t fast_pc_before = avr->pc;
+                    avr->pc = batch.new_pc;
+                    check_after_step(cpu_Running, fast_pc_before);
+                    if constexpr (kCover) edges->hit(batch.new_pc);
+                    if (stop_requested_) break;
+                    continue;
+                }
+                if (batch.ended == PredecodedCore::Ended::Count || countdown <= 1) continue;
+                if constexpr (kStopAtSleep) {
+                    if (opcode_at(avr, avr->pc) == kSleepOpcode) break;
+                }
+            }
             --countdown;
-            // avr_run_one leaves avr->pc alone: it still holds the PC before the instruction.
-            const std::uint32_t pc = avr_run_one(avr);
+            // avr_run_one (or the predecoded core) leaves avr->pc alone: it still holds the PC before the instruction.
+            const std::uint32_t pc = stepper.run_one();
             // Never null here: the horizon timer stays in the list until run_until
             // cancels it (only a reset drops it, and resets happen in timers).
             const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;

@@ -33,6 +33,7 @@ namespace avrbench {
 class Adc;
 class DebugHook;
 class IdleLoopSkipper;
+class PredecodedCore;
 class TimingProfiler;
 class Mcu;
 class Twi;
@@ -49,6 +50,11 @@ struct McuOptions {
     // (core/IdleLoopSkip.hpp); exact, so on unless a test compares without.
     // The reference run loop never skips.
     bool skip_idle_loops = true;
+    // Execute instructions on core/PredecodedCore (decoded once per flash
+    // word; proven to do what simavr's avr_run_one does) or, with false, on
+    // avr_run_one itself (`--simavr-core`; kept selectable for one release).
+    // The reference run loop always uses avr_run_one.
+    bool predecoded_core = true;
     // Fuse bytes low, high, extended (e.g. an UNO's 0xFF, 0xDE, 0xFD);
     // replace the ELF's .fuse section when given.
     std::optional<std::array<std::uint8_t, 3>> fuses;
@@ -103,6 +109,8 @@ public:
     std::uint32_t frequency_hz() const { return frequency_hz_; }
     const ElfImage& elf() const { return elf_; }
     avr_t* avr() const { return avr_; }
+    // The predecoded instruction core, nullptr on avr_run_one (McuOptions::predecoded_core).
+    const PredecodedCore* predecoded_core() const { return predecoded_.get(); }
 
     // Inline (the lockstep asks each MCU its cycle several times per turn):
     // a pointer to simavr's own counter, set when the core is made.
@@ -298,6 +306,7 @@ private:
     std::unique_ptr<Adc> adc_;
     std::unique_ptr<Twi> twi_;
     std::unique_ptr<IdleLoopSkipper> skipper_;  // nullptr: never skip
+    std::unique_ptr<PredecodedCore> predecoded_;  // nullptr: avr_run_one (McuOptions::predecoded_core)
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;

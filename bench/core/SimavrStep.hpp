@@ -30,11 +30,20 @@ extern "C" {
 #include <sim_interrupts.h>
 }
 
+#include "core/PredecodedCore.hpp"
+
 namespace avrbench {
 
 class SimavrStepper {
 public:
-    explicit SimavrStepper(avr_t* avr) : avr_(avr) { recheck(); }
+    // With `core`, an instruction is PredecodedCore::run_one (avr_run_one's
+    // contract, proven equal); without, simavr's avr_run_one.
+    explicit SimavrStepper(avr_t* avr, PredecodedCore* core = nullptr) : avr_(avr), core_(core) { recheck(); }
+
+    // One instruction: avr_run_one or the predecoded core.
+    __attribute__((always_inline)) avr_flashaddr_t run_one() {
+        return core_ != nullptr ? core_->run_one(avr_) : avr_run_one(avr_);
+    }
 
     __attribute__((always_inline)) int step() {
         avr_t* const avr = avr_;
@@ -44,7 +53,7 @@ public:
             return state;
         }
         avr_flashaddr_t new_pc = avr->pc;
-        if (avr->state == cpu_Running) new_pc = avr_run_one(avr);
+        if (avr->state == cpu_Running) new_pc = run_one();
         return finish(new_pc);
     }
 
@@ -117,6 +126,7 @@ private:
     void recheck() { raw_ = avr_->run == &avr_callback_run_raw && avr_->run_cycle_limit == 1; }
 
     avr_t* avr_;
+    PredecodedCore* core_;
     bool raw_ = false;
 };
 

@@ -1,0 +1,252 @@
+#include "core/PredecodedCore.hpp"
+
+#include <new>
+
+#include "core/Mcu.hpp"
+
+namespace avrbench {
+
+PredecodedCore::PredecodedCore(const avr_t* avr) {
+    // One slot per flash word; calloc leaves untouched pages unmapped and
+    // zero is kUndecoded, so only the code that runs costs memory.
+    const std::size_t words = static_cast<std::size_t>(avr->flashend) / 2 + 2;
+    slots_.reset(static_cast<Slot*>(std::calloc(words, sizeof(Slot))));
+    if (!slots_) throw std::bad_alloc();
+}
+
+// The dispatch tree of simavr 1.6's avr_run_one (sim_core.c), in its order,
+// so that every opcode lands where simavr's switch sends it; the leaves this
+// core does not execute itself are kSimavr.
+PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opcode, avr_flashaddr_t pc) {
+    Slot s{};
+    s.word = opcode;
+    s.kind = kSimavr;
+    const auto d5 = [&] { return static_cast<std::uint8_t>((opcode >> 4) & 0x1f); };
+    const auto r5 = [&] { return static_cast<std::uint8_t>(((opcode >> 5) & 0x10) | (opcode & 0xf)); };
+    const auto set = [&](Kind kind, unsigned a, unsigned b) {
+        s.kind = kind;
+        s.a = static_cast<std::uint8_t>(a);
+        s.b = static_cast<std::uint8_t>(b);
+    };
+    const avr_flashaddr_t next_pc = pc + 2;
+    switch (opcode & 0xf000) {
+        case 0x0000:
+            if (opcode == 0x0000) {
+                s.kind = kNop;
+                break;
+            }
+            switch (opcode & 0xfc00) {
+                case 0x0400: set(kCpc, d5(), r5()); break;
+                case 0x0c00: set(kAdd, d5(), r5()); break;
+                case 0x0800: set(kSbc, d5(), r5()); break;
+                default:
+                    switch (opcode & 0xff00) {
+                        case 0x0100: set(kMovw, ((opcode >> 4) & 0xf) << 1, (opcode & 0xf) << 1); break;
+                        case 0x0200: set(kMuls, 16 + ((opcode >> 4) & 0xf), 16 + (opcode & 0xf)); break;
+                        case 0x0300: {
+                            const unsigned d = 16 + ((opcode >> 4) & 0x7), r = 16 + (opcode & 0x7);
+                            switch (opcode & 0x88) {
+                                case 0x00: set(kMulsu, d, r); break;
+                                case 0x08: set(kFmul, d, r); break;
+                                case 0x80: set(kFmuls, d, r); break;
+                                default: set(kFmulsu, d, r); break;
+                            }
+                        } break;
+                        default: break;  // invalid
+                    }
+            }
+            break;
+        case 0x1000:
+            switch (opcode & 0xfc00) {
+                case 0x1800: set(kSub, d5(), r5()); break;
+                case 0x1000: set(kCpse, d5(), r5()); break;
+                case 0x1400: set(kCp, d5(), r5()); break;
+                case 0x1c00: set(kAdc, d5(), r5()); break;
+                default: break;
+            }
+            break;
+        case 0x2000:
+            switch (opcode & 0xfc00) {
+                case 0x2000: set(kAnd, d5(), r5()); break;
+                case 0x2400: set(kEor, d5(), r5()); break;
+                case 0x2800: set(kOr, d5(), r5()); break;
+                case 0x2c00: set(kMov, d5(), r5()); break;
+                default: break;
+            }
+            break;
+        case 0x3000: case 0x4000: case 0x5000: case 0x6000: case 0x7000: {
+            const unsigned h = 16 + ((opcode >> 4) & 0xf);
+            const unsigned k = ((opcode & 0x0f00) >> 4) | (opcode & 0xf);
+            const Kind kinds[] = {kCpi, kSbci, kSubi, kOri, kAndi};
+            set(kinds[((opcode & 0xf000) >> 12) - 3], h, k);
+        } break;
+        case 0xa000:
+        case 0x8000: {
+            const unsigned q = ((opcode & 0x2000) >> 8) | ((opcode & 0x0c00) >> 7) | (opcode & 0x7);
+            const bool store = (opcode & 0x0200) != 0;
+            switch (opcode & 0xd008) {
+                case 0xa000: case 0x8000: set(store ? kStdZ : kLddZ, d5(), q); break;
+                case 0xa008: case 0x8008: set(store ? kStdY : kLddY, d5(), q); break;
+                default: break;
+            }
+        } break;
+        case 0x9000:
+            if ((opcode & 0xff0f) == 0x9408) {
+                const unsigned bit = (opcode >> 4) & 7;
+                if (bit != S_I) set((opcode & 0x0080) ? kSregClear : kSregSet, 0, bit);
+                break;  // SEI/CLI change the interrupt state: simavr
+            }
+            switch (opcode) {
+                case 0x9588:  // SLEEP
+                case 0x9598:  // BREAK
+                case 0x95a8:  // WDR
+                case 0x95e8:  // SPM
+                case 0x9419:  // EIJMP
+                case 0x9519:  // EICALL
+                case 0x9518:  // RETI
+                case 0x95d8:  // ELPM
+                    break;
+                case 0x9409: s.kind = kIjmp; break;
+                case 0x9509: s.kind = kIcall; break;
+                case 0x9508: s.kind = kRet; break;
+                case 0x95c8: s.kind = kLpmR0; break;
+                default:
+                    switch (opcode & 0xfe0f) {
+                        case 0x9000: set(kLds, d5(), 0); break;
+                        case 0x9004: set(kLpm, d5(), 0); break;
+                        case 0x9005: set(kLpmInc, d5(), 0); break;
+                        case 0x9006: case 0x9007: break;  // ELPM
+                        case 0x900c: case 0x900d: case 0x900e: set(kLdX, d5(), opcode & 3); break;
+                        case 0x920c: case 0x920d: case 0x920e: set(kStX, d5(), opcode & 3); break;
+                        case 0x9009: case 0x900a: set(kLdY, d5(), opcode & 3); break;
+                        case 0x9209: case 0x920a: set(kStY, d5(), opcode & 3); break;
+                        case 0x9200: set(kSts, d5(), 0); break;
+                        case 0x9001: case 0x9002: set(kLdZ, d5(), opcode & 3); break;
+                        case 0x9201: case 0x9202: set(kStZ, d5(), opcode & 3); break;
+                        case 0x900f: set(kPop, d5(), 0); break;
+                        case 0x920f: set(kPush, d5(), 0); break;
+                        case 0x9400: set(kCom, d5(), 0); break;
+                        case 0x9401: set(kNeg, d5(), 0); break;
+                        case 0x9402: set(kSwap, d5(), 0); break;
+                        case 0x9403: set(kInc, d5(), 0); break;
+                        case 0x9405: set(kAsr, d5(), 0); break;
+                        case 0x9406: set(kLsr, d5(), 0); break;
+                        case 0x9407: set(kRor, d5(), 0); break;
+                        case 0x940a: set(kDec, d5(), 0); break;
+                        case 0x940c: case 0x940d:
+                            s.kind = kJmp;
+                            s.c = static_cast<std::uint8_t>(((opcode & 0x01f0) >> 3) | (opcode & 1));
+                            break;
+                        case 0x940e: case 0x940f:
+                            s.kind = kCall;
+                            s.c = static_cast<std::uint8_t>(((opcode & 0x01f0) >> 3) | (opcode & 1));
+                            break;
+                        default:
+                            switch (opcode & 0xff00) {
+                                case 0x9600: case 0x9700: {
+                                    const unsigned p = 24 + ((opcode >> 3) & 0x6);
+                                    const unsigned k = ((opcode & 0x00c0) >> 2) | (opcode & 0xf);
+                                    set((opcode & 0xff00) == 0x9600 ? kAdiw : kSbiw, p, k);
+                                } break;
+                                case 0x9800: case 0x9a00: break;  // CBI, SBI: read-modify-write of I/O
+                                case 0x9900: case 0x9b00: {
+                                    const unsigned io = ((opcode >> 3) & 0x1f) + 32;
+                                    set((opcode & 0xff00) == 0x9900 ? kSbic : kSbis, io, 1u << (opcode & 0x7));
+                                } break;
+                                default:
+                                    if ((opcode & 0xfc00) == 0x9c00) set(kMul, d5(), r5());
+                                    break;
+                            }
+                    }
+            }
+            break;
+        case 0xb000: {
+            const unsigned A = ((((opcode >> 9) & 3) << 4) | (opcode & 0xf)) + 32;
+            switch (opcode & 0xf800) {
+                case 0xb800: set(kOut, A, d5()); break;
+                case 0xb000: set(kIn, d5(), A); break;
+                default: break;
+            }
+        } break;
+        case 0xc000:
+        case 0xd000: {
+            const std::int16_t o = static_cast<std::int16_t>(static_cast<std::int16_t>((opcode << 4) & 0xffff) >> 3);
+            s.kind = (opcode & 0xf000) == 0xc000 ? kRjmp : kRcall;
+            s.target = (next_pc + o) % (avr->flashend + 1);
+        } break;
+        case 0xe000: set(kLdi, 16 + ((opcode >> 4) & 0xf), ((opcode & 0x0f00) >> 4) | (opcode & 0xf)); break;
+        case 0xf000:
+            switch (opcode & 0xfe00) {
+                case 0xf000: case 0xf200: case 0xf400: case 0xf600: {
+                    // simavr's `case 0xf100` (its flash-overflow opcode 0xF1F1)
+                    // can never match under this mask: 0xF1F1 is a branch.
+                    const std::int16_t o = static_cast<std::int16_t>(static_cast<std::int16_t>(static_cast<std::uint32_t>(opcode) << 6) >> 9);
+                    const bool if_set = (opcode & 0x0400) == 0;
+                    set(if_set ? kBrbs : kBrbc, 0, opcode & 7);
+                    s.target = next_pc + (o << 1);
+                } break;
+                case 0xf800: case 0xf900: set(kBld, d5(), opcode & 7); break;
+                case 0xfa00: case 0xfb00: set(kBst, d5(), opcode & 7); break;
+                case 0xfc00: case 0xfe00: set((opcode & 0x0200) ? kSbrs : kSbrc, d5(), opcode & 7); break;
+                default: break;
+            }
+            break;
+        default: break;
+    }
+    if (moves_sp(s.kind)) s.flags |= kMovesSp;
+    return s;
+}
+
+template <bool kCover>
+PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& limits, PcEdgeMap* edges) {
+    using predecoded_detail::sp_of;
+    Batch batch;
+    const predecoded_detail::Machine m(avr);
+    // With SP already below the floor (a half-written SP, which the oracle
+    // lets pass) every step needs the oracle: the general step takes them.
+    if (sp_of(m.data) < limits.stack_floor) return batch;
+    // The PC and the cycle count live in registers until the batch ends:
+    // nothing executed here reads them from avr_t.
+    avr_flashaddr_t pc = avr->pc;
+    avr_cycle_count_t cycle = avr->cycle;
+    Slot* const slots = slots_.get();
+    const avr_cycle_count_t cycle_limit = limits.cycle;
+    const std::uint32_t max_steps = limits.max_steps;
+    // A PC past the flash is avr_run_one's (it crashes the core). Inside the
+    // loop the PC stays below the code's end (the CheckPc test), which is
+    // within the flash.
+    if (pc >= m.flashend || limits.code_end_minus_one > m.flashend) return batch;
+    while (batch.steps < max_steps) {
+        const Slot& slot = *slot_at(slots, m, pc);
+        avr_flashaddr_t new_pc;
+        int cycles;
+        if (!execute(m, slot, pc, new_pc, cycles)) break;  // Ended::HandOver
+        cycle += static_cast<avr_cycle_count_t>(cycles);
+        ++batch.steps;
+        if (__builtin_expect(cycle >= cycle_limit, 0)) {
+            batch.ended = Ended::TimerDue;
+            batch.new_pc = new_pc;
+            break;
+        }
+        // SP only changes through the kinds that store to the data space.
+        if (__builtin_expect(new_pc - 1 >= limits.code_end_minus_one || new_pc == limits.bad_interrupt_pc ||
+                                 ((slot.flags & kMovesSp) && sp_of(m.data) < limits.stack_floor),
+                             0)) {
+            batch.ended = Ended::CheckPc;
+            batch.new_pc = new_pc;
+            break;
+        }
+        pc = new_pc;
+        if constexpr (kCover) edges->hit(new_pc);
+        else (void)edges;
+    }
+    if (batch.ended == Ended::HandOver && batch.steps == max_steps) batch.ended = Ended::Count;
+    avr->pc = pc;
+    avr->cycle = cycle;
+    return batch;
+}
+
+template PredecodedCore::Batch PredecodedCore::run_batch<false>(avr_t*, const BatchLimits&, PcEdgeMap*);
+template PredecodedCore::Batch PredecodedCore::run_batch<true>(avr_t*, const BatchLimits&, PcEdgeMap*);
+
+}  // namespace avrbench

@@ -1,0 +1,149 @@
+// core/PredecodedCore against simavr's avr_run_one, instruction by
+// instruction: every firmware the build makes runs on two MCUs, one on each
+// core, with the same serial input, and after every instruction the two
+// must agree on the cycle, PC, core state, interrupt state, all eight SREG
+// flags, the 32 registers and SP; every 64 instructions and at the end on
+// all of data memory (registers, I/O, RAM). Anything the predecoded core
+// does not execute itself it hands to avr_run_one, so the test also counts
+// what it did execute: nearly all instructions, and every kind of
+// instruction it has, somewhere in the firmware set (core_sweep exists to
+// reach the kinds compiled C rarely emits, over all operand pairs).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstring>
+#include <set>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include <sim_avr.h>
+}
+
+#include "core/ElfImage.hpp"
+#include "core/Errors.hpp"
+#include "core/Mcu.hpp"
+#include "core/PredecodedCore.hpp"
+#include "support/EveryFirmware.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+struct Compared {
+    std::uint64_t instructions = 0;
+    std::uint64_t handed = 0;
+    std::set<int> kinds;
+};
+
+// Runs `name` on both cores for up to `max_steps` instructions; the first
+// difference fails the test with the instruction's PC and cycle.
+void run_both(const std::string& name, std::uint64_t max_steps, Compared& out) {
+    const ElfImage elf = ElfImage::load(test::firmware(name));
+    McuOptions simavr_options, predecoded_options;
+    simavr_options.predecoded_core = false;
+    simavr_options.skip_idle_loops = predecoded_options.skip_idle_loops = false;
+    test::set_board_mcu(name, elf, simavr_options);
+    test::set_board_mcu(name, elf, predecoded_options);
+    Mcu ref(elf, simavr_options), fast(elf, predecoded_options);
+    ASSERT_EQ(ref.predecoded_core(), nullptr);
+    ASSERT_NE(fast.predecoded_core(), nullptr);
+    for (Mcu* m : {&ref, &fast}) {
+        try {
+            m->uart(0).send("G1 X1\n?\nM105\nhello\n");
+        } catch (const BadInput&) {
+            // an MCU without USART0
+        }
+    }
+    const avr_t* a = ref.avr();
+    const avr_t* b = fast.avr();
+    const std::size_t data_size = static_cast<std::size_t>(a->ramend) + 1;
+    std::uint64_t step = 0;
+    for (; step < max_steps; ++step) {
+        const avr_flashaddr_t pc = a->pc;
+        const Cycle cycle = a->cycle;
+        if (a->state == cpu_Running && pc < a->flashend) {
+            const std::uint16_t word = static_cast<std::uint16_t>(a->flash[pc] | (a->flash[pc + 1] << 8));
+            out.kinds.insert(PredecodedCore::decode(a, word, pc).kind);
+        }
+        const bool ref_alive = ref.step();
+        const bool fast_alive = fast.step();
+        const auto where = [&] {
+            return name + ": instruction " + std::to_string(step) + " at PC 0x" + [&] {
+                char hex[16];
+                std::snprintf(hex, sizeof hex, "%04x", pc);
+                return std::string(hex);
+            }() + ", cycle " + std::to_string(cycle);
+        };
+        ASSERT_EQ(ref_alive, fast_alive) << where();
+        ASSERT_EQ(a->cycle, b->cycle) << where();
+        ASSERT_EQ(a->pc, b->pc) << where();
+        ASSERT_EQ(a->state, b->state) << where();
+        ASSERT_EQ(a->interrupt_state, b->interrupt_state) << where();
+        ASSERT_EQ(0, std::memcmp(a->sreg, b->sreg, sizeof a->sreg)) << where() << ": SREG differs";
+        ASSERT_EQ(0, std::memcmp(a->data, b->data, 32)) << where() << ": registers differ";
+        ASSERT_EQ(a->data[R_SPL], b->data[R_SPL]) << where();
+        ASSERT_EQ(a->data[R_SPH], b->data[R_SPH]) << where();
+        if ((step & 63) == 0) {
+            ASSERT_EQ(0, std::memcmp(a->data, b->data, data_size)) << where() << ": data memory differs";
+        }
+        if (!ref_alive) break;
+    }
+    ASSERT_EQ(0, std::memcmp(a->data, b->data, data_size)) << name << ": data memory differs at the end";
+    EXPECT_EQ(ref.findings().size(), fast.findings().size()) << name;
+    out.instructions += step;
+    out.handed += fast.predecoded_core()->handed_to_simavr();
+}
+
+TEST(PredecodedCore, MatchesAvrRunOneInstructionByInstructionOnEveryFirmware) {
+    const auto names = test::all_firmware();
+    ASSERT_GT(names.size(), 100u);  // the build's whole firmware set
+    Compared total;
+    for (const auto& name : names) {
+        // 200 000 instructions: past every firmware's start-up (clearing
+        // .bss, copying .data, setting up peripherals) into its main loop
+        // and its first interrupts; core_sweep to its end.
+        run_both(name, name == "core_sweep" ? 100'000'000 : 200'000, total);
+        if (::testing::Test::HasFatalFailure()) return;
+    }
+    // The predecoded core executed most instructions itself (the rest are
+    // I/O with callbacks, SEI/CLI/RETI, SLEEP...), so the comparison
+    // compared it, not avr_run_one with itself.
+    EXPECT_LT(total.handed * 4, total.instructions) << total.handed << " of " << total.instructions << " handed to avr_run_one";
+    // Every kind the core executes itself ran somewhere.
+    for (int kind = PredecodedCore::kNop; kind < PredecodedCore::kKinds; ++kind) {
+        EXPECT_TRUE(total.kinds.count(kind)) << "no firmware executed predecoded kind " << kind;
+    }
+}
+
+// A flash word that changes under a decoded slot (a boot loader or SPM
+// rewriting the application, a debugger) is decoded again: the slot keeps
+// the word it was decoded from. Here the firmware's flash is patched
+// between two runs of the same instruction: LDI r16, 0x12 becomes
+// LDI r16, 0x34 (opcodes from the AVR instruction set manual:
+// 1110 KKKK dddd KKKK, d = 16 + dddd).
+TEST(PredecodedCore, DecodesAgainWhenTheFlashWordChanges) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    PredecodedCore core(avr);
+    // A scratch location at the end of flash, far from the program.
+    const avr_flashaddr_t at = (avr->flashend + 1) - 64;
+    const auto put = [&](std::uint16_t word) {
+        avr->flash[at] = static_cast<std::uint8_t>(word);
+        avr->flash[at + 1] = static_cast<std::uint8_t>(word >> 8);
+    };
+    avr->pc = at;
+    put(0xe102);  // LDI r16, 0x12
+    EXPECT_EQ(core.run_one(avr), at + 2);
+    EXPECT_EQ(avr->data[16], 0x12);
+    put(0xe304);  // LDI r16, 0x34
+    const Cycle before = avr->cycle;
+    EXPECT_EQ(core.run_one(avr), at + 2);
+    EXPECT_EQ(avr->data[16], 0x34);
+    EXPECT_EQ(avr->cycle, before + 1);  // LDI: 1 cycle
+    EXPECT_EQ(core.handed_to_simavr(), 0u);
+}
+
+}  // namespace
+}  // namespace avrbench
