@@ -148,7 +148,10 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
                                     const unsigned k = ((opcode & 0x00c0) >> 2) | (opcode & 0xf);
                                     set((opcode & 0xff00) == 0x9600 ? kAdiw : kSbiw, p, k);
                                 } break;
-                                case 0x9800: case 0x9a00: break;  // CBI, SBI: read-modify-write of I/O
+                                case 0x9800: case 0x9a00: {
+                                    const unsigned io = ((opcode >> 3) & 0x1f) + 32;
+                                    set((opcode & 0xff00) == 0x9800 ? kCbi : kSbi, io, 1u << (opcode & 0x7));
+                                } break;
                                 case 0x9900: case 0x9b00: {
                                     const unsigned io = ((opcode >> 3) & 0x1f) + 32;
                                     set((opcode & 0xff00) == 0x9900 ? kSbic : kSbis, io, 1u << (opcode & 0x7));
@@ -205,24 +208,40 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // With SP already below the floor (a half-written SP, which the oracle
     // lets pass) every step needs the oracle: the general step takes them.
     if (sp_of(m.data) < limits.stack_floor) return batch;
-    // The PC and the cycle count live in registers until the batch ends:
-    // nothing executed here reads them from avr_t.
+    // The PC and the cycle count live in registers until the batch ends;
+    // execute() stores them before it calls simavr's I/O callbacks.
     avr_flashaddr_t pc = avr->pc;
     avr_cycle_count_t cycle = avr->cycle;
     Slot* const slots = slots_.get();
-    const avr_cycle_count_t cycle_limit = limits.cycle;
     const std::uint32_t max_steps = limits.max_steps;
     // A PC past the flash is avr_run_one's (it crashes the core). Inside the
     // loop the PC stays below the code's end (the CheckPc test), which is
     // within the flash.
     if (pc >= m.flashend || limits.code_end_minus_one > m.flashend) return batch;
+    avr_cycle_count_t cycle_limit = limits.cycle;
     while (batch.steps < max_steps) {
         const Slot& slot = *slot_at(slots, m, pc);
         avr_flashaddr_t new_pc;
         int cycles;
-        if (!execute(m, slot, pc, new_pc, cycles)) break;  // Ended::HandOver
-        cycle += static_cast<avr_cycle_count_t>(cycles);
+        const Done done = execute(m, slot, pc, cycle, new_pc, cycles);
+        if (done == Done::HandOver) break;
+        if (__builtin_expect(done == Done::Plain, 1)) cycle += static_cast<avr_cycle_count_t>(cycles);
         ++batch.steps;
+        if (__builtin_expect(done == Done::CalledSimavr, 0)) {
+            // A callback may move the cycle count itself (simavr's EEPROM
+            // read halts the core for 4 cycles that way): count on from it.
+            cycle = avr->cycle + static_cast<avr_cycle_count_t>(cycles);
+            avr->cycle = cycle;
+            // What the fast path checks after avr_run_one: a timer the
+            // callbacks made due, a core no longer running, an interrupt.
+            const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
+            if (first == nullptr || first->when <= cycle || avr->state != cpu_Running || avr->interrupt_state != 0) {
+                batch.ended = Ended::TimerDue;
+                batch.new_pc = new_pc;
+                break;
+            }
+            cycle_limit = first->when;
+        }
         if (__builtin_expect(cycle >= cycle_limit, 0)) {
             batch.ended = Ended::TimerDue;
             batch.new_pc = new_pc;

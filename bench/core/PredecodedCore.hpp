@@ -96,7 +96,7 @@ public:
         kPop, kPush,
         kCom, kNeg, kSwap, kInc, kAsr, kLsr, kRor, kDec,
         kJmp, kCall, kAdiw, kSbiw, kSbic, kSbis, kMul,
-        kOut, kIn,
+        kOut, kIn, kCbi, kSbi,
         kRjmp, kRcall, kLdi, kBrbs, kBrbc, kBld, kBst, kSbrc, kSbrs,
         kIjmp, kIcall, kRet,
         kKinds
@@ -120,8 +120,14 @@ public:
 
 private:
     __attribute__((always_inline)) static Slot* slot_at(Slot* slots, const predecoded_detail::Machine& m, avr_flashaddr_t pc);
-    // One instruction's effect; false (nothing changed) when avr_run_one must execute it.
-    __attribute__((always_inline)) bool execute(const predecoded_detail::Machine& m, const Slot& slot, avr_flashaddr_t pc, avr_flashaddr_t& new_pc, int& cycles);
+    enum class Done : std::uint8_t {
+        HandOver,      // nothing changed: avr_run_one must execute it
+        Plain,         // executed, nothing in simavr called
+        CalledSimavr,  // executed, I/O callbacks or IRQs of simavr called (they may add timers or raise interrupts)
+    };
+    // One instruction's effect (avr->cycle was `cycle_before` when it began).
+    __attribute__((always_inline)) Done execute(const predecoded_detail::Machine& m, const Slot& slot, avr_flashaddr_t pc,
+                                                avr_cycle_count_t cycle_before, avr_flashaddr_t& new_pc, int& cycles);
 
     // The kinds that may store to SPL/SPH (when those have no callbacks).
     static constexpr bool moves_sp(Kind k) {
@@ -189,6 +195,38 @@ __attribute__((always_inline)) inline bool plain_read(const Machine& m, std::uin
     if (addr == R_SREG) return false;
     const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
     return io.r.c == nullptr && io.irq == nullptr;
+}
+
+// An I/O register this core may read or write itself through simavr's
+// callbacks, as _avr_get_ram/_avr_set_r do: not SREG, within RAM, no GDB stub.
+__attribute__((always_inline)) inline bool io_callable(const Machine& m, std::uint16_t addr) {
+    return addr >= 32 && addr < MAX_IOs + 31 && addr != R_SREG && addr <= m.ramend && !m.watched;
+}
+
+// Raises the register's IRQs with `v`: the whole byte, then each bit
+// (what _avr_get_ram and _avr_set_r do when avr_iomem_getirq made them).
+inline void io_raise(avr_irq_t* irq, std::uint8_t v) {
+    avr_raise_irq(irq + AVR_IOMEM_IRQ_ALL, v);
+    for (int i = 0; i < 8; i++) avr_raise_irq(irq + i, (v >> i) & 1);
+}
+
+// _avr_get_ram(addr) for an io_callable address: the read callback's value
+// stored, the IRQs raised, then the byte as avr_core_watch_read returns it.
+__attribute__((always_inline)) inline std::uint8_t io_read(const Machine& m, std::uint16_t addr) {
+    const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
+    if (io.r.c) m.data[addr] = io.r.c(m.avr, addr, io.r.param);
+    if (io.irq) io_raise(io.irq, m.data[addr]);
+    return m.data[addr];
+}
+
+// _avr_set_r(addr, v) for an io_callable address.
+__attribute__((always_inline)) inline void io_write(const Machine& m, std::uint16_t addr, std::uint8_t v) {
+    const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
+    if (io.w.c)
+        io.w.c(m.avr, addr, v, io.w.param);
+    else
+        m.data[addr] = v;
+    if (io.irq) io_raise(io.irq, v);
 }
 
 // The stack pointer's own writes (_avr_sp_set) are plain.
@@ -287,7 +325,7 @@ __attribute__((always_inline)) inline avr_flashaddr_t PredecodedCore::run_one(av
         const predecoded_detail::Machine m(avr);
         avr_flashaddr_t new_pc;
         int cycles;
-        if (__builtin_expect(execute(m, *slot_at(slots_.get(), m, pc), pc, new_pc, cycles), 1)) {
+        if (__builtin_expect(execute(m, *slot_at(slots_.get(), m, pc), pc, avr->cycle, new_pc, cycles) != Done::HandOver, 1)) {
             avr->cycle += static_cast<avr_cycle_count_t>(cycles);
             return new_pc;
         }
@@ -296,7 +334,9 @@ __attribute__((always_inline)) inline avr_flashaddr_t PredecodedCore::run_one(av
     return avr_run_one(avr);
 }
 
-__attribute__((always_inline)) inline bool PredecodedCore::execute(const predecoded_detail::Machine& m, const Slot& slot_ref, avr_flashaddr_t pc, avr_flashaddr_t& new_pc_out, int& cycles_out) {
+__attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execute(const predecoded_detail::Machine& m, const Slot& slot_ref, avr_flashaddr_t pc,
+                                                                           avr_cycle_count_t cycle_before, avr_flashaddr_t& new_pc_out,
+                                                                           int& cycles_out) {
     using namespace predecoded_detail;
     const Slot* const slot = &slot_ref;
     std::uint8_t* const data = m.data;
@@ -304,6 +344,15 @@ __attribute__((always_inline)) inline bool PredecodedCore::execute(const predeco
     const std::uint8_t a = slot->a, b = slot->b;
     avr_flashaddr_t new_pc = pc + 2;
     int cycle = 1;
+    // Before simavr's I/O callbacks run: they see avr->pc at this
+    // instruction and avr->cycle before it, as inside avr_run_one.
+    Done done = Done::Plain;
+#define AVRBENCH_BEFORE_CALLBACKS()     \
+    do {                                \
+        m.avr->pc = pc;                 \
+        m.avr->cycle = cycle_before;    \
+        done = Done::CalledSimavr;      \
+    } while (0)
     // The skip of CPSE/SBRC/SBRS/SBIC/SBIS: one word or two, one cycle or two.
 #define AVRBENCH_SKIP()                                   \
     do {                                                  \
@@ -593,9 +642,24 @@ __attribute__((always_inline)) inline bool PredecodedCore::execute(const predeco
             cycle++;
         } break;
         case kSbic: case kSbis: {
-            if (!plain_read(m, a)) goto hand_over;
-            const bool set = (data[a] & b) != 0;
+            std::uint8_t v;
+            if (plain_read(m, a)) {
+                v = data[a];
+            } else {
+                if (!io_callable(m, a)) goto hand_over;
+                AVRBENCH_BEFORE_CALLBACKS();
+                v = io_read(m, a);
+            }
+            const bool set = (v & b) != 0;
             if (set == (slot->kind == kSbis)) AVRBENCH_SKIP();
+        } break;
+        case kCbi: case kSbi: {
+            // 1001 10x0 AAAA Abbb: read, change one bit, write (2 cycles).
+            if (!io_callable(m, a)) goto hand_over;
+            AVRBENCH_BEFORE_CALLBACKS();
+            const std::uint8_t v = io_read(m, a);
+            io_write(m, a, static_cast<std::uint8_t>(slot->kind == kSbi ? (v | b) : (v & ~b)));
+            cycle++;
         } break;
         case kMul: {
             const std::uint16_t res = static_cast<std::uint16_t>(data[a] * data[b]);
@@ -606,8 +670,13 @@ __attribute__((always_inline)) inline bool PredecodedCore::execute(const predeco
             sreg[S_C] = static_cast<std::uint8_t>((res >> 15) & 1);
         } break;
         case kOut:
-            if (!plain_write(m, a)) goto hand_over;
-            data[a] = data[b];
+            if (plain_write(m, a)) {
+                data[a] = data[b];
+                break;
+            }
+            if (!io_callable(m, a)) goto hand_over;
+            AVRBENCH_BEFORE_CALLBACKS();
+            io_write(m, a, data[b]);
             break;
         case kIn:
             if (b == R_SREG) {
@@ -619,8 +688,13 @@ __attribute__((always_inline)) inline bool PredecodedCore::execute(const predeco
                 data[a] = v;
                 break;
             }
-            if (!plain_read(m, b)) goto hand_over;
-            data[a] = data[b];
+            if (plain_read(m, b)) {
+                data[a] = data[b];
+                break;
+            }
+            if (!io_callable(m, b)) goto hand_over;
+            AVRBENCH_BEFORE_CALLBACKS();
+            data[a] = io_read(m, b);
             break;
         case kRjmp:
             new_pc = slot->target;
@@ -695,11 +769,12 @@ __attribute__((always_inline)) inline bool PredecodedCore::execute(const predeco
             __builtin_unreachable();  // decode() makes no other kind
     }
 #undef AVRBENCH_SKIP
+#undef AVRBENCH_BEFORE_CALLBACKS
     new_pc_out = new_pc;
     cycles_out = cycle;
-    return true;
+    return done;
 hand_over:
-    return false;
+    return Done::HandOver;
 }
 
 }  // namespace avrbench
