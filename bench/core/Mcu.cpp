@@ -289,6 +289,15 @@ void Mcu::set_skip_idle_loops(bool on) {
         skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
     }
 }
+void Mcu::set_predecoded_core(bool on) {
+    if (in_run_) throw std::logic_error("Mcu::set_predecoded_core during a run");
+    options_.predecoded_core = on;
+    if (!on || options_.reference_run_loop) {
+        predecoded_.reset();
+    } else if (!predecoded_) {
+        predecoded_ = std::make_unique<PredecodedCore>(avr_);
+    }
+}
 std::uint64_t Mcu::idle_jumps() const { return skipper_ ? skipper_->jumps() : 0; }
 std::uint64_t Mcu::idle_cycles_skipped() const { return skipper_ ? skipper_->cycles_skipped() : 0; }
 std::uint32_t Mcu::pc_bytes() const { return avr_->pc; }

@@ -226,6 +226,8 @@ public:
     std::uint64_t steps() const { return steps_; }
     // Switches idle-loop skipping on or off (McuOptions::skip_idle_loops).
     void set_skip_idle_loops(bool on);
+    // McuOptions::predecoded_core after construction (not during a run).
+    void set_predecoded_core(bool on);
     // Idle-loop jumps taken and the cycles they covered (core/IdleLoopSkip.hpp).
     std::uint64_t idle_jumps() const;
     std::uint64_t idle_cycles_skipped() const;

@@ -411,7 +411,8 @@ void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
 
 // --mips: MIPS on the same ELF, busy_poll_passes (busy_poll's loop for a
 // fixed 20 M passes, then power-down with interrupts off at busy_poll_done):
-// the bench as (b) runs it (every pin traced, the VCD streamed), bare simavr
+// the bench as (b) runs it (every pin traced, the VCD streamed), the same on
+// simavr's avr_run_one instead of the predecoded core, bare simavr
 // as (a), and qemu-system-avr (perf_qemu.cpp: from main to busy_poll_done,
 // QEMU's TCG, not cycle-exact). The instructions are the bench's count to
 // the end (all three run the same program to the same place); CPU seconds,
@@ -435,11 +436,14 @@ void run_mips(const std::string& firmware_dir, int repeats, const std::string& v
         cycles = mcu.cycle();
     }
     const std::string qemu = avrbench_perf::qemu_version();
-    std::vector<double> bare, bench, emu;
+    std::vector<double> bare, bench, bench_simavr_core, emu;
     std::string why;
     std::uint64_t events = 0;
+    avrbench::McuOptions simavr_core;
+    simavr_core.predecoded_core = false;
     for (int i = 0; i < repeats; ++i) {
         bench.push_back(run_avrbench(elf, cycles, vcd_path, &events));
+        bench_simavr_core.push_back(run_avrbench(elf, cycles, vcd_path, &events, simavr_core));
         bare.push_back(run_bare_simavr(elf, cycles));
         if (!qemu.empty() && why.empty()) {
             const double s = avrbench_perf::qemu_cpu_seconds(path, *main_addr, *done_addr, why);
@@ -458,6 +462,7 @@ void run_mips(const std::string& firmware_dir, int repeats, const std::string& v
                     cpu / b);
     };
     row("avrbench (every pin and USART0 traced, VCD streamed)", b);
+    row("avrbench --simavr-core (avr_run_one per instruction)", median(bench_simavr_core));
     row("bare simavr (run_avr's loop)", median(bare));
     if (qemu.empty()) {
         std::printf("%-56s (not installed: bash ci/setup --perf)\n", "qemu-system-avr");

@@ -68,6 +68,7 @@ struct RunArgs {
     std::string line_timeout;  // --line-timeout: overrides the board's
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
     bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
+    bool simavr_core = false;           // --simavr-core: execute on avr_run_one, not the predecoded core
     bool no_periodic_waves = false;     // --no-periodic-waves: every PWM edge through the nets
     std::vector<std::string> gdb;       // --gdb [MCU=]PORT (repeatable)
     bool break_at_finding = false;
@@ -191,6 +192,7 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
     for (const auto& pf : port_files(args.uart_out, "--uart-out")) o.uart_out.push_back({pf.port, pf.path});
     o.read_uart_input = read_uart_input;
     o.skip_idle_loops = !args.no_idle_skip;
+    o.predecoded_core = !args.simavr_core;
     o.periodic_waves = !args.no_periodic_waves;
     o.job_port = args.host;
     if (!args.gcode.empty()) {
@@ -258,6 +260,7 @@ int run_command(const RunArgs& args) {
     o.elf = args.elf;
     o.mcu_type = args.mcu;
     o.skip_idle_loops = !args.no_idle_skip;
+    o.predecoded_core = !args.simavr_core;
     if (!args.freq.empty()) o.frequency_hz = parse_frequency_hz(args.freq, "--freq");
     o.duration_ps = parse_duration_ps(args.duration, "--for");
     o.duration_text = args.duration;
@@ -367,6 +370,9 @@ Command add_run_command(CLI::App& app) {
     run_cmd->add_option("--break-at-cycle", run.break_at_cycle, "--gdb: stop at the first instruction at or after this cycle");
     run_cmd->add_flag("--no-idle-skip", run.no_idle_skip,
                       "run every pass of the firmware's idle loops instead of jumping over them (same results, slower)");
+    run_cmd->add_flag("--simavr-core", run.simavr_core,
+                      "execute every instruction on simavr's own avr_run_one instead of the predecoded core "
+                      "(same results, slower; kept for one release to compare)");
     run_cmd->add_flag("--no-periodic-waves", run.no_periodic_waves,
                       "deliver every edge of a timer PWM through its net even when nothing records it "
                       "(heaters follow each edge instead of the mean power; slower)");

@@ -110,7 +110,10 @@ BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
 
     bench_ = std::make_unique<Bench>(std::move(spec), options_.firmware);
     Board& board = bench_->board();
-    for (Mcu* m : board.mcus()) m->set_skip_idle_loops(options_.skip_idle_loops);
+    for (Mcu* m : board.mcus()) {
+        m->set_skip_idle_loops(options_.skip_idle_loops);
+        m->set_predecoded_core(options_.predecoded_core);
+    }
     if (!options_.profile.empty()) {
         for (Mcu* m : board.mcus()) m->enable_profile();
     }

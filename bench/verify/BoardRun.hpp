@@ -34,6 +34,7 @@ struct BoardRunOptions {
     Picoseconds duration_ps = kPsPerMs * 1000;    // the run's limit (with a job: for finishing it)
     Picoseconds settle_ps = 50 * kPsPerMs;        // a job is done once motion and lines were quiet this long
     bool skip_idle_loops = true;                  // core/IdleLoopSkip.hpp
+    bool predecoded_core = true;                  // core/PredecodedCore.hpp; false: simavr's avr_run_one
     bool periodic_waves = true;                   // core/PeriodicOutput.hpp
 
     // Serial ports by name ("" = the board's first).

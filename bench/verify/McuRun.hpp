@@ -25,6 +25,7 @@ struct McuRunOptions {
     std::string mcu_type;            // "" = from the ELF's .mmcu section
     std::uint32_t frequency_hz = 0;  // 0 = from the ELF's .mmcu section
     bool skip_idle_loops = true;
+    bool predecoded_core = true;  // core/PredecodedCore.hpp; false: simavr's avr_run_one
     Picoseconds duration_ps = 1000 * kPsPerMs;
     std::string duration_text = "1s";  // as the user wrote it, for messages
     bool until_sleep = false;          // stop at the first SLEEP (bounded by the duration)

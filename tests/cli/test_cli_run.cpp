@@ -57,6 +57,35 @@ TEST(CliRun, TwoRunsGiveByteIdenticalVcds) {
     EXPECT_EQ(a, test::slurp(dir / "b.vcd"));
 }
 
+// --simavr-core runs the same program on simavr's avr_run_one instead of
+// core/PredecodedCore: the same VCD byte for byte, on a board job with
+// five MCUs (the printer demo's board, a short job) and on one MCU.
+TEST(CliRun, SimavrCoreGivesTheSameVcdAsThePredecodedCore) {
+    const auto dir = test::scratch_dir("cli-simavr-core");
+    for (const char* core : {"", " --simavr-core"}) {
+        const std::string tag = *core ? "simavr" : "predecoded";
+        const auto one = test::run_command(kCli + " run " + quoted(test::firmware("uart_echo")) +
+                                               " --for 5ms --uart-in " + quoted(test::source_path("tests/cli/echo_input.txt")) +
+                                               " --vcd " + quoted((dir / (tag + "-one.vcd")).string()) + core, dir);
+        ASSERT_EQ(one.exit_code, 0) << one.err;
+        const std::string fw = std::string(AVRBENCH_FIRMWARE_DIR) + "/";
+        const auto board = test::run_command(
+            kCli + " run " + quoted(fw + "printer3d_interp.elf") + " --board " +
+                quoted(test::source_path("bench/boards/printer3d-seed001.yaml")) + " --firmware drive_x=" +
+                quoted(fw + "printer3d_drive.elf") + " --firmware drive_y=" + quoted(fw + "printer3d_drive.elf") +
+                " --firmware drive_z=" + quoted(fw + "printer3d_drive.elf") + " --firmware drive_e=" +
+                quoted(fw + "printer3d_drive.elf") + " --firmware heater=" + quoted(fw + "printer3d_heater.elf") +
+                " --for 300ms --vcd " + quoted((dir / (tag + "-board.vcd")).string()) + core,
+            dir);
+        ASSERT_EQ(board.exit_code, 0) << board.err;
+    }
+    for (const char* which : {"-one.vcd", "-board.vcd"}) {
+        const std::string a = test::slurp(dir / (std::string("predecoded") + which));
+        ASSERT_GT(a.size(), 200u) << which;
+        EXPECT_TRUE(a == test::slurp(dir / (std::string("simavr") + which))) << which << " differs";
+    }
+}
+
 // Marlin's resend protocol with a line the firmware rejects every time: a
 // lone `*` is a checksum with no line before it, so seed 001's interpolator
 // answers "Error:checksum mismatch", "Resend: 1", "ok" each time (its
