@@ -228,8 +228,8 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         if (__builtin_expect(done == Done::Plain, 1)) cycle += static_cast<avr_cycle_count_t>(cycles);
         ++batch.steps;
         if (__builtin_expect(done == Done::CalledSimavr, 0)) {
-            // A callback may move the cycle count itself (simavr's EEPROM
-            // read halts the core for 4 cycles that way): count on from it.
+            // A callback may move the cycle count itself (fixes/EepromTiming
+            // halts the core 4 cycles on a read that way): count on from it.
             cycle = avr->cycle + static_cast<avr_cycle_count_t>(cycles);
             avr->cycle = cycle;
             // What the fast path checks after avr_run_one: a timer the
