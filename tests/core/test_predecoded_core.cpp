@@ -116,6 +116,32 @@ TEST(PredecodedCore, MatchesAvrRunOneInstructionByInstructionOnEveryFirmware) {
     }
 }
 
+// The batched fast path (PredecodedCore::run_batch inside Mcu::run_until)
+// against the reference loop (avr_run_one, every timer processed on every
+// step) over all of core_sweep: RunLoop.* cover every firmware for 20 ms,
+// which is a fraction of the sweep. Both end halted at the same cycle with
+// the same registers, SREG and RAM.
+TEST(PredecodedCore, BatchedRunEndsWhereTheReferenceLoopEndsOnCoreSweep) {
+    const ElfImage elf = ElfImage::load(test::firmware("core_sweep"));
+    McuOptions reference_options;
+    reference_options.reference_run_loop = true;
+    Mcu fast(elf, McuOptions{}), reference(elf, reference_options);
+    ASSERT_NE(fast.predecoded_core(), nullptr);
+    // 2 s of simulated time; the sweep ends after ~0.75 s (11.9 M cycles at 16 MHz).
+    const Cycle limit = 32'000'000;
+    EXPECT_EQ(fast.run_until(limit), StopReason::Halted);
+    EXPECT_EQ(reference.run_until(limit), StopReason::Halted);
+    const avr_t* a = reference.avr();
+    const avr_t* b = fast.avr();
+    EXPECT_EQ(a->cycle, b->cycle);
+    EXPECT_EQ(a->pc, b->pc);
+    EXPECT_EQ(0, std::memcmp(a->sreg, b->sreg, sizeof a->sreg));
+    EXPECT_TRUE(reference.data_memory() == fast.data_memory());
+    EXPECT_EQ(reference.steps(), fast.steps());
+    // The batches ran nearly all of it: the sweep has no I/O but its end.
+    EXPECT_LT(fast.predecoded_core()->handed_to_simavr(), 1000u);
+}
+
 // A flash word that changes under a decoded slot (a boot loader or SPM
 // rewriting the application, a debugger) is decoded again: the slot keeps
 // the word it was decoded from. Here the firmware's flash is patched
