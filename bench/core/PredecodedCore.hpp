@@ -254,6 +254,15 @@ __attribute__((always_inline)) inline void set_sp(std::uint8_t* data, std::uint1
     data[R_SPH] = static_cast<std::uint8_t>(sp >> 8);
 }
 
+// _avr_push_addr once plain_push said yes: the return address in words,
+// low byte first, downwards from SP, then SP below it.
+__attribute__((always_inline)) inline void push_return(const Machine& m, avr_flashaddr_t return_pc) {
+    std::uint16_t sp = sp_of(m.data);
+    avr_flashaddr_t ret = return_pc >> 1;
+    for (int i = 0; i < m.address_size; i++, ret >>= 8, sp--) m.data[sp] = static_cast<std::uint8_t>(ret);
+    set_sp(m.data, sp);
+}
+
 // The flag helpers of sim_core.c, expression for expression.
 __attribute__((always_inline)) inline void flags_zns(std::uint8_t* s, std::uint8_t res) {
     s[S_Z] = res == 0;
@@ -617,13 +626,9 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
         case kCall: {
             // _avr_push_addr: the word address, low byte first, downwards.
             const avr_flashaddr_t target = (static_cast<avr_flashaddr_t>(slot->c) << 16) | flash16(m.flash, new_pc);
-            const int size = m.address_size;
-            std::uint16_t sp = sp_of(data);
-            if (!plain_push(m, sp, size)) goto hand_over;
-            avr_flashaddr_t ret = (new_pc + 2) >> 1;
-            for (int i = 0; i < size; i++, ret >>= 8, sp--) data[sp] = static_cast<std::uint8_t>(ret);
-            set_sp(data, sp);
-            cycle += 1 + size;
+            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
+            push_return(m, new_pc + 2);
+            cycle += 1 + m.address_size;
             new_pc = target << 1;
         } break;
         case kAdiw: case kSbiw: {
@@ -701,13 +706,9 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
             cycle++;
             break;
         case kRcall: {
-            const int size = m.address_size;
-            std::uint16_t sp = sp_of(data);
-            if (!plain_push(m, sp, size)) goto hand_over;
-            avr_flashaddr_t ret = new_pc >> 1;
-            for (int i = 0; i < size; i++, ret >>= 8, sp--) data[sp] = static_cast<std::uint8_t>(ret);
-            set_sp(data, sp);
-            cycle += size;
+            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
+            push_return(m, new_pc);
+            cycle += m.address_size;
             new_pc = slot->target;
         } break;
         case kLdi: data[a] = b; break;
@@ -739,14 +740,10 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
             cycle++;
             break;
         case kIcall: {
-            const int size = m.address_size;
-            std::uint16_t sp = sp_of(data);
-            if (!plain_push(m, sp, size)) goto hand_over;
+            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
             const avr_flashaddr_t z = static_cast<avr_flashaddr_t>(data[R_ZL] | (data[R_ZH] << 8));
-            avr_flashaddr_t ret = new_pc >> 1;
-            for (int i = 0; i < size; i++, ret >>= 8, sp--) data[sp] = static_cast<std::uint8_t>(ret);
-            set_sp(data, sp);
-            cycle += size - 1;
+            push_return(m, new_pc);
+            cycle += m.address_size - 1;
             new_pc = z << 1;
             cycle++;
         } break;
