@@ -428,7 +428,8 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         if (kProfile || (!kStopAtSleep && stop_at_sleep_) || debug_ != nullptr || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
         // Fast path: while the core runs, no interrupt is on its way and no
-        // cycle timer is due, a step of SimavrStepper is avr_run_one and the
+        // cycle timer is due, a step of SimavrStepper is one instruction (the
+        // predecoded core's run_batch, or avr_run_one) and the
         // new PC. Anything else is finished by SimavrStepper::finish, as
         // step() would, and the loop goes back to the general step. The
         // horizon timer (at the target, put back after a reset) is in the

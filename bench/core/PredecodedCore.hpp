@@ -10,12 +10,14 @@
 // avr->pc left alone, the new PC returned - and every instruction it
 // executes itself does exactly what simavr 1.6's avr_run_one does,
 // its quirks included (an RJMP wraps modulo the flash size, a branch does
-// not; the flags of every ALU instruction; 0xF1F1 is a branch). Everything else is handed
-// to avr_run_one before any state changes: anything that reads or writes an
-// I/O register with a callback or an IRQ, SREG through the data space,
-// SEI/CLI/RETI (interrupt state), SLEEP, BREAK, WDR, SPM, ELPM/EIJMP/EICALL,
-// a data address outside RAM, a PC past the flash, invalid opcodes, and
-// every access while simavr's own GDB stub is attached (its watchpoints).
+// not; the flags of every ALU instruction; 0xF1F1 is a branch). IN, OUT,
+// SBI, CBI, SBIS and SBIC on an I/O register with callbacks or IRQs call
+// them as simavr's _avr_get_ram/_avr_set_r do. Everything else is handed
+// to avr_run_one before any state changes: loads and stores that reach such
+// a register, SREG through the data space, SEI/CLI/RETI (interrupt state),
+// SLEEP, BREAK, WDR, SPM, ELPM/EIJMP/EICALL, a data address outside RAM, a
+// PC past the flash, invalid opcodes, and every access while simavr's own
+// GDB stub is attached (its watchpoints).
 // Exactness is proven instruction by instruction against avr_run_one on
 // every firmware the build makes (tests/core/test_predecoded_core.cpp) and
 // by every run-loop, scenario and golden test, which run on this core.
@@ -151,8 +153,8 @@ namespace predecoded_detail {
 
 // The core's view of avr_t, read once per batch: a store through data[]
 // (uint8_t, which may alias anything) would otherwise make the compiler
-// reload every avr_t field after each instruction. None of these fields can
-// change while only predecoded instructions run (nothing in simavr is called).
+// reload every avr_t field after each instruction. Nothing a batch runs
+// changes them (simavr's I/O callbacks do not either).
 struct Machine {
     explicit Machine(avr_t* a)
         : avr(a), data(a->data), sreg(a->sreg), flash(a->flash), ramend(a->ramend), flashend(a->flashend),
