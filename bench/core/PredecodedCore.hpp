@@ -179,25 +179,20 @@ __attribute__((always_inline)) inline bool is_32_bit(const std::uint8_t* flash, 
     return o == 0x9200 || o == 0x9000 || o == 0x940c || o == 0x940d || o == 0x940e || o == 0x940f;
 }
 
-// True when simavr's _avr_set_ram(addr, v) would only store v in data[addr]:
-// a register, an I/O slot with no write callback and no IRQ (not SREG), or
-// RAM up to RAMEND, with no GDB stub watching.
-__attribute__((always_inline)) inline bool plain_write(const Machine& m, std::uint16_t addr) {
+// True when simavr's _avr_set_ram(addr, v) (kWrite) would only store v in
+// data[addr], or its _avr_get_ram(addr) only read it: a register, an I/O
+// slot with no callback that way and no IRQ (not SREG), or RAM up to
+// RAMEND, with no GDB stub watching.
+template <bool kWrite>
+__attribute__((always_inline)) inline bool plain_access(const Machine& m, std::uint16_t addr) {
     if (addr > m.ramend || m.watched) return false;
     if (addr < 32 || addr >= MAX_IOs + 31) return true;
     if (addr == R_SREG) return false;
     const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
-    return io.w.c == nullptr && io.irq == nullptr;
+    return (kWrite ? io.w.c == nullptr : io.r.c == nullptr) && io.irq == nullptr;
 }
-
-// The same for _avr_get_ram(addr): no read callback, no IRQ, not SREG.
-__attribute__((always_inline)) inline bool plain_read(const Machine& m, std::uint16_t addr) {
-    if (addr > m.ramend || m.watched) return false;
-    if (addr < 32 || addr >= MAX_IOs + 31) return true;
-    if (addr == R_SREG) return false;
-    const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
-    return io.r.c == nullptr && io.irq == nullptr;
-}
+__attribute__((always_inline)) inline bool plain_write(const Machine& m, std::uint16_t addr) { return plain_access<true>(m, addr); }
+__attribute__((always_inline)) inline bool plain_read(const Machine& m, std::uint16_t addr) { return plain_access<false>(m, addr); }
 
 // An I/O register this core may read or write itself through simavr's
 // callbacks, as _avr_get_ram/_avr_set_r do: not SREG, within RAM, no GDB stub.
