@@ -4,6 +4,8 @@
 #include <mutex>
 #include <set>
 
+#include "core/ProcessHeap.hpp"
+
 namespace avrbench {
 
 namespace {
@@ -25,6 +27,8 @@ void notice(const std::string& line) {
     {
         const std::lock_guard<std::mutex> lock(notice_mutex());
         // A fuzzer loads its board once per input: say it once.
+        // What was said stays said when a fuzz target restores its board.
+        const OnProcessHeap outlives_the_board;
         static std::set<std::string> said;
         if (!said.insert(line).second) return;
         sink = current_sink();

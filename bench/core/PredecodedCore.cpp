@@ -3,6 +3,7 @@
 #include <new>
 
 #include "core/Mcu.hpp"
+#include "core/ProcessHeap.hpp"
 
 namespace avrbench {
 
@@ -10,6 +11,11 @@ PredecodedCore::PredecodedCore(const avr_t* avr) {
     // One slot per flash word; calloc leaves untouched pages unmapped and
     // zero is kUndecoded, so only the code that runs costs memory.
     const std::size_t words = static_cast<std::size_t>(avr->flashend) / 2 + 2;
+    // A cache of what flash says (each slot is checked against its flash
+    // word on every fetch), so a fuzz target that restores its board
+    // (core/ProcessHeap.hpp) keeps it on the process's heap: what one input
+    // decoded, the next need not decode again.
+    const OnProcessHeap cache_outlives_restores;
     slots_.reset(static_cast<Slot*>(std::calloc(words, sizeof(Slot))));
     if (!slots_) throw std::bad_alloc();
 }
