@@ -5,8 +5,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <sstream>
 #include <string>
 
+#include <simavr/avr_eeprom.h>
+#include <simavr/sim_avr.h>
+#include <simavr/sim_interrupts.h>
+#include <simavr/sim_irq.h>
+
+#include "SnapshotHeap.hpp"
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
 #include "verify/Bench.hpp"
@@ -78,6 +86,8 @@ TargetConfig config_from_environment(const char* who, const char* executable) {
     if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) config.raw = std::string(raw) == "1";
     if (const char* hang = std::getenv("AVRBENCH_FUZZ_HANG")) config.hang_at_bound = std::string(hang) == "1";
     if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) config.boot_s = std::max(0.0, std::atof(boot));
+    if (const char* fork = std::getenv("AVRBENCH_FUZZ_FORK")) config.fork = std::string(fork) == "1";
+    if (!snapshot_heap::available()) config.fork = true;
     if (const char* list = std::getenv("AVRBENCH_FUZZ_FIRMWARE")) {
         std::string entries = list;
         for (std::size_t start = 0; start < entries.size();) {
@@ -98,8 +108,26 @@ TargetConfig config_from_environment(const char* who, const char* executable) {
 
 bool target_is_raw() { return g_config.raw; }
 
+namespace {
+void boot(const TargetConfig& config, const char* who);
+}
+
+bool target_restores() { return !g_config.fork; }
+
 void boot_target(const TargetConfig& config, const char* who) {
     g_config = config;
+    {
+        // Everything the board allocates from here on is in the snapshot.
+        std::optional<snapshot_heap::Collecting> collecting;
+        if (!config.fork) collecting.emplace();
+        boot(config, who);
+    }
+    if (!config.fork) snapshot_heap::take();
+}
+
+namespace {
+
+void boot(const TargetConfig& config, const char* who) {
     try {
         BoardSpec spec = load_board_file(config.board);
         g_mcu_name = spec.serial_port_mcu();
@@ -135,6 +163,8 @@ void boot_target(const TargetConfig& config, const char* who) {
         std::exit(2);
     }
 }
+
+}  // namespace
 
 void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_map, std::uint32_t edge_mask,
                InputOutcome& outcome) {
@@ -218,6 +248,103 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
         outcome.finding = true;
         std::snprintf(outcome.detail, sizeof outcome.detail, "%s", detail.c_str());
     }
+}
+
+void run_input_and_restore(const std::uint8_t* data, std::size_t size, std::uint8_t* edges, std::uint32_t edge_mask,
+                           InputOutcome& outcome) {
+    // The first input runs on the process's heap (SnapshotHeap.hpp): what it
+    // makes lazily for the whole process (stdio buffers, function-local
+    // statics) then outlives the restores. Where its allocations live changes
+    // nothing of what it does.
+    static bool first_input_done = false;
+    if (!first_input_done) {
+        first_input_done = true;
+        run_input(data, size, edges, edge_mask, outcome);
+    } else {
+        const snapshot_heap::Collecting collecting;
+        run_input(data, size, edges, edge_mask, outcome);
+    }
+    snapshot_heap::restore();
+}
+
+namespace {
+
+// One line per item: "name value", the value a hash where it is long.
+class StateLines {
+public:
+    void add(const std::string& name, const std::string& value) { out_ << name << ' ' << value << '\n'; }
+    void add(const std::string& name, std::uint64_t value) { out_ << name << ' ' << value << '\n'; }
+    void add_bytes(const std::string& name, const std::uint8_t* bytes, std::size_t size) {
+        std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a
+        for (std::size_t i = 0; i < size; ++i) hash = (hash ^ bytes[i]) * 0x100000001b3ull;
+        char text[40];
+        std::snprintf(text, sizeof text, "%zu:%016llx", size, static_cast<unsigned long long>(hash));
+        add(name, text);
+    }
+    std::string str() const { return out_.str(); }
+
+private:
+    std::ostringstream out_;
+};
+
+void add_mcu_state(StateLines& lines, const std::string& name, Mcu& mcu) {
+    avr_t* avr = mcu.avr();
+    const std::string p = name + ".";
+    lines.add(p + "cycle", avr->cycle);
+    lines.add(p + "pc", avr->pc);
+    lines.add(p + "state", static_cast<std::uint64_t>(avr->state));
+    lines.add(p + "steps", mcu.steps());
+    lines.add_bytes(p + "sreg", avr->sreg, sizeof avr->sreg);
+    lines.add_bytes(p + "data", avr->data, static_cast<std::size_t>(avr->ramend) + 1);  // registers, I/O, SRAM
+    lines.add_bytes(p + "flash", avr->flash, static_cast<std::size_t>(avr->flashend) + 1);
+    // simavr 1.6's EEPROM_GET answers -1 even when it filled the
+    // descriptor: the pointer says whether it did.
+    avr_eeprom_desc_t eeprom{};
+    eeprom.size = avr->e2end + 1;
+    (void)avr_ioctl(avr, AVR_IOCTL_EEPROM_GET, &eeprom);
+    if (eeprom.ee != nullptr) lines.add_bytes(p + "eeprom", eeprom.ee, eeprom.size);
+    std::string irqs;
+    for (int i = 0; i < avr->irq_pool.count; ++i) {
+        const avr_irq_t* irq = avr->irq_pool.irq[i];
+        irqs += std::to_string(irq->value) + (irq->flags & IRQ_FLAG_INIT ? "i" : "") + ",";
+    }
+    lines.add_bytes(p + "irq_values", reinterpret_cast<const std::uint8_t*>(irqs.data()), irqs.size());
+    std::string pending;
+    for (int i = 0; i < avr->interrupts.vector_count; ++i) {
+        const avr_int_vector_t* v = avr->interrupts.vector[i];
+        pending += std::to_string(v->vector) + (v->pending ? "p" : "") + ",";
+    }
+    pending += "running=" + std::to_string(avr->interrupts.running_ptr);
+    lines.add(p + "interrupts", pending);
+    // Pending cycle timers: when each falls due, from now (the callbacks are
+    // the same code at the same addresses).
+    std::string timers;
+    for (const avr_cycle_timer_slot_t* t = avr->cycle_timers.timer; t != nullptr; t = t->next) {
+        timers += std::to_string(t->when - avr->cycle) + ",";
+    }
+    lines.add(p + "cycle_timers", timers);
+}
+
+}  // namespace
+
+std::string observable_state() {
+    Bench& bench = *g_bench;
+    StateLines lines;
+    for (Mcu* mcu : bench.board().mcus()) add_mcu_state(lines, mcu->name(), *mcu);
+    for (const auto& net : bench.board().nets()) lines.add("net." + net->name(), net->level() ? 1 : 0);
+    for (Part* part : bench.board().parts()) lines.add("part." + std::string(part->name()), part->summary());
+    if (!g_config.raw) {
+        UartHost& host = bench.host();
+        lines.add("host.lines", host.lines().size());
+        lines.add("host.acknowledged", host.lines_acknowledged());
+        lines.add("host.events", host.events().size());
+        lines.add("host.ready", host.ready() ? 1 : 0);
+    }
+    lines.add("serial.pending_rx", bench.serial().pending_rx());
+    std::string findings;
+    for (const Finding& f : bench.board().findings()) findings += f.describe() + "\n";
+    lines.add_bytes("findings", reinterpret_cast<const std::uint8_t*>(findings.data()), findings.size());
+    return lines.str();
 }
 
 }  // namespace avrbench::fuzz

@@ -23,6 +23,9 @@
 //   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
 //                        answer, for what the lines set in motion (default 0.1:
 //                        five RC-servo frames)
+//   AVRBENCH_FUZZ_FORK   1: each input runs in a forked child of the booted
+//                        process (the path before snapshots; also the one
+//                        sanitizer builds take, whose malloc is not ours)
 //
 // When AVRBENCH_FUZZ_BOARD is not set, the same variables come from a file
 // beside the executable, named after it with ".avrbench" added
@@ -33,11 +36,13 @@
 //
 // Once, at start-up, the firmware boots on the board until its host sees the
 // family's banner (the board's serial port says which: grbl, marlin, teacup).
-// An engine then forks per input; in the child, run_input() sends the
-// input's lines, runs the MCU and counts every program-counter edge
-// (previous PC, PC) into the engine's map, so the search follows the
-// firmware's branches, not the bench's. Booting once and forking keeps an
-// execution to the input's own simulated time.
+// The booted board is then snapshot (SnapshotHeap.hpp): per input,
+// run_input_and_restore() sends the input's lines, runs the MCU, counts every
+// program-counter edge (previous PC, PC) into the engine's map, so the search
+// follows the firmware's branches, not the bench's, and puts the board back
+// as it was booted, in this process. With AVRBENCH_FUZZ_FORK=1 the engine
+// forks per input instead and the child calls run_input(). Either way an
+// execution costs the input's own simulated time, not a boot.
 //
 // Oracles: every finding the MCU and board raise during the input (bad
 // opcode, PC outside the program, stack into .bss, watchdog reset, bad
@@ -64,6 +69,7 @@ struct TargetConfig {
     bool raw = false;
     bool hang_at_bound = false;  // an unanswered line at the bound's end is a finding
     double boot_s = 0.2;   // raw mode: no banner, boot this long
+    bool fork = false;     // fork per input instead of restoring a snapshot
 };
 
 // From the AVRBENCH_FUZZ_* variables (or the file beside `executable`, see
@@ -71,9 +77,14 @@ struct TargetConfig {
 // missing.
 TargetConfig config_from_environment(const char* who, const char* executable);
 
-// Builds the board and boots the firmware to its ready state; on failure
-// prints one line naming the cause and exits with 2.
+// Builds the board and boots the firmware to its ready state, then (unless
+// it forks) takes the snapshot; on failure prints one line naming the cause
+// and exits with 2.
 void boot_target(const TargetConfig& config, const char* who);
+
+// True when the inputs run in this process from the snapshot
+// (run_input_and_restore), false when the engine must fork per input.
+bool target_restores();
 
 // What one input did (filled in the child, so engines put it in shared memory).
 struct InputOutcome {
@@ -86,6 +97,18 @@ struct InputOutcome {
 // edges[0..edge_mask]. Changes the target for good: call it in a forked child.
 void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edges, std::uint32_t edge_mask,
                InputOutcome& outcome);
+
+// run_input() on the snapshot, then the board back as booted: the next input
+// starts from exactly where this one did. Only when target_restores().
+void run_input_and_restore(const std::uint8_t* data, std::size_t size, std::uint8_t* edges, std::uint32_t edge_mask,
+                           InputOutcome& outcome);
+
+// Everything of the booted board a run can observe, one "name value" line
+// per item (MCU registers, RAM, flash, EEPROM, cycle, PC, every IRQ's
+// value, pending interrupts and cycle timers; each net's level, each part's
+// summary, the host's progress, the findings): the snapshot test compares
+// the board after a restore with the board as booted.
+std::string observable_state();
 
 bool target_is_raw();
 

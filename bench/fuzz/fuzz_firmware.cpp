@@ -19,9 +19,10 @@
 //                        libFuzzer (in fork mode, -ignore_crashes) keeps the
 //                        input as crash-*.
 //
-// Per input the process forks; the child runs the input and leaves the edge
-// map and the outcome in memory shared with the parent, which copies the map
-// into libFuzzer's extra counters.
+// Per input the target runs from the booted board's snapshot in this
+// process and puts the board back (FirmwareTarget.hpp), its PC edges going
+// straight into libFuzzer's extra counters; with AVRBENCH_FUZZ_FORK=1 (and in
+// sanitizer builds) it forks per input instead.
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -71,6 +72,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
     const char* who = "fuzz_firmware";
     const char* executable = argc != nullptr && *argc > 0 ? (*argv)[0] : nullptr;
     avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(who, executable), who);
+    if (avrbench::fuzz::target_restores()) return 0;
     void* shared = ::mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
     if (shared == MAP_FAILED) {
         std::perror("fuzz_firmware: mmap");
@@ -80,7 +82,12 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
     return 0;
 }
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+namespace {
+
+// The fork path (AVRBENCH_FUZZ_FORK=1, sanitizer builds): the child runs the
+// input and leaves the edge map and the outcome in memory shared with this
+// process, which copies the map into libFuzzer's extra counters.
+avrbench::fuzz::InputOutcome run_forked(const std::uint8_t* data, std::size_t size) {
     std::memset(g_shared->edges, 0, kMapSize);
     g_shared->outcome = avrbench::fuzz::InputOutcome{};
     const pid_t child = ::fork();
@@ -100,10 +107,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::fprintf(stderr, "fuzz_firmware: the bench itself died on this input (status 0x%x): a bug of the bench\n", status);
         std::abort();
     }
-    if (g_shared->outcome.finding) {
-        char line[sizeof g_shared->outcome.detail + 96];
+    return g_shared->outcome;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    avrbench::fuzz::InputOutcome outcome;
+    if (avrbench::fuzz::target_restores()) {
+        std::memset(g_counters, 0, kMapSize);
+        avrbench::fuzz::run_input_and_restore(data, size, g_counters, kMapSize - 1, outcome);
+    } else {
+        outcome = run_forked(data, size);
+    }
+    if (outcome.finding) {
+        char line[sizeof outcome.detail + 96];
         std::snprintf(line, sizeof line, "avrbench fuzz: FINDING after %llu AVR instructions: %s",
-                      static_cast<unsigned long long>(g_shared->outcome.steps), g_shared->outcome.detail);
+                      static_cast<unsigned long long>(outcome.steps), outcome.detail);
         if (const char* seen = std::getenv("AVRBENCH_FUZZ_SEEN"); seen != nullptr && *seen != '\0') {
             const std::string kind = avrbench::finding_kind(line);
             std::ifstream in(seen);

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The tests the docs name exist: every `Suite.Name`, `Suite.*` and
 `...NameEnd` in docs/*.md and README.md is a test (or suite) of the GoogleTest
-binary, so a table's "test" column cannot point at a test that was renamed or
-removed. Usage: check_test_names.py TEST_BINARY SOURCE_DIR"""
+binaries, so a table's "test" column cannot point at a test that was renamed or
+removed. Usage: check_test_names.py TEST_BINARY SOURCE_DIR [MORE_TEST_BINARIES...]"""
 import glob
 import re
 import subprocess
@@ -29,8 +29,8 @@ def plain(test):
 
 
 def main():
-    binary, source = sys.argv[1], sys.argv[2]
-    tests = {plain(t) for t in listed_tests(binary)}
+    binaries, source = [sys.argv[1]] + sys.argv[3:], sys.argv[2]
+    tests = {plain(t) for binary in binaries for t in listed_tests(binary)}
     suites = {t.split(".")[0] for t in tests}
     missing = []
     files = sorted(glob.glob(source + "/docs/*.md")) + [source + "/README.md"]

@@ -1,0 +1,223 @@
+// The in-process fuzz targets' snapshot (bench/fuzz/SnapshotHeap.hpp,
+// FirmwareTarget.hpp), in a binary of its own: it replaces malloc, which the
+// main suite's binary must not (and it is not built with sanitizers, whose
+// malloc it would displace). A target boots once per process, so every test
+// boots its board in a child and reads back what the child saw.
+//
+// What would make these fail: a piece of state the run changes outside the
+// snapshot heap (a global, a cache, a buffer the region does not hold), a
+// page written without the fault handler noting it, the allocator's own
+// bookkeeping not rewound. Expected values come from the fork path, which
+// gives each input a fresh copy of the booted process (the kernel's
+// copy-on-write), and from the booted board read before any input ran.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "FirmwareTarget.hpp"
+#include "SnapshotHeap.hpp"
+#include "support/Paths.hpp"
+
+namespace avrbench {
+namespace {
+
+namespace fuzz = avrbench::fuzz;
+
+// A guard against a hang, not a budget: each child runs a bounded number of
+// inputs of bounded simulated time.
+constexpr unsigned kChildGuardSeconds = 600;
+constexpr std::uint32_t kMapSize = 1u << 16;
+
+struct ChildResult {
+    int status = 0;
+    std::string text;
+};
+
+// Runs `body` in a forked child; its text comes back through a pipe.
+ChildResult in_child(const std::function<std::string()>& body) {
+    int fds[2];
+    if (::pipe(fds) != 0) return {-1, "pipe failed"};
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::close(fds[0]);
+        ::alarm(kChildGuardSeconds);
+        const std::string text = body();
+        for (std::size_t at = 0; at < text.size();) {
+            const ssize_t n = ::write(fds[1], text.data() + at, text.size() - at);
+            if (n <= 0) ::_exit(3);
+            at += static_cast<std::size_t>(n);
+        }
+        ::_exit(0);
+    }
+    ::close(fds[1]);
+    ChildResult result;
+    char buffer[65536];
+    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) result.text.append(buffer, static_cast<std::size_t>(n));
+    ::close(fds[0]);
+    ::waitpid(child, &result.status, 0);
+    return result;
+}
+
+fuzz::TargetConfig config(const std::string& elf, const std::string& board, const std::string& family) {
+    fuzz::TargetConfig c;
+    c.elf = test::firmware(elf);
+    c.board = board;
+    c.family = family;
+    return c;
+}
+
+std::string outcome_line(const fuzz::InputOutcome& outcome, const std::vector<std::uint8_t>& edges) {
+    std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a of the edge map
+    for (std::uint8_t e : edges) hash = (hash ^ e) * 0x100000001b3ull;
+    std::ostringstream line;
+    line << "steps " << outcome.steps << " edges " << std::hex << hash << std::dec << " finding "
+         << (outcome.finding ? outcome.detail : "-");
+    return line.str();
+}
+
+// Each input run twice from the booted board: in a forked child (the fork
+// path), then in this process from the snapshot; one line per input and
+// path, "fork: ..." and "restore: ...".
+std::string both_paths(const fuzz::TargetConfig& c, const std::vector<std::string>& inputs) {
+    fuzz::boot_target(c, "test_snapshot_heap");
+    if (!fuzz::target_restores()) return "the target does not restore";
+    std::string out;
+    for (const std::string& input : inputs) {
+        const ChildResult forked = in_child([&] {
+            std::vector<std::uint8_t> edges(kMapSize);
+            fuzz::InputOutcome outcome;
+            fuzz::run_input(reinterpret_cast<const std::uint8_t*>(input.data()), input.size(), edges.data(),
+                            kMapSize - 1, outcome);
+            return outcome_line(outcome, edges);
+        });
+        out += "fork: " + forked.text + "\n";
+    }
+    for (const std::string& input : inputs) {
+        std::vector<std::uint8_t> edges(kMapSize);
+        fuzz::InputOutcome outcome;
+        fuzz::run_input_and_restore(reinterpret_cast<const std::uint8_t*>(input.data()), input.size(), edges.data(),
+                                    kMapSize - 1, outcome);
+        out += "restore: " + outcome_line(outcome, edges) + "\n";
+    }
+    return out;
+}
+
+std::vector<std::string> lines_starting(const std::string& text, const std::string& prefix) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind(prefix, 0) == 0) out.push_back(line.substr(prefix.size()));
+    }
+    return out;
+}
+
+void expect_paths_agree(const std::string& text, std::size_t inputs) {
+    const auto forked = lines_starting(text, "fork: ");
+    const auto restored = lines_starting(text, "restore: ");
+    ASSERT_EQ(forked.size(), inputs) << text;
+    ASSERT_EQ(restored.size(), inputs) << text;
+    for (std::size_t i = 0; i < inputs; ++i) EXPECT_EQ(restored[i], forked[i]) << "input " << i << "\n" << text;
+}
+
+}  // namespace
+
+TEST(SnapshotHeap, IsAvailableInThisBuild) {
+    // This binary is only built without sanitizers (tests/CMakeLists.txt),
+    // where the snapshot heap owns malloc.
+    EXPECT_TRUE(fuzz::snapshot_heap::available());
+}
+
+TEST(SnapshotHeap, RestoredBoardIsTheBootedBoardInEverythingARunObserves) {
+    const ChildResult r = in_child([] {
+        fuzz::boot_target(config("printer3d_interp", test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml"),
+                                 "marlin"),
+                          "test_snapshot_heap");
+        const std::string booted = fuzz::observable_state();
+        std::vector<std::uint8_t> edges(kMapSize);
+        fuzz::InputOutcome outcome;
+        // The first input runs outside the snapshot heap (SnapshotHeap.hpp).
+        const std::string first = "M105\n";
+        fuzz::run_input_and_restore(reinterpret_cast<const std::uint8_t*>(first.data()), first.size(), edges.data(),
+                                    kMapSize - 1, outcome);
+        const std::string after_first = fuzz::observable_state();
+        // A move: the carriage, the step counters, the host's lines, RAM.
+        const std::string move = "G1 X5 Y3 F3000\nM114\n";
+        std::string after_move;
+        {
+            const fuzz::snapshot_heap::Collecting collecting;
+            fuzz::run_input(reinterpret_cast<const std::uint8_t*>(move.data()), move.size(), edges.data(), kMapSize - 1,
+                            outcome);
+        }
+        after_move = fuzz::observable_state();
+        fuzz::snapshot_heap::restore();
+        const std::string restored = fuzz::observable_state();
+        const std::size_t pages = fuzz::snapshot_heap::pages_restored();
+        return booted + "====\n" + after_first + "====\n" + after_move + "====\n" + restored + "====\npages " +
+               std::to_string(pages) + "\n";
+    });
+    ASSERT_EQ(r.status, 0) << r.text;
+    std::vector<std::string> parts;
+    for (std::size_t start = 0;;) {
+        const std::size_t end = r.text.find("====\n", start);
+        if (end == std::string::npos) {
+            parts.push_back(r.text.substr(start));
+            break;
+        }
+        parts.push_back(r.text.substr(start, end - start));
+        start = end + 5;
+    }
+    ASSERT_EQ(parts.size(), 5u) << r.text;
+    const std::string& booted = parts[0];
+    // The fixture's one MCU is named "interp".
+    EXPECT_NE(booted.find("interp.data 8704:"), std::string::npos) << booted;     // ATmega2560: RAMEND 0x21FF
+    EXPECT_NE(booted.find("interp.flash 262144:"), std::string::npos) << booted;  // 256 KiB
+    EXPECT_NE(booted.find("interp.eeprom 4096:"), std::string::npos) << booted;   // 4 KiB
+    EXPECT_EQ(parts[1], booted) << "after the first input (restored)";
+    EXPECT_NE(parts[2], booted) << "the move must change what a run observes, or this test proves nothing";
+    EXPECT_EQ(parts[3], booted) << "after the move, restored";
+    EXPECT_NE(parts[4], "pages 0\n");
+}
+
+TEST(SnapshotHeap, RestoredRunsFindWhatForkedRunsFindOnTheThesisParser) {
+    // Seed 001's thesis parser (Code 4.11 as printed): a line longer than its
+    // 50-byte buffer overruns the stack (strcpy); the board's 0.5 s line
+    // timeout catches a line it never answers.
+    const std::vector<std::string> inputs = {
+        "G1 X10 F600\n", "M105\n", "G1 X" + std::string(70, '1') + "\n", "G28\nG1 X1 Y1 F1200\nM114\n", "M105\n",
+        "G1 X" + std::string(70, '2') + "\n", "G91\nG1 X2\nG90\n"};
+    const ChildResult r = in_child([&] {
+        return both_paths(config("printer3d_interp_thesis_parser",
+                                 test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-thesis.yaml"), "marlin"),
+                          inputs);
+    });
+    ASSERT_EQ(r.status, 0) << r.text;
+    expect_paths_agree(r.text, inputs.size());
+    const auto restored = lines_starting(r.text, "restore: ");
+    ASSERT_EQ(restored.size(), inputs.size());
+    EXPECT_NE(restored[0].find("finding timeout: line 1 'G1 X10 F600' got no answer within 0.5 s"), std::string::npos)
+        << "the unanswered line\n" << r.text;
+    EXPECT_NE(restored[2].find("strcpy"), std::string::npos) << "the overrun, in strcpy\n" << r.text;
+    EXPECT_NE(restored[1].find("finding -"), std::string::npos) << "M105 is not\n" << r.text;
+}
+
+TEST(SnapshotHeap, RestoredRunsFindWhatForkedRunsFindOnGrbl) {
+    const std::vector<std::string> inputs = {"X160\n", "G X1\n", "$$\n", "?\n", "G1 X5 Y2 F500\n", "G0 X-3\n$X\n", "X160\n"};
+    const ChildResult r = in_child([&] {
+        return both_paths(config("grbl_stepper", test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), "generic"),
+                          inputs);
+    });
+    ASSERT_EQ(r.status, 0) << r.text;
+    expect_paths_agree(r.text, inputs.size());
+    const auto restored = lines_starting(r.text, "restore: ");
+    ASSERT_EQ(restored.size(), inputs.size());
+    // The same input first and last: the board it met was the same.
+    EXPECT_EQ(restored.front(), restored.back()) << r.text;
+}
+
+}  // namespace avrbench
