@@ -1,7 +1,8 @@
 // `avrbench fuzz`: the front door to the firmware fuzz target
 // (bench/fuzz/FirmwareTarget.hpp). Checks the board and firmware, writes a
 // seed corpus and a G-code dictionary, runs the engine for the given wall
-// time - Debian's libFuzzer in fork mode (fuzz_firmware.cpp), or Debian's
+// time - Debian's libFuzzer, one job in one process or --jobs in its fork
+// mode (fuzz_firmware.cpp), or Debian's
 // AFL++ as one main and --jobs - 1 secondary instances on a shared sync
 // directory (fuzz_firmware_afl.cpp); findings do not stop the campaign -
 // then replays every reproducer once to name its finding, groups them, and
@@ -228,7 +229,17 @@ Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>
                                      "-max_len=512",
                                      "-dict=" + (out / "gcode.dict").string(),
                                      "-artifact_prefix=" + findings.string() + "/",
-                                     "-seed=" + std::to_string(args.seed)};
+                                     "-seed=" + std::to_string(args.seed),
+                                     // The target runs in libFuzzer's process (a snapshot, not a
+                                     // fork per input), where libFuzzer's memcmp/strcmp interceptors
+                                     // would take the bench's own compares (the host reading answers)
+                                     // for the firmware's and mutate towards them; the firmware's
+                                     // compares are AVR instructions it cannot see.
+                                     "-use_cmp=0",
+                                     // Entropic's bookkeeping costs per feature per execution, and
+                                     // an execution here has thousands (PC edges): measured, half of
+                                     // each execution (docs/PERFORMANCE.md, "Fuzzing throughput").
+                                     "-entropic=0"};
     if (in_process) {
         argv.push_back("-print_final_stats=1");
     } else {

@@ -12,7 +12,7 @@
 // fork server in the target, the G-code mutator as its custom mutator, -E).
 // Seed 004's delta: the out-of-table angle with AFL++, nothing in the
 // improved build. Measured with these seeds (the same on every run):
-// libFuzzer (one job, in one process) had both bugs by its 13th execution
+// libFuzzer (one job, in one process) had both bugs by its 17th execution
 // (bound: 600); AFL++ the stack overrun at execution 55 and the unanswered
 // line at 73 (bound: 1500), the delta's angle at 198 (bound: 2000). The
 // improved builds must give nothing in 1000.
