@@ -199,7 +199,14 @@ void on_segv(int signal, siginfo_t* info, void* context) {
         g_previous_segv.sa_handler(signal);
         return;
     }
-    ::signal(SIGSEGV, SIG_DFL);  // returning re-runs the access, which now kills
+    // libFuzzer installs its handler after ours and calls ours first (its
+    // "upstream"), never reporting the fault itself: say what it was, then
+    // die of it (returning re-runs the access, which now kills) - the
+    // engine sees a crash (AFL++ keeps the input; libFuzzer's parent, with
+    // --jobs, too).
+    static const char message[] = "avrbench: SIGSEGV outside the fuzz target's snapshot region: the bench crashed on this input\n";
+    (void)!::write(2, message, sizeof message - 1);
+    ::signal(SIGSEGV, SIG_DFL);
 }
 
 void watch_writes() {

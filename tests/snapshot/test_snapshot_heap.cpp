@@ -11,6 +11,8 @@
 // gives each input a fresh copy of the booted process (the kernel's
 // copy-on-write), and from the booted board read before any input ran.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -218,6 +220,22 @@ TEST(SnapshotHeap, RestoredRunsFindWhatForkedRunsFindOnGrbl) {
     ASSERT_EQ(restored.size(), inputs.size());
     // The same input first and last: the board it met was the same.
     EXPECT_EQ(restored.front(), restored.back()) << r.text;
+}
+
+TEST(SnapshotHeap, AFaultOutsideTheRegionStillKillsTheProcess) {
+    // The write-protection handler takes the faults in its region only: a
+    // bench bug elsewhere must still end the process (a crash the engine
+    // sees), neither swallowed nor retried forever (the guard would end that).
+    const ChildResult r = in_child([] {
+        fuzz::boot_target(config("printer3d_interp", test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml"),
+                                 "marlin"),
+                          "test_snapshot_heap");
+        void* page = ::mmap(nullptr, 4096, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (page == MAP_FAILED) return std::string("mmap failed");
+        *static_cast<volatile int*>(page) = 1;
+        return std::string("survived the write");
+    });
+    EXPECT_TRUE(WIFSIGNALED(r.status) && WTERMSIG(r.status) == SIGSEGV) << "status 0x" << std::hex << r.status << ": " << r.text;
 }
 
 }  // namespace avrbench
