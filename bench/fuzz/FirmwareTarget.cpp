@@ -154,21 +154,6 @@ void boot(const TargetConfig& config, const char* who) {
                              config.board.c_str(), host.failed() ? host.failure_message().c_str() : "no banner");
                 std::exit(2);
             }
-            if (host.options().startup == Startup::Immediately) {
-                // A firmware of no known family: the host may send at once,
-                // but the snapshot should hold the booted firmware, not its
-                // boot (which every input would otherwise run again). Booted:
-                // its serial output quiet for the host's quiet_after_welcome_s
-                // after its last byte, or boot_s gone by when it says nothing.
-                const Cycle start = mcu.cycle();
-                const Cycle quiet = mcu.cycles_from_seconds(host.options().quiet_after_welcome_s);
-                const Cycle silent_boot = mcu.cycles_from_seconds(config.boot_s);
-                while (!mcu.halted() && mcu.cycle() < limit) {
-                    const auto& received = host.received();
-                    if (received.empty() ? mcu.cycle() - start >= silent_boot : mcu.cycle() - received.back().cycle >= quiet) break;
-                    g_bench->run_for(0.001);
-                }
-            }
         }
         const auto at_ready = g_bench->board().findings();
         g_findings_at_ready = at_ready.size();

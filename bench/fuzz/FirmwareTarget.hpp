@@ -16,11 +16,7 @@
 //                        host, so no banner to wait for (the firmware boots
 //                        for AVRBENCH_FUZZ_BOOT seconds, default 0.2) and no
 //                        hang oracle; the run ends the settle time after the
-//                        last byte went in. A firmware of no known family
-//                        (generic) has no banner either: it boots until its
-//                        serial output has been quiet for the host's
-//                        quiet_after_welcome_s (0.2 s) after its last byte,
-//                        or for AVRBENCH_FUZZ_BOOT seconds if it says nothing
+//                        last byte went in
 //   AVRBENCH_FUZZ_HANG   1: a line still unanswered when the bound ends is a
 //                        finding ("hang"), keep-alives or not (the
 //                        serial port's line timeout is restarted by them)
