@@ -97,12 +97,15 @@ void run_input_from(const char* path, std::uint8_t* map) {
 // The persistent child: AFL writes each input to the same file (or to
 // standard input, rewound), then resumes this process.
 [[noreturn]] void run_persistent(const char* path, std::uint8_t* map) {
-    for (int i = 0; i < kInputsPerChild; ++i) {
+    for (int i = 1;; ++i) {
         if (path == nullptr) (void)::lseek(0, 0, SEEK_SET);
         run_input_from(path, map);
+        // The last input's status is this exit (as AFL++'s own __AFL_LOOP
+        // ends): stopping first would leave the next request answered by an
+        // exit with no input run.
+        if (i == kInputsPerChild) std::_Exit(0);
         ::raise(SIGSTOP);
     }
-    std::_Exit(0);
 }
 
 std::uint8_t* coverage_map() {
