@@ -14,6 +14,10 @@ namespace avrbench {
 
 // How many OnProcessHeap scopes this thread is inside.
 int process_heap_depth() noexcept;
+// The same scope without an object, for code that cannot hold one across
+// calls (the fuzz targets' hooks on function-local statics' initialization).
+void enter_process_heap() noexcept;
+void leave_process_heap() noexcept;
 
 class OnProcessHeap {
 public:

@@ -273,6 +273,8 @@ void restore() {
     g_dirty_count = 0;
 }
 
+bool holds(const void* p) noexcept { return in_region(p); }
+
 std::size_t snapshot_bytes() noexcept { return g_snapshot_bytes; }
 
 std::size_t pages_restored() noexcept { return g_pages_restored; }
@@ -294,6 +296,26 @@ namespace {
 
 #ifndef AVRBENCH_SANITIZER_OWNS_MALLOC
 namespace heap = avrbench::fuzz::snapshot_heap;
+
+// A function-local static's initialization, bracketed by the C++ runtime's
+// guard calls (Itanium C++ ABI 3.3.2), runs on the process heap: the static
+// outlives every restore. The runtime's own functions do the guarding.
+namespace {
+using GuardAcquire = int (*)(std::uint64_t*);
+using GuardDone = void (*)(std::uint64_t*);
+GuardAcquire g_guard_acquire = nullptr;
+GuardDone g_guard_release = nullptr;
+GuardDone g_guard_abort = nullptr;
+
+template <class F>
+F runtime_function(F& cached, const char* name) {
+    if (cached == nullptr) {
+        cached = reinterpret_cast<F>(::dlsym(RTLD_NEXT, name));
+        if (cached == nullptr) heap::die("the C++ runtime's guard functions are not there");
+    }
+    return cached;
+}
+}  // namespace
 
 extern "C" {
 
@@ -358,6 +380,22 @@ std::size_t malloc_usable_size(void* p) {
     if (p == nullptr) return 0;
     if (heap::in_region(p)) return heap::header_of(p)->capacity;
     return heap::libc_usable_size(p);
+}
+
+int __cxa_guard_acquire(std::uint64_t* guard) {
+    const int initialize = runtime_function(g_guard_acquire, "__cxa_guard_acquire")(guard);
+    if (initialize != 0) avrbench::enter_process_heap();
+    return initialize;
+}
+
+void __cxa_guard_release(std::uint64_t* guard) {
+    runtime_function(g_guard_release, "__cxa_guard_release")(guard);
+    avrbench::leave_process_heap();
+}
+
+void __cxa_guard_abort(std::uint64_t* guard) {
+    runtime_function(g_guard_abort, "__cxa_guard_abort")(guard);
+    avrbench::leave_process_heap();
 }
 
 }  // extern "C"

@@ -24,10 +24,14 @@
 //
 // What it cannot see: memory outside the region that the run changes.
 // Process-wide caches grow on the process heap (OnProcessHeap) and keep
-// what they learnt; a lazily made process-wide object (a stdio buffer, a
-// function-local static) is made on the process heap by the targets' first
-// input, which runs outside the region (first_input_outside()). The test
-// SnapshotHeap.* checks restored runs against forked ones input by input.
+// what they learnt. A function-local static first reached by an input is
+// made on the process heap too: this file also wraps the C++ runtime's
+// __cxa_guard_acquire/release/abort, which bracket such an initialization,
+// in an OnProcessHeap scope (else the next restore would take back memory
+// the static still points at). Other lazily made process state (stdio
+// buffers) is made by the targets' first input, which runs outside the
+// region. The test SnapshotHeap.* checks restored runs against forked ones
+// input by input.
 #pragma once
 
 #include <cstddef>
@@ -54,6 +58,9 @@ void take();
 // region is again what it was at take(). Nothing may still point into memory
 // allocated since (call it after the input's objects are gone).
 void restore();
+
+// Whether `p` points into the region (memory a restore takes back).
+bool holds(const void* p) noexcept;
 
 // What the region held at take(), in bytes, and how many pages the last
 // restore() wrote back.

@@ -127,6 +127,12 @@ void expect_paths_agree(const std::string& text, std::size_t inputs) {
     for (std::size_t i = 0; i < inputs; ++i) EXPECT_EQ(restored[i], forked[i]) << "input " << i << "\n" << text;
 }
 
+// Reached for the first time inside a Collecting scope (below).
+const std::string& made_on_first_use() {
+    static const std::string text(4096, 'x');
+    return text;
+}
+
 }  // namespace
 
 TEST(SnapshotHeap, IsAvailableInThisBuild) {
@@ -220,6 +226,33 @@ TEST(SnapshotHeap, RestoredRunsFindWhatForkedRunsFindOnGrbl) {
     ASSERT_EQ(restored.size(), inputs.size());
     // The same input first and last: the board it met was the same.
     EXPECT_EQ(restored.front(), restored.back()) << r.text;
+}
+
+TEST(SnapshotHeap, AFunctionLocalStaticFirstReachedByAnInputOutlivesTheRestore) {
+    // A static made during an input, on the region, would point into memory
+    // the next restore takes back; the guard hooks put it on the process heap.
+    const ChildResult r = in_child([] {
+        fuzz::boot_target(config("printer3d_interp", test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml"),
+                                 "marlin"),
+                          "test_snapshot_heap");
+        // Only booleans cross the restore: anything allocated in the scope is taken back by it.
+        bool ordinary_in_region = false, static_in_region = false;
+        {
+            const fuzz::snapshot_heap::Collecting collecting;
+            // The control: an ordinary allocation in the scope is the region's.
+            auto* ordinary = new std::string(4096, 'y');
+            ordinary_in_region = fuzz::snapshot_heap::holds(ordinary->data());
+            delete ordinary;
+            static_in_region = fuzz::snapshot_heap::holds(made_on_first_use().data());
+        }
+        fuzz::snapshot_heap::restore();
+        std::string out = std::string("ordinary ") + (ordinary_in_region ? "region" : "process") + "\n";
+        out += std::string("static ") + (static_in_region ? "region" : "process") + "\n";
+        out += "after restore " + std::to_string(made_on_first_use().size()) + " " + made_on_first_use().substr(0, 3) + "\n";
+        return out;
+    });
+    ASSERT_EQ(r.status, 0) << r.text;
+    EXPECT_EQ(r.text, "ordinary region\nstatic process\nafter restore 4096 xxx\n");
 }
 
 TEST(SnapshotHeap, AFaultOutsideTheRegionStillKillsTheProcess) {
