@@ -253,9 +253,9 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
 void run_input_and_restore(const std::uint8_t* data, std::size_t size, std::uint8_t* edges, std::uint32_t edge_mask,
                            InputOutcome& outcome) {
     // The first input runs on the process's heap (SnapshotHeap.hpp): what it
-    // makes lazily for the whole process (stdio buffers, function-local
-    // statics) then outlives the restores. Where its allocations live changes
-    // nothing of what it does.
+    // makes lazily for the whole process (stdio buffers; function-local
+    // statics are on the process heap anyway) then outlives the restores.
+    // Where its allocations live changes nothing of what it does.
     static bool first_input_done = false;
     if (!first_input_done) {
         first_input_done = true;
