@@ -358,6 +358,16 @@ void* realloc(void* p, std::size_t bytes) {
     return moved;
 }
 
+// glibc's own reallocarray would hand a region block to its realloc.
+void* reallocarray(void* p, std::size_t count, std::size_t size) {
+    std::size_t bytes = 0;
+    if (__builtin_mul_overflow(count, size, &bytes)) {
+        errno = ENOMEM;
+        return nullptr;
+    }
+    return realloc(p, bytes);
+}
+
 void* memalign(std::size_t alignment, std::size_t bytes) { return heap::checked_aligned(alignment, bytes); }
 
 void* aligned_alloc(std::size_t alignment, std::size_t bytes) { return heap::checked_aligned(alignment, bytes); }

@@ -14,13 +14,14 @@
 // notes the page and makes it writable (chaining any other fault to the
 // handler that was there before).
 //
-// How allocations get there: this file's malloc, free, calloc, realloc and
-// the aligned variants replace the C library's in the executable that links
-// it (the fuzz targets only; glibc's "Replacing malloc"). A thread inside a
-// Collecting scope allocates from the region; everything else (libFuzzer,
-// AFL, other threads, OnProcessHeap scopes: core/ProcessHeap.hpp) from the C
-// library's heap; free and realloc go by address. In sanitizer builds the
-// sanitizer owns malloc: available() is false and the targets fork.
+// How allocations get there: this file's malloc, free, calloc, realloc,
+// reallocarray and the aligned variants replace the C library's in the
+// executable that links it (the fuzz targets only; glibc's "Replacing
+// malloc"). A thread inside a Collecting scope allocates from the region;
+// everything else (libFuzzer, AFL, other threads, OnProcessHeap scopes:
+// core/ProcessHeap.hpp) from the C library's heap; free and realloc go by
+// address. In sanitizer builds the sanitizer owns malloc: available() is
+// false and the targets fork.
 //
 // What it cannot see: memory outside the region that the run changes.
 // Process-wide caches grow on the process heap (OnProcessHeap) and keep
