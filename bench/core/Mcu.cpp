@@ -170,7 +170,6 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     extint_ = reinterpret_cast<avr_extint_t*>(find_io_module(avr_, "extint"));
     acomp_ = reinterpret_cast<avr_acomp_t*>(find_io_module(avr_, "ac"));
     if (options_.skip_idle_loops && !options_.reference_run_loop) skipper_ = std::make_unique<IdleLoopSkipper>(avr_);
-    if (options_.predecoded_core && !options_.reference_run_loop) predecoded_ = std::make_unique<PredecodedCore>(avr_);
 
     for (avr_io_t* io = avr_->io_port; io != nullptr; io = io->next) {
         if (io->kind != nullptr && std::strcmp(io->kind, "watchdog") == 0 && io->reset != nullptr) {
@@ -189,6 +188,12 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     code_end_bytes_ = elf_code_end_bytes_;
     bad_interrupt_pc_ = elf_bad_interrupt_pc_;
     stack_floor_ = elf_stack_floor_;
+    if (options_.predecoded_core && !options_.reference_run_loop) predecoded_ = make_predecoded_core();
+}
+
+std::unique_ptr<PredecodedCore> Mcu::make_predecoded_core() const {
+    // The oracle limits run_until passes (code_end_bytes_ - 1 as there).
+    return std::make_unique<PredecodedCore>(avr_, code_end_bytes_ - 1, bad_interrupt_pc_);
 }
 
 void Mcu::load_bootloader() {
@@ -295,7 +300,7 @@ void Mcu::set_predecoded_core(bool on) {
     if (!on || options_.reference_run_loop) {
         predecoded_.reset();
     } else if (!predecoded_) {
-        predecoded_ = std::make_unique<PredecodedCore>(avr_);
+        predecoded_ = make_predecoded_core();
     }
 }
 std::uint64_t Mcu::idle_jumps() const { return skipper_ ? skipper_->jumps() : 0; }

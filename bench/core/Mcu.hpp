@@ -309,6 +309,7 @@ private:
     std::unique_ptr<Twi> twi_;
     std::unique_ptr<IdleLoopSkipper> skipper_;  // nullptr: never skip
     std::unique_ptr<PredecodedCore> predecoded_;  // nullptr: avr_run_one (McuOptions::predecoded_core)
+    std::unique_ptr<PredecodedCore> make_predecoded_core() const;
     std::uint32_t skip_countdown_ = 1;
     Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;

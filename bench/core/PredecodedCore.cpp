@@ -1,5 +1,6 @@
 #include "core/PredecodedCore.hpp"
 
+#include <cstring>
 #include <new>
 
 #include "core/Mcu.hpp"
@@ -7,17 +8,45 @@
 
 namespace avrbench {
 
-PredecodedCore::PredecodedCore(const avr_t* avr) {
+PredecodedCore::PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc) {
     // One slot per flash word; calloc leaves untouched pages unmapped and
     // zero is kUndecoded, so only the code that runs costs memory.
-    const std::size_t words = static_cast<std::size_t>(avr->flashend) / 2 + 2;
+    slot_count_ = static_cast<std::size_t>(avr->flashend) / 2 + 2;
     // A cache of what flash says (each slot is checked against its flash
     // word on every fetch), so a fuzz target that restores its board
     // (core/ProcessHeap.hpp) keeps it on the process's heap: what one input
     // decoded, the next need not decode again.
     const OnProcessHeap cache_outlives_restores;
-    slots_.reset(static_cast<Slot*>(std::calloc(words, sizeof(Slot))));
-    if (!slots_) throw std::bad_alloc();
+    slots_.reset(static_cast<Slot*>(std::calloc(slot_count_, sizeof(Slot))));
+    checked_for_.reset(static_cast<CheckedFor*>(std::malloc(sizeof(CheckedFor))));
+    if (!slots_ || !checked_for_) throw std::bad_alloc();
+    *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc};
+}
+
+PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc) const {
+    Slot s = decode(avr, word, pc);
+    // run_batch tests the crash oracles (Mcu::check_after_step: PC 0 or
+    // past the code, __bad_interrupt, SP below .bss) only after the
+    // instructions that can trip them: those that may move SP, those whose
+    // next PC is computed at run time (IJMP, ICALL, RET, and JMP, whose
+    // target word is read when it runs), and those whose next PC can be one
+    // of the limits: pc + 2, + 4 or + 6 (a skip over a two-word
+    // instruction), or the branch target.
+    const CheckedFor& limits = *checked_for_;
+    const auto trips = [&](avr_flashaddr_t next) { return next - 1 >= limits.code_end_minus_one || next == limits.bad_interrupt_pc; };
+    bool check = (s.flags & kMovesSp) || trips(pc + 2) || trips(pc + 4) || trips(pc + 6);
+    switch (s.kind) {
+        case kIjmp: case kIcall: case kRet: case kJmp: case kCall:
+            check = true;
+            break;
+        case kRjmp: case kRcall: case kBrbs: case kBrbc:
+            check = check || trips(s.target);
+            break;
+        default:
+            break;
+    }
+    s.check = check ? 1 : 0;
+    return s;
 }
 
 // The dispatch tree of simavr 1.6's avr_run_one (sim_core.c), in its order,
@@ -202,74 +231,181 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
             break;
         default: break;
     }
+    if ((s.kind == kLds || s.kind == kSts) && next_pc + 1 > avr->flashend) s.kind = kSimavr;  // no address word in flash
     if (moves_sp(s.kind)) s.flags |= kMovesSp;
+    if (s.kind == kLds || s.kind == kSts) {
+        // The address word, for the handlers' fast path while flash holds
+        // it: RAM past the I/O registers, up to RAMEND (no SREG, no
+        // register file; simavr's io[] still covers its first bytes, whose
+        // callbacks and IRQs the handler looks at).
+        s.word2 = static_cast<std::uint16_t>(avr->flash[next_pc] | (avr->flash[next_pc + 1] << 8));
+        s.target = s.word2;
+        if (s.word2 > avr->ioend && s.word2 <= avr->ramend) s.flags |= kRamOperand;
+    }
+    // STS and OUT store to SPL/SPH only when that is their (decoded) address.
+    if ((s.kind == kSts && s.word2 != R_SPL && s.word2 != R_SPH) || (s.kind == kOut && s.a != R_SPL && s.a != R_SPH)) {
+        s.flags &= static_cast<std::uint8_t>(~kMovesSp);
+    }
     return s;
 }
 
+// Threaded code: every handler of PredecodedOps.inc ends in its own copy of
+// the checks after an instruction and of the next instruction's dispatch
+// (with this instruction's cycle count folded in as a constant; the
+// compiler may still share identical tails), instead of one switch in a
+// loop with the bounds check, the Done result and the checks of every
+// kind behind it. On busy_poll that took the batch from 82 to 47 host
+// instructions per AVR instruction, together with the slot's `check` and
+// the LDS/STS address decoded once (docs/PERFORMANCE.md).
+// Labels as values are a GNU extension (GCC and clang).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
 template <bool kCover>
 PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& limits, PcEdgeMap* edges) {
-    using predecoded_detail::sp_of;
+    using namespace predecoded_detail;
     Batch batch;
-    const predecoded_detail::Machine m(avr);
+    // simavr's GDB stub watches data accesses: run_one (the general step)
+    // hands each of them to avr_run_one.
+    if (avr->gdb != nullptr) return batch;
+    const Machine m(avr, false);
     // With SP already below the floor (a half-written SP, which the oracle
     // lets pass) every step needs the oracle: the general step takes them.
     if (sp_of(m.data) < limits.stack_floor) return batch;
-    // The PC and the cycle count live in registers until the batch ends;
-    // execute() stores them before it calls simavr's I/O callbacks.
-    avr_flashaddr_t pc = avr->pc;
-    avr_cycle_count_t cycle = avr->cycle;
-    Slot* const slots = slots_.get();
-    const std::uint32_t max_steps = limits.max_steps;
     // A PC past the flash is avr_run_one's (it crashes the core). Inside the
-    // loop the PC stays below the code's end (the CheckPc test), which is
-    // within the flash.
-    if (pc >= m.flashend || limits.code_end_minus_one > m.flashend) return batch;
-    avr_cycle_count_t cycle_limit = limits.cycle;
-    while (batch.steps < max_steps) {
-        const Slot& slot = *slot_at(slots, m, pc);
-        avr_flashaddr_t new_pc;
-        int cycles;
-        const Done done = execute(m, slot, pc, cycle, new_pc, cycles);
-        if (done == Done::HandOver) break;
-        if (__builtin_expect(done == Done::Plain, 1)) cycle += static_cast<avr_cycle_count_t>(cycles);
-        ++batch.steps;
-        if (__builtin_expect(done == Done::CalledSimavr, 0)) {
-            // A callback may move the cycle count itself (fixes/EepromTiming
-            // halts the core 4 cycles on a read that way): count on from it.
-            cycle = avr->cycle + static_cast<avr_cycle_count_t>(cycles);
-            avr->cycle = cycle;
-            // What the fast path checks after avr_run_one: a timer the
-            // callbacks made due, a core no longer running, an interrupt.
-            const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
-            if (first == nullptr || first->when <= cycle || avr->state != cpu_Running || avr->interrupt_state != 0) {
-                batch.ended = Ended::TimerDue;
-                batch.new_pc = new_pc;
-                break;
-            }
-            cycle_limit = first->when;
-        }
-        if (__builtin_expect(cycle >= cycle_limit, 0)) {
-            batch.ended = Ended::TimerDue;
-            batch.new_pc = new_pc;
-            break;
-        }
-        // SP only changes through the kinds that store to the data space.
-        if (__builtin_expect(new_pc - 1 >= limits.code_end_minus_one || new_pc == limits.bad_interrupt_pc ||
-                                 ((slot.flags & kMovesSp) && sp_of(m.data) < limits.stack_floor),
-                             0)) {
-            batch.ended = Ended::CheckPc;
-            batch.new_pc = new_pc;
-            break;
-        }
-        pc = new_pc;
-        if constexpr (kCover) edges->hit(new_pc);
-        else (void)edges;
+    // loop the PC stays below the code's end (the check after every
+    // instruction that can leave it), which is within the flash.
+    // (A PC is even: every new PC is a word address times 2; the slot of
+    // byte address pc is at byte offset pc * 8.)
+    if (avr->pc >= m.flashend() || (avr->pc & 1) != 0 || limits.code_end_minus_one > m.flashend()) return batch;
+    if (limits.max_steps == 0) {
+        batch.ended = Ended::Count;
+        return batch;
     }
-    if (batch.ended == Ended::HandOver && batch.steps == max_steps) batch.ended = Ended::Count;
+    if (checked_for_->code_end_minus_one != limits.code_end_minus_one || checked_for_->bad_interrupt_pc != limits.bad_interrupt_pc) {
+        // Other oracle limits (a boot loader wrote another application):
+        // every slot is decoded again, with its `check` for these.
+        std::memset(static_cast<void*>(slots_.get()), 0, slot_count_ * sizeof(Slot));
+        *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc};
+    }
+    static const void* const kHandlers[kKinds] = {
+#define AVRBENCH_HANDLER_ADDRESS(kind) &&op_##kind,
+        AVRBENCH_PREDECODED_KINDS(AVRBENCH_HANDLER_ADDRESS)
+#undef AVRBENCH_HANDLER_ADDRESS
+    };
+    Slot* const slots = slots_.get();
+    std::uint8_t* const data = m.data;
+    std::uint8_t* const sreg = m.sreg;
+    // The oracles' limits are read from `limits` in the (cold) check.
+    const std::uint32_t max_steps = limits.max_steps;
+    // The PC and the cycle count live in registers until the batch ends;
+    // AVRBENCH_BEFORE_CALLBACKS stores them before simavr's I/O callbacks.
+    // The count is kept as the cycles left to the first timer (`budget`,
+    // counted down): the timer test is then one subtraction.
+    avr_flashaddr_t pc = avr->pc;
+    avr_cycle_count_t cycle_limit = limits.cycle;
+    std::int64_t budget = static_cast<std::int64_t>(cycle_limit - avr->cycle);
+    std::uint32_t remaining = max_steps;  // steps left
+    const Slot* slot;
+    avr_flashaddr_t new_pc;
+    int cycle;
+
+#define AVRBENCH_DISPATCH()                                                                       \
+    do {                                                                                          \
+        slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + std::size_t{pc} * 8); \
+        if (__builtin_expect(slot->word != flash16(m.flash, pc), 0)) goto decode_slot;            \
+        new_pc = pc + 2;                                                                          \
+        cycle = 1;                                                                                \
+        goto* kHandlers[slot->kind];                                                              \
+    } while (0)
+    // What Mcu::run_until's fast path checks after an instruction, then the
+    // next one: the first cycle timer due, the crash oracles (only after
+    // the slots that can trip them), the step count.
+#define AVRBENCH_NEXT()                                                                           \
+    do {                                                                                          \
+        --remaining;                                                                              \
+        budget -= cycle;                                                                          \
+        if (__builtin_expect(budget <= 0, 0)) goto timer_due;                                     \
+        if (__builtin_expect(slot->check != 0, 0)) goto check_oracles;                            \
+        pc = new_pc;                                                                              \
+        if constexpr (kCover) edges->hit(pc);                                                     \
+        if (__builtin_expect(remaining == 0, 0)) goto count_reached;                              \
+        AVRBENCH_DISPATCH();                                                                      \
+    } while (0)
+#define AVRBENCH_NEXT_CALLED() goto after_callbacks
+#define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(budget))
+#define AVRBENCH_HAND_OVER() goto hand_over
+    // Each handler is a block with the slot's operands; it begins by
+    // closing the one before (which never falls through: every handler
+    // ends in a jump), so they are not live across the dispatch.
+#define AVRBENCH_OP(kind)                                    \
+    }                                                        \
+    op_##kind : {                                            \
+        [[maybe_unused]] const std::uint8_t a = slot->a;     \
+        [[maybe_unused]] const std::uint8_t b = slot->b;
+
+    AVRBENCH_DISPATCH();
+    {
+#include "core/PredecodedOps.inc"
+    }
+op_kUndecoded:  // a calloc'd slot, whose word 0 matched a NOP in flash
+decode_slot:
+    slots[pc >> 1] = decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
+    new_pc = pc + 2;
+    cycle = 1;
+    goto* kHandlers[slot->kind];
+op_kSimavr:
+hand_over:
+    batch.ended = Ended::HandOver;
+    goto out;
+after_callbacks : {
+    --remaining;
+    // A callback may move the cycle count itself (fixes/EepromTiming
+    // halts the core 4 cycles on a read that way): count on from it.
+    const avr_cycle_count_t cycle_now = avr->cycle + static_cast<avr_cycle_count_t>(cycle);
+    avr->cycle = cycle_now;
+    cycle_limit = cycle_now;
+    budget = 0;
+    // What the fast path checks after avr_run_one: a timer the callbacks
+    // made due, a core no longer running, an interrupt on its way.
+    const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
+    if (first == nullptr || first->when <= cycle_now || avr->state != cpu_Running || avr->interrupt_state != 0) goto timer_due;
+    cycle_limit = first->when;
+    budget = static_cast<std::int64_t>(cycle_limit - cycle_now);
+    if (slot->check == 0) goto advance;
+}
+check_oracles:
+    // SP only changes through the kinds that may store to the data space.
+    if (new_pc - 1 >= limits.code_end_minus_one || new_pc == limits.bad_interrupt_pc ||
+        ((slot->flags & kMovesSp) && sp_of(data) < limits.stack_floor)) {
+        batch.ended = Ended::CheckPc;
+        batch.new_pc = new_pc;
+        goto out;
+    }
+advance:
+    pc = new_pc;
+    if constexpr (kCover) edges->hit(pc);
+    if (remaining == 0) goto count_reached;
+    AVRBENCH_DISPATCH();
+timer_due:
+    // avr->pc stays at the last instruction; Mcu finishes it (SimavrStepper::finish).
+    batch.ended = Ended::TimerDue;
+    batch.new_pc = new_pc;
+    goto out;
+count_reached:
+    batch.ended = Ended::Count;
+out:
+#undef AVRBENCH_OP
+#undef AVRBENCH_CYCLE_BEFORE
+#undef AVRBENCH_HAND_OVER
+#undef AVRBENCH_NEXT_CALLED
+#undef AVRBENCH_NEXT
+#undef AVRBENCH_DISPATCH
+    batch.steps = max_steps - remaining;
     avr->pc = pc;
-    avr->cycle = cycle;
+    avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(budget);
     return batch;
 }
+#pragma GCC diagnostic pop
 
 template PredecodedCore::Batch PredecodedCore::run_batch<false>(avr_t*, const BatchLimits&, PcEdgeMap*);
 template PredecodedCore::Batch PredecodedCore::run_batch<true>(avr_t*, const BatchLimits&, PcEdgeMap*);

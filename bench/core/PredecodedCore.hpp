@@ -45,9 +45,33 @@ namespace predecoded_detail {
 struct Machine;
 }
 
+// Every slot kind, in the order of PredecodedCore::Kind (the enum and
+// run_batch's handler table are both made from this list). kUndecoded:
+// calloc'd slots start here; kSimavr: avr_run_one executes it; the X/Y/Z
+// loads and stores carry in operand b 0 (plain), 1 (post-increment) or
+// 2 (pre-decrement).
+#define AVRBENCH_PREDECODED_KINDS(X)                                                          \
+    X(kUndecoded) X(kSimavr) X(kNop)                                                          \
+    X(kCpc) X(kAdd) X(kSbc) X(kMovw) X(kMuls) X(kMulsu) X(kFmul) X(kFmuls) X(kFmulsu)         \
+    X(kSub) X(kCpse) X(kCp) X(kAdc) X(kAnd) X(kEor) X(kOr) X(kMov)                            \
+    X(kCpi) X(kSbci) X(kSubi) X(kOri) X(kAndi)                                                \
+    X(kLddZ) X(kStdZ) X(kLddY) X(kStdY)                                                       \
+    X(kSregSet) X(kSregClear)                                                                 \
+    X(kLpmR0) X(kLpm) X(kLpmInc) X(kLds) X(kSts)                                              \
+    X(kLdX) X(kStX) X(kLdY) X(kStY) X(kLdZ) X(kStZ)                                           \
+    X(kPop) X(kPush)                                                                          \
+    X(kCom) X(kNeg) X(kSwap) X(kInc) X(kAsr) X(kLsr) X(kRor) X(kDec)                          \
+    X(kJmp) X(kCall) X(kAdiw) X(kSbiw) X(kSbic) X(kSbis) X(kMul)                              \
+    X(kOut) X(kIn) X(kCbi) X(kSbi)                                                            \
+    X(kRjmp) X(kRcall) X(kLdi) X(kBrbs) X(kBrbc) X(kBld) X(kBst) X(kSbrc) X(kSbrs)            \
+    X(kIjmp) X(kIcall) X(kRet)
+
 class PredecodedCore {
 public:
-    explicit PredecodedCore(const avr_t* avr);
+    // code_end_minus_one and bad_interrupt_pc: the crash oracles' limits
+    // Mcu::run_until will pass in BatchLimits (decoding records which
+    // instructions can reach them; other limits later cost one re-decode).
+    explicit PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u);
 
     // avr_run_one for one instruction (see above).
     __attribute__((always_inline)) avr_flashaddr_t run_one(avr_t* avr);
@@ -85,22 +109,9 @@ public:
     std::uint64_t handed_to_simavr() const { return handed_; }
 
     enum Kind : std::uint8_t {
-        kUndecoded = 0,  // calloc'd slots start here
-        kSimavr,         // avr_run_one executes it
-        kNop,
-        kCpc, kAdd, kSbc, kMovw, kMuls, kMulsu, kFmul, kFmuls, kFmulsu,
-        kSub, kCpse, kCp, kAdc, kAnd, kEor, kOr, kMov,
-        kCpi, kSbci, kSubi, kOri, kAndi,
-        kLddZ, kStdZ, kLddY, kStdY,
-        kSregSet, kSregClear,  // BSET/BCLR of any flag but I
-        kLpmR0, kLpm, kLpmInc, kLds, kSts,
-        kLdX, kStX, kLdY, kStY, kLdZ, kStZ,  // operand b: 0 plain, 1 post-increment, 2 pre-decrement
-        kPop, kPush,
-        kCom, kNeg, kSwap, kInc, kAsr, kLsr, kRor, kDec,
-        kJmp, kCall, kAdiw, kSbiw, kSbic, kSbis, kMul,
-        kOut, kIn, kCbi, kSbi,
-        kRjmp, kRcall, kLdi, kBrbs, kBrbc, kBld, kBst, kSbrc, kSbrs,
-        kIjmp, kIcall, kRet,
+#define AVRBENCH_KIND_ENUMERATOR(kind) kind,
+        AVRBENCH_PREDECODED_KINDS(AVRBENCH_KIND_ENUMERATOR)
+#undef AVRBENCH_KIND_ENUMERATOR
         kKinds
     };
 
@@ -110,18 +121,26 @@ public:
         std::uint8_t a;         // Rd, Rh, the I/O data address, the pointer register
         std::uint8_t b;         // Rr, the immediate K, q, a bit number, the X/Y/Z mode
         std::uint8_t c;         // JMP/CALL: address bits 16..21
-        std::uint8_t flags;     // kMovesSp
-        std::uint8_t unused;
-        std::uint32_t target;   // RJMP/RCALL/branch: the new PC in bytes
+        std::uint8_t flags;     // kMovesSp, kRamOperand
+        std::uint8_t check;     // nonzero: after it, run_batch must test the crash oracles
+        std::uint32_t target;   // RJMP/RCALL/branch: the new PC in bytes; LDS/STS: the data address
+        std::uint16_t word2;    // LDS/STS: the second word `target` was decoded from
+        std::uint16_t unused;
     };
-    static_assert(sizeof(Slot) == 12);
-    static constexpr std::uint8_t kMovesSp = 1;  // the instruction may store to SPL/SPH
+    // 16 bytes: a slot's address is the flash byte address times 8.
+    static_assert(sizeof(Slot) == 16);
+    static constexpr std::uint8_t kMovesSp = 1;          // the instruction may store to SPL/SPH
+    static constexpr std::uint8_t kRamOperand = 2;  // LDS/STS of RAM past the I/O registers (ioend), within RAMEND
 
     // The slot for `word` at byte address `pc` (public for the tests).
+    // Its `check` is left 0: that depends on the oracles' limits.
     static Slot decode(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc);
 
 private:
-    __attribute__((always_inline)) static Slot* slot_at(Slot* slots, const predecoded_detail::Machine& m, avr_flashaddr_t pc);
+    // The slot at `pc`, decoded again when flash no longer holds its word.
+    __attribute__((always_inline)) Slot* slot_at(const predecoded_detail::Machine& m, avr_flashaddr_t pc);
+    // decode() and the slot's `check` for the limits in checked_for_.
+    Slot decode_checked(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc) const;
     enum class Done : std::uint8_t {
         HandOver,      // nothing changed: avr_run_one must execute it
         Plain,         // executed, nothing in simavr called
@@ -143,34 +162,52 @@ private:
     }
 
     struct FreeDeleter {
-        void operator()(Slot* p) const { std::free(p); }
+        void operator()(void* p) const { std::free(p); }
     };
     std::unique_ptr<Slot[], FreeDeleter> slots_;
+    std::size_t slot_count_ = 0;
+    // The limits the slots' `check` was computed for. Beside the slots on
+    // the process heap (core/ProcessHeap.hpp), so that a fuzz target's
+    // restore cannot pair them with slots decoded for other limits.
+    struct CheckedFor {
+        std::uint32_t code_end_minus_one;
+        std::uint32_t bad_interrupt_pc;
+    };
+    std::unique_ptr<CheckedFor, FreeDeleter> checked_for_;
     std::uint64_t handed_ = 0;
 };
 
 namespace predecoded_detail {
 
-// The core's view of avr_t, read once per batch: a store through data[]
-// (uint8_t, which may alias anything) would otherwise make the compiler
-// reload every avr_t field after each instruction. Nothing a batch runs
-// changes them (simavr's I/O callbacks do not either).
+// The core's view of avr_t: the pointers every instruction uses, read once
+// per batch (a store through data[], uint8_t, which may alias anything,
+// would otherwise make the compiler reload them after each instruction).
+// The rarely used sizes are read from avr_t where needed, so that they do
+// not take registers across run_batch's dispatch. Nothing a batch runs
+// changes any of them (simavr's I/O callbacks do not either).
 struct Machine {
-    explicit Machine(avr_t* a)
-        : avr(a), data(a->data), sreg(a->sreg), flash(a->flash), ramend(a->ramend), flashend(a->flashend),
-          address_size(a->address_size), watched(a->gdb != nullptr) {}
+    explicit Machine(avr_t* a) : Machine(a, a->gdb != nullptr) {}
+    // `watched` false where the caller has seen that no GDB stub is attached
+    // (a constant the compiler folds into every access check).
+    Machine(avr_t* a, bool is_watched) : avr(a), data(a->data), sreg(a->sreg), flash(a->flash), watched(is_watched) {}
     avr_t* avr;
     std::uint8_t* data;
     std::uint8_t* sreg;
     const std::uint8_t* flash;
-    std::uint32_t ramend;
-    std::uint32_t flashend;
-    int address_size;
     bool watched;  // simavr's GDB stub is attached (its watchpoints see data accesses)
+    std::uint32_t ramend() const { return avr->ramend; }
+    std::uint32_t flashend() const { return avr->flashend; }
+    int address_size() const { return avr->address_size; }
 };
 
 __attribute__((always_inline)) inline std::uint16_t flash16(const std::uint8_t* flash, avr_flashaddr_t addr) {
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    std::uint16_t word;  // one load: flash is little-endian, like this host
+    std::memcpy(&word, flash + addr, sizeof word);
+    return word;
+#else
     return static_cast<std::uint16_t>(flash[addr] | (flash[addr + 1] << 8));
+#endif
 }
 
 // _avr_is_instruction_32_bits (sim_core.c).
@@ -185,7 +222,7 @@ __attribute__((always_inline)) inline bool is_32_bit(const std::uint8_t* flash, 
 // RAMEND, with no GDB stub watching.
 template <bool kWrite>
 __attribute__((always_inline)) inline bool plain_access(const Machine& m, std::uint16_t addr) {
-    if (addr > m.ramend || m.watched) return false;
+    if (addr > m.ramend() || m.watched) return false;
     if (addr < 32 || addr >= MAX_IOs + 31) return true;
     if (addr == R_SREG) return false;
     const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
@@ -194,17 +231,43 @@ __attribute__((always_inline)) inline bool plain_access(const Machine& m, std::u
 __attribute__((always_inline)) inline bool plain_write(const Machine& m, std::uint16_t addr) { return plain_access<true>(m, addr); }
 __attribute__((always_inline)) inline bool plain_read(const Machine& m, std::uint16_t addr) { return plain_access<false>(m, addr); }
 
+// plain_access for an address past the I/O registers (ioend) within
+// RAMEND, as LDS/STS decode it (PredecodedCore::kRamOperand): beyond
+// simavr's io[] always plain; inside it, while nothing hooks the byte.
+template <bool kWrite>
+__attribute__((always_inline)) inline bool plain_ram_operand(const Machine& m, std::uint16_t addr) {
+    if (m.watched) return false;
+    if (addr >= MAX_IOs + 31) return true;
+    const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
+    return (kWrite ? io.w.c == nullptr : io.r.c == nullptr) && io.irq == nullptr;
+}
+
 // An I/O register this core may read or write itself through simavr's
 // callbacks, as _avr_get_ram/_avr_set_r do: not SREG, within RAM, no GDB stub.
 __attribute__((always_inline)) inline bool io_callable(const Machine& m, std::uint16_t addr) {
-    return addr >= 32 && addr < MAX_IOs + 31 && addr != R_SREG && addr <= m.ramend && !m.watched;
+    return addr >= 32 && addr < MAX_IOs + 31 && addr != R_SREG && addr <= m.ramend() && !m.watched;
+}
+
+// avr_raise_irq(irq, value). With no hook on the IRQ, simavr 1.6's
+// avr_raise_irq_float (sim_irq.c) only stores the value (inverted by
+// IRQ_FLAG_NOT) and clears IRQ_FLAG_INIT: its early return for a filtered
+// unchanged value changes nothing either, as INIT is then already clear,
+// and FLOATING is put back as it was. So that case is done here without
+// the call; an IRQ with hooks goes to simavr.
+__attribute__((always_inline)) inline void raise_irq(avr_irq_t* irq, std::uint32_t value) {
+    if (__builtin_expect(irq->hook == nullptr, 1)) {
+        irq->value = (irq->flags & IRQ_FLAG_NOT) ? !value : value;
+        irq->flags = static_cast<std::uint8_t>(irq->flags & ~IRQ_FLAG_INIT);
+    } else {
+        avr_raise_irq(irq, value);
+    }
 }
 
 // Raises the register's IRQs with `v`: the whole byte, then each bit
 // (what _avr_get_ram and _avr_set_r do when avr_iomem_getirq made them).
 inline void io_raise(avr_irq_t* irq, std::uint8_t v) {
-    avr_raise_irq(irq + AVR_IOMEM_IRQ_ALL, v);
-    for (int i = 0; i < 8; i++) avr_raise_irq(irq + i, (v >> i) & 1);
+    raise_irq(irq + AVR_IOMEM_IRQ_ALL, v);
+    for (int i = 0; i < 8; i++) raise_irq(irq + i, (v >> i) & 1);
 }
 
 // _avr_get_ram(addr) for an io_callable address: the read callback's value
@@ -256,7 +319,7 @@ __attribute__((always_inline)) inline void set_sp(std::uint8_t* data, std::uint1
 __attribute__((always_inline)) inline void push_return(const Machine& m, avr_flashaddr_t return_pc) {
     std::uint16_t sp = sp_of(m.data);
     avr_flashaddr_t ret = return_pc >> 1;
-    for (int i = 0; i < m.address_size; i++, ret >>= 8, sp--) m.data[sp] = static_cast<std::uint8_t>(ret);
+    for (int i = 0; i < m.address_size(); i++, ret >>= 8, sp--) m.data[sp] = static_cast<std::uint8_t>(ret);
     set_sp(m.data, sp);
 }
 
@@ -271,31 +334,48 @@ __attribute__((always_inline)) inline void flags_zns16(std::uint8_t* s, std::uin
     s[S_N] = static_cast<std::uint8_t>((res >> 15) & 1);
     s[S_S] = s[S_N] ^ s[S_V];
 }
-__attribute__((always_inline)) inline void flags_add_zns(std::uint8_t* s, std::uint8_t res, std::uint8_t rd, std::uint8_t rr) {
-    const std::uint8_t add_carry = static_cast<std::uint8_t>((rd & rr) | (rr & ~res) | (~res & rd));
-    s[S_H] = (add_carry >> 3) & 1;
-    s[S_C] = (add_carry >> 7) & 1;
-    s[S_V] = (((rd & rr & ~res) | (~rd & ~rr & res)) >> 7) & 1;
-    flags_zns(s, res);
+// The flags of ADD/ADC and of SUB/SBC/SUBI/SBCI/CP/CPC/CPI, which
+// sim_core.c computes with the datasheet's bit formulas
+// (_avr_flags_add_zns, _avr_flags_sub_zns, _avr_flags_sub_Rzns), here from
+// the result before it is cut to 8 bits, by the full adder's identities
+// (the same function of the operands; core_sweep runs every one of these
+// instructions over all operand pairs against avr_run_one):
+// - C, the carry (borrow) out of bit 7: bit 8 of the sum (of the two's
+//   complement difference, negative exactly when there is a borrow);
+// - H, the carry (borrow) out of bit 3: bit 4 of rd ^ rr ^ result, since
+//   each result bit is rd ^ rr ^ the carry into it;
+// - V: for a sum, both operands' signs differ from the result's; for a
+//   difference, the operands' signs differ and the result's differs from rd's.
+// `sum` is rd + rr (+ C); `diff` is rd - rr (- C).
+__attribute__((always_inline)) inline void flags_add(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr, unsigned sum) {
+    const std::uint8_t res = static_cast<std::uint8_t>(sum);
+    const std::uint8_t v = static_cast<std::uint8_t>(((rd ^ res) & (rr ^ res)) >> 7);
+    const std::uint8_t n = static_cast<std::uint8_t>(res >> 7);
+    s[S_H] = static_cast<std::uint8_t>(((rd ^ rr ^ sum) >> 4) & 1);
+    s[S_C] = static_cast<std::uint8_t>((sum >> 8) & 1);
+    s[S_V] = v;
+    s[S_N] = n;
+    s[S_Z] = res == 0;
+    s[S_S] = n ^ v;
 }
-__attribute__((always_inline)) inline void flags_sub_common(std::uint8_t* s, std::uint8_t res, std::uint8_t rd, std::uint8_t rr) {
-    const std::uint8_t sub_carry = static_cast<std::uint8_t>((~rd & rr) | (rr & res) | (res & ~rd));
-    s[S_H] = (sub_carry >> 3) & 1;
-    s[S_C] = (sub_carry >> 7) & 1;
-    s[S_V] = (((rd & ~rr & ~res) | (~rd & rr & res)) >> 7) & 1;
-}
-__attribute__((always_inline)) inline void flags_sub_zns(std::uint8_t* s, std::uint8_t res, std::uint8_t rd, std::uint8_t rr) {
-    flags_sub_common(s, res, rd, rr);
-    flags_zns(s, res);
-}
-__attribute__((always_inline)) inline void flags_Rzns(std::uint8_t* s, std::uint8_t res) {
-    if (res) s[S_Z] = 0;
-    s[S_N] = (res >> 7) & 1;
-    s[S_S] = s[S_N] ^ s[S_V];
-}
-__attribute__((always_inline)) inline void flags_sub_Rzns(std::uint8_t* s, std::uint8_t res, std::uint8_t rd, std::uint8_t rr) {
-    flags_sub_common(s, res, rd, rr);
-    flags_Rzns(s, res);
+// SBC, SBCI and CPC leave Z set only if it was set and the result is zero.
+enum ZeroFlag : bool { kSetZ = false, kKeepZ = true };
+template <ZeroFlag kZ>
+__attribute__((always_inline)) inline void flags_sub(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr, int diff) {
+    const unsigned d = static_cast<unsigned>(diff);
+    const std::uint8_t res = static_cast<std::uint8_t>(d);
+    const std::uint8_t v = static_cast<std::uint8_t>(((rd ^ rr) & (rd ^ res)) >> 7);
+    const std::uint8_t n = static_cast<std::uint8_t>(res >> 7);
+    s[S_H] = static_cast<std::uint8_t>(((rd ^ rr ^ d) >> 4) & 1);
+    s[S_C] = static_cast<std::uint8_t>((d >> 8) & 1);
+    s[S_V] = v;
+    s[S_N] = n;
+    if (kZ == kKeepZ) {
+        if (res) s[S_Z] = 0;
+    } else {
+        s[S_Z] = res == 0;
+    }
+    s[S_S] = n ^ v;
 }
 __attribute__((always_inline)) inline void flags_zcvs(std::uint8_t* s, std::uint8_t res, std::uint8_t vr) {
     s[S_Z] = res == 0;
@@ -317,11 +397,10 @@ __attribute__((always_inline)) inline void flags_znv0s(std::uint8_t* s, std::uin
 
 }  // namespace predecoded_detail
 
-__attribute__((always_inline)) inline PredecodedCore::Slot* PredecodedCore::slot_at(Slot* slots, const predecoded_detail::Machine& m,
-                                                                                avr_flashaddr_t pc) {
-    Slot* slot = &slots[pc >> 1];
+__attribute__((always_inline)) inline PredecodedCore::Slot* PredecodedCore::slot_at(const predecoded_detail::Machine& m, avr_flashaddr_t pc) {
+    Slot* slot = &slots_[pc >> 1];
     const std::uint16_t word = predecoded_detail::flash16(m.flash, pc);
-    if (__builtin_expect(slot->word != word || slot->kind == kUndecoded, 0)) *slot = decode(m.avr, word, pc);
+    if (__builtin_expect(slot->word != word || slot->kind == kUndecoded, 0)) *slot = decode_checked(m.avr, word, pc);
     return slot;
 }
 
@@ -331,7 +410,7 @@ __attribute__((always_inline)) inline avr_flashaddr_t PredecodedCore::run_one(av
         const predecoded_detail::Machine m(avr);
         avr_flashaddr_t new_pc;
         int cycles;
-        if (__builtin_expect(execute(m, *slot_at(slots_.get(), m, pc), pc, avr->cycle, new_pc, cycles) != Done::HandOver, 1)) {
+        if (__builtin_expect(execute(m, *slot_at(m, pc), pc, avr->cycle, new_pc, cycles) != Done::HandOver, 1)) {
             avr->cycle += static_cast<avr_cycle_count_t>(cycles);
             return new_pc;
         }
@@ -350,423 +429,33 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
     const std::uint8_t a = slot->a, b = slot->b;
     avr_flashaddr_t new_pc = pc + 2;
     int cycle = 1;
-    // Before simavr's I/O callbacks run: they see avr->pc at this
-    // instruction and avr->cycle before it, as inside avr_run_one.
-    Done done = Done::Plain;
-#define AVRBENCH_BEFORE_CALLBACKS()     \
-    do {                                \
-        m.avr->pc = pc;                 \
-        m.avr->cycle = cycle_before;    \
-        done = Done::CalledSimavr;      \
-    } while (0)
-    // The skip of CPSE/SBRC/SBRS/SBIC/SBIS: one word or two, one cycle or two.
-#define AVRBENCH_SKIP()                                   \
-    do {                                                  \
-        const int words = is_32_bit(m.flash, new_pc) ? 2 : 1; \
-        new_pc += 2u * static_cast<unsigned>(words);      \
-        cycle += words;                                   \
-    } while (0)
+    // The handlers' endings (PredecodedOps.inc).
+#define AVRBENCH_CYCLE_BEFORE cycle_before
+#define AVRBENCH_OP(kind) case kind:
+#define AVRBENCH_NEXT() goto plain
+#define AVRBENCH_NEXT_CALLED() goto called_simavr
+#define AVRBENCH_HAND_OVER() goto hand_over
     switch (slot->kind) {
-        case kNop: break;
-        case kCpc: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd - vr - sreg[S_C]);
-            flags_sub_Rzns(sreg, res, vd, vr);
-        } break;
-        case kAdd: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd + vr);
-            data[a] = res;
-            flags_add_zns(sreg, res, vd, vr);
-        } break;
-        case kSbc: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd - vr - sreg[S_C]);
-            data[a] = res;
-            flags_sub_Rzns(sreg, res, vd, vr);
-        } break;
-        case kMovw: {
-            const std::uint16_t vr = static_cast<std::uint16_t>(data[b] | (data[b + 1] << 8));
-            data[a] = static_cast<std::uint8_t>(vr);
-            data[a + 1] = static_cast<std::uint8_t>(vr >> 8);
-        } break;
-        case kMuls: {
-            const std::int16_t res = static_cast<std::int16_t>(static_cast<std::int8_t>(data[b]) * static_cast<std::int8_t>(data[a]));
-            data[0] = static_cast<std::uint8_t>(res);
-            data[1] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(res) >> 8);
-            sreg[S_C] = static_cast<std::uint8_t>((res >> 15) & 1);
-            sreg[S_Z] = res == 0;
-            cycle++;
-        } break;
-#define AVRBENCH_MUL_FORM(kind, R, D, shift)                                               \
-        case kind: {                                                                       \
-            std::int16_t res = static_cast<std::int16_t>((R)data[b] * (D)data[a]);         \
-            const std::uint8_t c = static_cast<std::uint8_t>((res >> 15) & 1);            \
-            if (shift) res = static_cast<std::int16_t>(res << 1);                          \
-            cycle++;                                                                       \
-            data[0] = static_cast<std::uint8_t>(res);                                      \
-            data[1] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(res) >> 8);     \
-            sreg[S_C] = c;                                                                 \
-            sreg[S_Z] = res == 0;                                                          \
-        } break;
-        // MULSU, FMUL, FMULS, FMULSU: the operand types and the shift of sim_core.c.
-        AVRBENCH_MUL_FORM(kMulsu, std::uint8_t, std::int8_t, false)
-        AVRBENCH_MUL_FORM(kFmul, std::uint8_t, std::uint8_t, true)
-        AVRBENCH_MUL_FORM(kFmuls, std::int8_t, std::int8_t, true)
-        AVRBENCH_MUL_FORM(kFmulsu, std::uint8_t, std::int8_t, true)
-#undef AVRBENCH_MUL_FORM
-        case kSub: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd - vr);
-            data[a] = res;
-            flags_sub_zns(sreg, res, vd, vr);
-        } break;
-        case kCpse:
-            if (data[a] == data[b]) AVRBENCH_SKIP();
-            break;
-        case kCp: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            flags_sub_zns(sreg, static_cast<std::uint8_t>(vd - vr), vd, vr);
-        } break;
-        case kAdc: {
-            const std::uint8_t vd = data[a], vr = data[b];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd + vr + sreg[S_C]);
-            data[a] = res;
-            flags_add_zns(sreg, res, vd, vr);
-        } break;
-        case kAnd: {
-            const std::uint8_t res = data[a] & data[b];
-            data[a] = res;
-            flags_znv0s(sreg, res);
-        } break;
-        case kEor: {
-            const std::uint8_t res = data[a] ^ data[b];
-            data[a] = res;
-            flags_znv0s(sreg, res);
-        } break;
-        case kOr: {
-            const std::uint8_t res = data[a] | data[b];
-            data[a] = res;
-            flags_znv0s(sreg, res);
-        } break;
-        case kMov: data[a] = data[b]; break;
-        case kCpi: {
-            const std::uint8_t vh = data[a];
-            flags_sub_zns(sreg, static_cast<std::uint8_t>(vh - b), vh, b);
-        } break;
-        case kSbci: {
-            const std::uint8_t vh = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>(vh - b - sreg[S_C]);
-            data[a] = res;
-            flags_sub_Rzns(sreg, res, vh, b);
-        } break;
-        case kSubi: {
-            const std::uint8_t vh = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>(vh - b);
-            data[a] = res;
-            flags_sub_zns(sreg, res, vh, b);
-        } break;
-        case kOri: {
-            const std::uint8_t res = data[a] | b;
-            data[a] = res;
-            flags_znv0s(sreg, res);
-        } break;
-        case kAndi: {
-            const std::uint8_t res = data[a] & b;
-            data[a] = res;
-            flags_znv0s(sreg, res);
-        } break;
-        case kLddZ: case kLddY: {
-            const std::uint8_t base = slot->kind == kLddZ ? R_ZL : R_YL;
-            const std::uint16_t addr = static_cast<std::uint16_t>((data[base] | (data[base + 1] << 8)) + b);
-            if (!plain_read(m, addr)) goto hand_over;
-            data[a] = data[addr];
-            cycle++;
-        } break;
-        case kStdZ: case kStdY: {
-            const std::uint8_t base = slot->kind == kStdZ ? R_ZL : R_YL;
-            const std::uint16_t addr = static_cast<std::uint16_t>((data[base] | (data[base + 1] << 8)) + b);
-            if (!plain_write(m, addr)) goto hand_over;
-            data[addr] = data[a];
-            cycle++;
-        } break;
-        case kSregSet: sreg[b] = 1; break;
-        case kSregClear: sreg[b] = 0; break;
-        case kLpmR0: {
-            const std::uint16_t z = static_cast<std::uint16_t>(data[R_ZL] | (data[R_ZH] << 8));
-            if (z > m.flashend) goto hand_over;
-            cycle += 2;
-            data[0] = m.flash[z];
-        } break;
-        case kLpm: case kLpmInc: {
-            std::uint16_t z = static_cast<std::uint16_t>(data[R_ZL] | (data[R_ZH] << 8));
-            if (z > m.flashend) goto hand_over;
-            data[a] = m.flash[z];
-            if (slot->kind == kLpmInc) {
-                z++;
-                data[R_ZH] = static_cast<std::uint8_t>(z >> 8);
-                data[R_ZL] = static_cast<std::uint8_t>(z);
-            }
-            cycle += 2;
-        } break;
-        case kLds: {
-            const std::uint16_t x = flash16(m.flash, new_pc);
-            if (!plain_read(m, x)) goto hand_over;
-            new_pc += 2;
-            data[a] = data[x];
-            cycle++;
-        } break;
-        case kSts: {
-            const std::uint16_t x = flash16(m.flash, new_pc);
-            if (!plain_write(m, x)) goto hand_over;
-            new_pc += 2;
-            cycle++;
-            data[x] = data[a];
-        } break;
-        case kLdX: case kLdY: case kLdZ: {
-            // LD Rd, X/X+/-X (Y, Z): the pointer is written back before Rd,
-            // as simavr does (it matters for the undefined LD r26, X+).
-            const std::uint8_t base = slot->kind == kLdX ? R_XL : slot->kind == kLdY ? R_YL : R_ZL;
-            std::uint16_t p = static_cast<std::uint16_t>((data[base + 1] << 8) | data[base]);
-            cycle++;
-            if (b == 2) p--;
-            if (!plain_read(m, p)) goto hand_over;
-            const std::uint8_t vd = data[p];
-            if (b == 1) p++;
-            data[base + 1] = static_cast<std::uint8_t>(p >> 8);
-            data[base] = static_cast<std::uint8_t>(p);
-            data[a] = vd;
-        } break;
-        case kStX: case kStY: case kStZ: {
-            const std::uint8_t base = slot->kind == kStX ? R_XL : slot->kind == kStY ? R_YL : R_ZL;
-            const std::uint8_t vd = data[a];
-            std::uint16_t p = static_cast<std::uint16_t>((data[base + 1] << 8) | data[base]);
-            cycle++;
-            if (b == 2) p--;
-            if (!plain_write(m, p)) goto hand_over;
-            data[p] = vd;
-            if (b == 1) p++;
-            data[base + 1] = static_cast<std::uint8_t>(p >> 8);
-            data[base] = static_cast<std::uint8_t>(p);
-        } break;
-        case kPop: {
-            const std::uint16_t sp = static_cast<std::uint16_t>(sp_of(data) + 1);
-            if (!plain_read(m, sp) || !plain_sp(m)) goto hand_over;
-            const std::uint8_t v = data[sp];
-            set_sp(data, sp);
-            data[a] = v;
-            cycle++;
-        } break;
-        case kPush: {
-            const std::uint8_t vd = data[a];
-            const std::uint16_t sp = sp_of(data);
-            if (!plain_write(m, sp) || !plain_sp(m)) goto hand_over;
-            data[sp] = vd;
-            set_sp(data, static_cast<std::uint16_t>(sp - 1));
-            cycle++;
-        } break;
-        case kCom: {
-            const std::uint8_t res = static_cast<std::uint8_t>(0xff - data[a]);
-            data[a] = res;
-            flags_znv0s(sreg, res);
-            sreg[S_C] = 1;
-        } break;
-        case kNeg: {
-            const std::uint8_t vd = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>(0x00 - vd);
-            data[a] = res;
-            sreg[S_H] = ((res >> 3) | (vd >> 3)) & 1;
-            sreg[S_V] = res == 0x80;
-            sreg[S_C] = res != 0;
-            flags_zns(sreg, res);
-        } break;
-        case kSwap: {
-            const std::uint8_t vd = data[a];
-            data[a] = static_cast<std::uint8_t>((vd >> 4) | (vd << 4));
-        } break;
-        case kInc: {
-            const std::uint8_t res = static_cast<std::uint8_t>(data[a] + 1);
-            data[a] = res;
-            sreg[S_V] = res == 0x80;
-            flags_zns(sreg, res);
-        } break;
-        case kAsr: {
-            const std::uint8_t vd = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>((vd >> 1) | (vd & 0x80));
-            data[a] = res;
-            flags_zcnvs(sreg, res, vd);
-        } break;
-        case kLsr: {
-            const std::uint8_t vd = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>(vd >> 1);
-            data[a] = res;
-            sreg[S_N] = 0;
-            flags_zcvs(sreg, res, vd);
-        } break;
-        case kRor: {
-            const std::uint8_t vd = data[a];
-            const std::uint8_t res = static_cast<std::uint8_t>((sreg[S_C] ? 0x80 : 0) | vd >> 1);
-            data[a] = res;
-            flags_zcnvs(sreg, res, vd);
-        } break;
-        case kDec: {
-            const std::uint8_t res = static_cast<std::uint8_t>(data[a] - 1);
-            data[a] = res;
-            sreg[S_V] = res == 0x7f;
-            flags_zns(sreg, res);
-        } break;
-        case kJmp: {
-            const avr_flashaddr_t target = (static_cast<avr_flashaddr_t>(slot->c) << 16) | flash16(m.flash, new_pc);
-            new_pc = target << 1;
-            cycle += 2;
-        } break;
-        case kCall: {
-            // _avr_push_addr: the word address, low byte first, downwards.
-            const avr_flashaddr_t target = (static_cast<avr_flashaddr_t>(slot->c) << 16) | flash16(m.flash, new_pc);
-            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
-            push_return(m, new_pc + 2);
-            cycle += 1 + m.address_size;
-            new_pc = target << 1;
-        } break;
-        case kAdiw: case kSbiw: {
-            const std::uint16_t vp = static_cast<std::uint16_t>(data[a] | (data[a + 1] << 8));
-            const std::uint16_t res = static_cast<std::uint16_t>(slot->kind == kAdiw ? vp + b : vp - b);
-            data[a + 1] = static_cast<std::uint8_t>(res >> 8);
-            data[a] = static_cast<std::uint8_t>(res);
-            if (slot->kind == kAdiw) {
-                sreg[S_V] = ((~vp & res) >> 15) & 1;
-                sreg[S_C] = ((~res & vp) >> 15) & 1;
-            } else {
-                sreg[S_V] = ((vp & ~res) >> 15) & 1;
-                sreg[S_C] = ((res & ~vp) >> 15) & 1;
-            }
-            flags_zns16(sreg, res);
-            cycle++;
-        } break;
-        case kSbic: case kSbis: {
-            std::uint8_t v;
-            if (plain_read(m, a)) {
-                v = data[a];
-            } else {
-                if (!io_callable(m, a)) goto hand_over;
-                AVRBENCH_BEFORE_CALLBACKS();
-                v = io_read(m, a);
-            }
-            const bool set = (v & b) != 0;
-            if (set == (slot->kind == kSbis)) AVRBENCH_SKIP();
-        } break;
-        case kCbi: case kSbi: {
-            // 1001 10x0 AAAA Abbb: read, change one bit, write (2 cycles).
-            if (!io_callable(m, a)) goto hand_over;
-            AVRBENCH_BEFORE_CALLBACKS();
-            const std::uint8_t v = io_read(m, a);
-            io_write(m, a, static_cast<std::uint8_t>(slot->kind == kSbi ? (v | b) : (v & ~b)));
-            cycle++;
-        } break;
-        case kMul: {
-            const std::uint16_t res = static_cast<std::uint16_t>(data[a] * data[b]);
-            cycle++;
-            data[0] = static_cast<std::uint8_t>(res);
-            data[1] = static_cast<std::uint8_t>(res >> 8);
-            sreg[S_Z] = res == 0;
-            sreg[S_C] = static_cast<std::uint8_t>((res >> 15) & 1);
-        } break;
-        case kOut:
-            if (plain_write(m, a)) {
-                data[a] = data[b];
-                break;
-            }
-            if (!io_callable(m, a)) goto hand_over;
-            AVRBENCH_BEFORE_CALLBACKS();
-            io_write(m, a, data[b]);
-            break;
-        case kIn:
-            if (b == R_SREG) {
-                if (m.watched) goto hand_over;
-                std::uint8_t v = 0;
-                for (int i = 0; i < 8; i++)
-                    if (sreg[i]) v |= static_cast<std::uint8_t>(1 << i);
-                data[R_SREG] = v;
-                data[a] = v;
-                break;
-            }
-            if (plain_read(m, b)) {
-                data[a] = data[b];
-                break;
-            }
-            if (!io_callable(m, b)) goto hand_over;
-            AVRBENCH_BEFORE_CALLBACKS();
-            data[a] = io_read(m, b);
-            break;
-        case kRjmp:
-            new_pc = slot->target;
-            cycle++;
-            break;
-        case kRcall: {
-            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
-            push_return(m, new_pc);
-            cycle += m.address_size;
-            new_pc = slot->target;
-        } break;
-        case kLdi: data[a] = b; break;
-        case kBrbs:
-            if (sreg[b]) {
-                cycle++;
-                new_pc = slot->target;
-            }
-            break;
-        case kBrbc:
-            if (!sreg[b]) {
-                cycle++;
-                new_pc = slot->target;
-            }
-            break;
-        case kBld: {
-            const std::uint8_t mask = static_cast<std::uint8_t>(1 << b);
-            data[a] = static_cast<std::uint8_t>((data[a] & ~mask) | (sreg[S_T] ? mask : 0));
-        } break;
-        case kBst: sreg[S_T] = (data[a] >> b) & 1; break;
-        case kSbrc:
-            if (!(data[a] & (1 << b))) AVRBENCH_SKIP();
-            break;
-        case kSbrs:
-            if (data[a] & (1 << b)) AVRBENCH_SKIP();
-            break;
-        case kIjmp:
-            new_pc = static_cast<avr_flashaddr_t>(data[R_ZL] | (data[R_ZH] << 8)) << 1;
-            cycle++;
-            break;
-        case kIcall: {
-            if (!plain_push(m, sp_of(data), m.address_size)) goto hand_over;
-            const avr_flashaddr_t z = static_cast<avr_flashaddr_t>(data[R_ZL] | (data[R_ZH] << 8));
-            push_return(m, new_pc);
-            cycle += m.address_size - 1;
-            new_pc = z << 1;
-            cycle++;
-        } break;
-        case kRet: {
-            // _avr_pop_addr: high byte first, upwards.
-            const int size = m.address_size;
-            std::uint16_t sp = static_cast<std::uint16_t>(sp_of(data) + 1);
-            if (!plain_pop(m, sp, size)) goto hand_over;
-            avr_flashaddr_t res = 0;
-            for (int i = 0; i < size; i++, sp++) res = (res << 8) | data[sp];
-            res <<= 1;
-            set_sp(data, static_cast<std::uint16_t>(sp - 1));
-            new_pc = res;
-            cycle += 1 + size;
-        } break;
+#include "core/PredecodedOps.inc"
         case kUndecoded:
         case kSimavr:
             goto hand_over;
         default:
             __builtin_unreachable();  // decode() makes no other kind
     }
-#undef AVRBENCH_SKIP
-#undef AVRBENCH_BEFORE_CALLBACKS
+#undef AVRBENCH_OP
+#undef AVRBENCH_CYCLE_BEFORE
+#undef AVRBENCH_NEXT
+#undef AVRBENCH_NEXT_CALLED
+#undef AVRBENCH_HAND_OVER
+plain:
     new_pc_out = new_pc;
     cycles_out = cycle;
-    return done;
+    return Done::Plain;
+called_simavr:
+    new_pc_out = new_pc;
+    cycles_out = cycle;
+    return Done::CalledSimavr;
 hand_over:
     return Done::HandOver;
 }

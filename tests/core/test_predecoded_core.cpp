@@ -171,5 +171,85 @@ TEST(PredecodedCore, DecodesAgainWhenTheFlashWordChanges) {
     EXPECT_EQ(core.handed_to_simavr(), 0u);
 }
 
+// LDS and STS keep the address word they were decoded with (the batch's
+// fast path, and whether an STS may move SP, come from it): flash holding
+// another address there is noticed. Opcodes from the AVR instruction set
+// manual: STS k, Rr = 1001 001d dddd 0000 + k; LDS Rd, k = 1001 000d dddd
+// 0000 + k; LDI Rd, K = 1110 KKKK dddd KKKK (d = 16 + dddd).
+TEST(PredecodedCore, LdsAndStsFollowTheirAddressWordWhenFlashChangesIt) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    PredecodedCore core(avr);
+    const avr_flashaddr_t at = (avr->flashend + 1) - 64;
+    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) {
+        avr->flash[where] = static_cast<std::uint8_t>(word);
+        avr->flash[where + 1] = static_cast<std::uint8_t>(word >> 8);
+    };
+    const std::uint16_t first = 0x0300, second = 0x0301;  // SRAM on the ATmega328P (0x0100..0x08FF)
+    put(at, 0x9300);  // STS k, r16
+    put(at + 2, first);
+    avr->data[16] = 0x5a;
+    avr->pc = at;
+    EXPECT_EQ(core.run_one(avr), at + 4);
+    EXPECT_EQ(avr->data[first], 0x5a);
+    put(at + 2, second);
+    avr->data[16] = 0xa5;
+    EXPECT_EQ(core.run_one(avr), at + 4);
+    EXPECT_EQ(avr->data[second], 0xa5);
+    EXPECT_EQ(avr->data[first], 0x5a);
+
+    put(at, 0x9110);  // LDS r17, k
+    put(at + 2, first);
+    EXPECT_EQ(core.run_one(avr), at + 4);
+    EXPECT_EQ(avr->data[17], 0x5a);
+    put(at + 2, second);
+    EXPECT_EQ(core.run_one(avr), at + 4);
+    EXPECT_EQ(avr->data[17], 0xa5);
+}
+
+// run_batch tests the crash oracles only after the slots whose `check`
+// says they can trip them, computed for the limits the core was given; a
+// batch with other limits (a boot loader that wrote another application)
+// decodes every slot again. Here a loop of NOP, NOP, RJMP back (RJMP k =
+// 1100 kkkk kkkk kkkk, k = -3 words: 0xCFFD) with __bad_interrupt placed
+// at each of its instructions in turn: the batch must stop in front of it.
+TEST(PredecodedCore, BatchStopsWhereTheOraclesLimitsSayEvenWhenTheyChange) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    const avr_flashaddr_t at = (avr->flashend + 1) - 64;
+    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) {
+        avr->flash[where] = static_cast<std::uint8_t>(word);
+        avr->flash[where + 1] = static_cast<std::uint8_t>(word >> 8);
+    };
+    put(at, 0x0000);
+    put(at + 2, 0x0000);
+    put(at + 4, 0xcffd);
+    const std::uint32_t code_end_minus_one = avr->flashend - 1;  // the loop is inside the code
+    PredecodedCore core(avr, code_end_minus_one, at + 2);
+    const auto batch = [&](std::uint32_t bad_interrupt_pc) {
+        avr->pc = at;
+        const PredecodedCore::BatchLimits limits{avr->cycle + 1'000'000, 100, code_end_minus_one, bad_interrupt_pc, 0};
+        return core.run_batch<false>(avr, limits, nullptr);
+    };
+    PredecodedCore::Batch b = batch(at + 2);
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::CheckPc);
+    EXPECT_EQ(b.steps, 1u);  // the first NOP, whose next PC is __bad_interrupt
+    EXPECT_EQ(b.new_pc, at + 2);
+    b = batch(~0u);  // no __bad_interrupt: the count ends it
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::Count);
+    EXPECT_EQ(b.steps, 100u);
+    b = batch(at + 4);
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::CheckPc);
+    EXPECT_EQ(b.steps, 2u);
+    EXPECT_EQ(b.new_pc, at + 4);
+    b = batch(at);  // reached by the RJMP
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::CheckPc);
+    EXPECT_EQ(b.steps, 3u);
+    EXPECT_EQ(b.new_pc, at);
+    EXPECT_EQ(core.handed_to_simavr(), 0u);
+}
+
 }  // namespace
 }  // namespace avrbench
