@@ -122,11 +122,16 @@ bool Lockstep::may_wake(const Influence& influence, const Mcu& influenced) const
     return false;
 }
 
+template <typename Time>
 Cycle Lockstep::cycle_of(std::size_t k, Time t) const {
-    if (t == kNever) return ~Cycle{0};
-    if (units_per_cycle_[k] == 1) return t > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(t);  // equal clocks: no division
-    const Time c = (t + units_per_cycle_[k] - 1) / units_per_cycle_[k];
-    return c > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(c);
+    if constexpr (sizeof(Time) == sizeof(Cycle)) {
+        return t;  // one clock
+    } else {
+        if (t == kNever<Time>) return ~Cycle{0};
+        if (units_per_cycle_[k] == 1) return t > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(t);  // equal clocks: no division
+        const Time c = (t + units_per_cycle_[k] - 1) / units_per_cycle_[k];
+        return c > ~Cycle{0} ? ~Cycle{0} : static_cast<Cycle>(c);
+    }
 }
 
 void Lockstep::couple(const Mcu& a, const Mcu& b) {
@@ -164,31 +169,40 @@ void Lockstep::reach(Mcu& mcu) {
 }
 
 StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
+    const bool one_clock = std::all_of(units_per_cycle_.begin(), units_per_cycle_.end(), [](std::uint64_t u) { return u == 1; });
+    return one_clock ? run_turns(end_ps, turns_one_clock_) : run_turns(end_ps, turns_mixed_clocks_);
+}
+
+template <typename Time>
+StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& turns) {
+    constexpr Time kNeverTime = kNever<Time>;
     const std::size_t n = mcus_.size();
     requested_stop_ = false;
     bool stopped = false;
     end_cycles_.resize(n);
-    present_.resize(n);
-    earliest_action_.resize(n);
-    next_.resize(n);
-    awake_.resize(n);
-    halted_.resize(n);
-    for (std::size_t k = 0; k < n; ++k) end_cycles_[k] = cycle_at_ps(*mcus_[k], end_ps);
+    turns.resize(n);
+    // Every turn reads these for every MCU: local pointers, which the
+    // stores into `turn` below cannot make the compiler load again.
+    Turn<Time>* const turn = turns.data();
+    Mcu* const* const mcus = mcus_.data();
+    Cycle* const end_cycles = end_cycles_.data();
+    for (std::size_t k = 0; k < n; ++k) end_cycles[k] = cycle_at_ps(*mcus[k], end_ps);
     for (;;) {
         // One look at each MCU per turn: present, next cycle timer, state.
         std::size_t runner = n;
-        Time runner_at = kNever;
+        Time runner_at = kNeverTime;
         for (std::size_t k = 0; k < n; ++k) {
-            const Mcu& m = *mcus_[k];
-            avr_t* const avr = m.avr();
-            halted_[k] = m.halted();
-            present_[k] = time_of(k, avr->cycle);
-            awake_[k] = !halted_[k] && !(lookahead_ && dormant_now(avr));
-            next_[k] = awake_[k] || halted_[k] ? kNever : time_of(k, next_event_now(avr));
+            const Mcu& m = *mcus[k];
+            const avr_t* const avr = m.avr();
+            Turn<Time>& t = turn[k];
+            t.halted = m.halted();
+            t.present = time_of<Time>(k, avr->cycle);
+            t.awake = !t.halted && !(lookahead_ && dormant_now(avr));
+            t.next = t.awake || t.halted ? kNeverTime : time_of<Time>(k, next_event_now(avr));
             // The MCU whose next step comes first: an awake one's present, a
             // dormant one's next event (or the run's end).
-            if (halted_[k] || avr->cycle >= end_cycles_[k]) continue;
-            const Time at = awake_[k] ? present_[k] : std::min(next_[k], time_of(k, end_cycles_[k]));
+            if (t.halted || avr->cycle >= end_cycles[k]) continue;
+            const Time at = t.awake ? t.present : std::min(t.next, time_of<Time>(k, end_cycles[k]));
             if (runner == n || at < runner_at) {
                 runner = k;
                 runner_at = at;
@@ -201,36 +215,37 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
         // one, reach() makes it yield at once and the bounds are worked out
         // again, so its own wake-ups never need to hold it back.)
         for (std::size_t k = 0; k < n; ++k) {
-            earliest_action_[k] = k == runner || halted_[k] ? kNever : awake_[k] ? present_[k] : next_[k];
+            Turn<Time>& t = turn[k];
+            t.earliest_action = k == runner || t.halted ? kNeverTime : t.awake ? t.present : t.next;
         }
         if (lookahead_) {
             for (bool changed = true; changed;) {
                 changed = false;
                 for (std::size_t k = 0; k < n; ++k) {
-                    if (k == runner || awake_[k] || halted_[k]) continue;
+                    Turn<Time>& t = turn[k];
+                    if (k == runner || t.awake || t.halted) continue;
                     for (const Influence& i : influenced_by_[k]) {
-                        if (earliest_action_[i.from] < earliest_action_[k] &&
-                            (i.any_change_may_wake || may_wake(i, *mcus_[k]))) {
-                            earliest_action_[k] = earliest_action_[i.from];
+                        if (turn[i.from].earliest_action < t.earliest_action && (i.any_change_may_wake || may_wake(i, *mcus[k]))) {
+                            t.earliest_action = turn[i.from].earliest_action;
                             changed = true;
                         }
                     }
                 }
             }
         }
-        Mcu& behind = *mcus_[runner];
-        Time bound = kNever;
-        for (const Influence& i : influenced_by_[runner]) bound = std::min(bound, earliest_action_[i.from]);
+        Mcu& behind = *mcus[runner];
+        Time bound = kNeverTime;
+        for (const Influence& i : influenced_by_[runner]) bound = std::min(bound, turn[i.from].earliest_action);
         for (const std::size_t x : influences_[runner]) {
-            if (awake_[x]) bound = std::min(bound, present_[x]);
+            if (turn[x].awake) bound = std::min(bound, turn[x].present);
         }
         if (!coupled_.empty()) {
             for (std::size_t k = 0; k < n; ++k) {
-                if (k != runner && !mcus_[k]->halted() && coupled(behind, *mcus_[k])) bound = std::min(bound, present_[k]);
+                if (k != runner && !mcus[k]->halted() && coupled(behind, *mcus[k])) bound = std::min(bound, turn[k].present);
             }
         }
         // At least one instruction, or two cores at the same time would never move.
-        const Cycle target = std::max(std::min(end_cycles_[runner], cycle_of(runner, bound)), behind.cycle() + 1);
+        const Cycle target = std::max(std::min(end_cycles[runner], cycle_of<Time>(runner, bound)), behind.cycle() + 1);
         running_ = &behind;
         const StopReason r = behind.run_until(target);
         running_ = nullptr;
@@ -240,8 +255,8 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
             // ones left where they slept) is brought to it first, so whatever
             // the caller does next happens at one time on the whole board.
             stopped = true;
-            const Time stop_at = time_of(runner, behind.cycle());
-            for (std::size_t k = 0; k < n; ++k) end_cycles_[k] = std::min(end_cycles_[k], cycle_of(k, stop_at));
+            const Time stop_at = time_of<Time>(runner, behind.cycle());
+            for (std::size_t k = 0; k < n; ++k) end_cycles[k] = std::min(end_cycles[k], cycle_of<Time>(k, stop_at));
         }
         requested_stop_ = false;
     }

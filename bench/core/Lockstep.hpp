@@ -83,8 +83,20 @@ public:
     std::uint64_t catch_ups() const { return catch_ups_; }
 
 private:
-    __extension__ using Time = unsigned __int128;  // cycles x (lcm of the clocks / the MCU's clock)
+    // Times count units of 1 / lcm(the clocks) seconds: an MCU's cycle is
+    // units_per_cycle_ of them. With every MCU on one clock a unit is a
+    // cycle and 64 bits hold every time (run_turns<std::uint64_t>); with
+    // mixed clocks the products need 128 bits.
+    __extension__ using WideTime = unsigned __int128;
+    template <typename Time>
+    struct Turn {  // one MCU, worked out for each turn of run_until_ps
+        Time present, next, earliest_action;
+        bool awake, halted;
+    };
+    template <typename Time>
     static constexpr Time kNever = ~Time{0};
+    template <typename Time>
+    StopReason run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& turns);
     struct Influence {
         std::size_t from = 0;
         bool any_change_may_wake = false;
@@ -93,9 +105,12 @@ private:
     std::size_t index_of(const Mcu& mcu) const;
     bool coupled(const Mcu& a, const Mcu& b) const;
     bool may_wake(const Influence& influence, const Mcu& influenced) const;
+    template <typename Time>
     Time time_of(std::size_t k, Cycle cycle) const {
-        return cycle == ~Cycle{0} ? kNever : static_cast<Time>(cycle) * units_per_cycle_[k];
+        if constexpr (sizeof(Time) == sizeof(Cycle)) return cycle;  // one clock: units are cycles, never is never
+        return cycle == ~Cycle{0} ? kNever<Time> : static_cast<Time>(cycle) * units_per_cycle_[k];
     }
+    template <typename Time>
     Cycle cycle_of(std::size_t k, Time t) const;  // the first cycle of MCU k at or after t
     void influence_everything();
 
@@ -105,9 +120,8 @@ private:
     std::vector<std::vector<std::size_t>> influences_;   // per MCU: whose view it can change
     bool influences_declared_ = false;
     std::vector<Cycle> end_cycles_;  // run_until_ps's end, per MCU
-    // Per MCU, worked out for each step of run_until_ps.
-    std::vector<Time> present_, next_, earliest_action_;
-    std::vector<char> awake_, halted_;
+    std::vector<Turn<std::uint64_t>> turns_one_clock_;
+    std::vector<Turn<WideTime>> turns_mixed_clocks_;
     std::set<std::pair<const Mcu*, const Mcu*>> coupled_;
     bool lookahead_ = true;
     Mcu* running_ = nullptr;
