@@ -30,6 +30,12 @@ extern "C" {
 namespace avrbench {
 namespace {
 
+// Writes one opcode word into flash at byte address `at` (little-endian).
+void put_word(avr_t* avr, avr_flashaddr_t at, std::uint16_t word) {
+    avr->flash[at] = static_cast<std::uint8_t>(word);
+    avr->flash[at + 1] = static_cast<std::uint8_t>(word >> 8);
+}
+
 struct Compared {
     std::uint64_t instructions = 0;
     std::uint64_t handed = 0;
@@ -155,10 +161,7 @@ TEST(PredecodedCore, DecodesAgainWhenTheFlashWordChanges) {
     PredecodedCore core(avr);
     // A scratch location at the end of flash, far from the program.
     const avr_flashaddr_t at = (avr->flashend + 1) - 64;
-    const auto put = [&](std::uint16_t word) {
-        avr->flash[at] = static_cast<std::uint8_t>(word);
-        avr->flash[at + 1] = static_cast<std::uint8_t>(word >> 8);
-    };
+    const auto put = [&](std::uint16_t word) { put_word(avr, at, word); };
     avr->pc = at;
     put(0xe102);  // LDI r16, 0x12
     EXPECT_EQ(core.run_one(avr), at + 2);
@@ -182,10 +185,7 @@ TEST(PredecodedCore, LdsAndStsFollowTheirAddressWordWhenFlashChangesIt) {
     avr_t* avr = mcu.avr();
     PredecodedCore core(avr);
     const avr_flashaddr_t at = (avr->flashend + 1) - 64;
-    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) {
-        avr->flash[where] = static_cast<std::uint8_t>(word);
-        avr->flash[where + 1] = static_cast<std::uint8_t>(word >> 8);
-    };
+    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) { put_word(avr, where, word); };
     const std::uint16_t first = 0x0300, second = 0x0301;  // SRAM on the ATmega328P (0x0100..0x08FF)
     put(at, 0x9300);  // STS k, r16
     put(at + 2, first);
@@ -219,10 +219,7 @@ TEST(PredecodedCore, BatchStopsWhereTheOraclesLimitsSayEvenWhenTheyChange) {
     Mcu mcu(elf, McuOptions{});
     avr_t* avr = mcu.avr();
     const avr_flashaddr_t at = (avr->flashend + 1) - 64;
-    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) {
-        avr->flash[where] = static_cast<std::uint8_t>(word);
-        avr->flash[where + 1] = static_cast<std::uint8_t>(word >> 8);
-    };
+    const auto put = [&](avr_flashaddr_t where, std::uint16_t word) { put_word(avr, where, word); };
     put(at, 0x0000);
     put(at + 2, 0x0000);
     put(at + 4, 0xcffd);
