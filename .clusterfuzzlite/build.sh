@@ -25,7 +25,7 @@ env -u CFLAGS -u CXXFLAGS -u LDFLAGS \
   cmake --build "$work/firmware" -j"$(nproc)" --target "${firmware[@]}" >> "$work/firmware.log"
 
 # The host side with the contract's compiler, flags and engine.
-cmake -S . -B "$work/build" -DAVRBENCH_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+cmake -S . -B "$work/build" -DAVRBENCH_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
   -DCMAKE_C_COMPILER="$CC" -DCMAKE_CXX_COMPILER="$CXX" \
   -DAVRBENCH_LIB_FUZZING_ENGINE="$LIB_FUZZING_ENGINE" > "$work/build.log"
 cmake --build "$work/build" -j"$(nproc)" \

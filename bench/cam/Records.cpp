@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "core/Errors.hpp"
@@ -9,7 +10,6 @@
 namespace avrbench {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // START byte bits (PORTB): PB0 X DIR, PB2 X EN (1 = off), PB4 Y EN, PB5 Y DIR.
 constexpr std::uint8_t kXNeg = 0x01, kXOff = 0x04, kYOff = 0x10, kYNeg = 0x20;
 
@@ -87,11 +87,11 @@ struct Converter {
         const double r = std::hypot(ci, cj);
         double a0 = std::atan2(sy - cy, sx - cx), a1 = std::atan2(ey - cy, ex - cx);
         double sweep = clockwise ? a0 - a1 : a1 - a0;  // positive, in the arc's direction
-        while (sweep <= 1e-9) sweep += 2 * kPi;        // a full circle when start == end
+        while (sweep <= 1e-9) sweep += 2 * std::numbers::pi;        // a full circle when start == end
         // Chords no longer than chord_deg, and short enough for 8-bit counts.
         const double max_chord_mm = 255.0 / o.steps_per_mm;
         const double by_length = 2.0 * std::asin(std::min(1.0, max_chord_mm / (2.0 * std::max(r, 1e-9))));
-        const double step = std::min(o.chord_deg * kPi / 180.0, by_length);
+        const double step = std::min(o.chord_deg * std::numbers::pi / 180.0, by_length);
         const int n = std::max(1, static_cast<int>(std::ceil(sweep / step - 1e-9)));
         std::string first(1, clockwise ? '\x02' : '\x03');
         bool head = true;

@@ -1,15 +1,15 @@
 #include "parts/DeltaKinematics.hpp"
 
 #include <cmath>
+#include <numbers>
 
 namespace avrbench {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A point rotated about z by `deg`.
 Eigen::Vector3d rotated_z(const Eigen::Vector3d& p, double deg) {
-    return Eigen::AngleAxisd(deg * kPi / 180.0, Eigen::Vector3d::UnitZ()) * p;
+    return Eigen::AngleAxisd(deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()) * p;
 }
 
 }  // namespace
@@ -21,7 +21,7 @@ std::optional<Eigen::Vector3d> delta_forward(const DeltaGeometry& g, const std::
     const double inset = (g.base_side_mm - g.effector_side_mm) / (2.0 * std::sqrt(3.0));
     std::array<Eigen::Vector3d, 3> centre;
     for (int i = 0; i < 3; ++i) {
-        const double t = theta_deg[static_cast<std::size_t>(i)] * kPi / 180.0;
+        const double t = theta_deg[static_cast<std::size_t>(i)] * std::numbers::pi / 180.0;
         const Eigen::Vector3d arm1(0.0, -(inset + g.upper_arm_mm * std::cos(t)), -g.upper_arm_mm * std::sin(t));
         centre[static_cast<std::size_t>(i)] = rotated_z(arm1, 120.0 * i);
     }
@@ -69,7 +69,7 @@ std::optional<std::array<double, 3>> delta_inverse(const DeltaGeometry& g, const
         if (disc < 0) return std::nullopt;
         const double yj = (y_f - a * b - std::sqrt(disc)) / (b * b + 1.0);  // the outer elbow
         const double zj = a + b * yj;
-        theta[static_cast<std::size_t>(i)] = std::atan2(-zj, y_f - yj) * 180.0 / kPi;
+        theta[static_cast<std::size_t>(i)] = std::atan2(-zj, y_f - yj) * 180.0 / std::numbers::pi;
     }
     return theta;
 }

@@ -3,6 +3,7 @@
 #include "parts/PartRegistry.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <sstream>
 
@@ -34,13 +35,12 @@ REGISTER_PART_TYPE(stepper_type("unipolar_stepper", true));
 const FindingKind HybridStepper::kMotorStall = FindingKind::declare("motor-stall", "a stepper motor's rotor lost synchronism with its excitation (lost steps)", Severity::Warning);
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTwoPi = 2 * kPi;
+constexpr double kTwoPi = 2 * std::numbers::pi;
 // A pole slip is counted when the rotor is more than this far (electrical)
 // from the equilibrium of its present count: past pi the torque pulls it to
 // the next equilibrium; the extra quarter turn keeps a rotor rocking on the
 // unstable point from counting slips back and forth.
-constexpr double kSlipThreshold = 1.25 * kPi;
+constexpr double kSlipThreshold = 1.25 * std::numbers::pi;
 
 // "1,2" -> {1, 2}: a winding's plus and minus outputs on its bridge.
 std::pair<int, int> output_pair(const std::string& text, const std::string& part, const std::string& param) {
@@ -239,7 +239,7 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
         }
     }
 
-    shaft_256_ = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (kPi / 2) * 256.0));
+    shaft_256_ = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (std::numbers::pi / 2) * 256.0));
     shaft_full_ = shaft_256_ >= 0 ? shaft_256_ / 256 : -((-shaft_256_ + 255) / 256);
     provide_port<ShaftMotion>("shaft", *this, "the rotor in full steps, for a linear_axis (a lead screw) to follow");
     sig_angle_ = add_signal("angle_deg", true);
@@ -292,12 +292,12 @@ void HybridStepper::sync() {
     check_slip();
 }
 
-double HybridStepper::angle_deg() const { return model_.angle() * 180.0 / kPi; }
+double HybridStepper::angle_deg() const { return model_.angle() * 180.0 / std::numbers::pi; }
 
 double HybridStepper::commanded_deg() const {
     // Before the first excitation the rotor is where it is told to be.
     if (!have_command_) return angle_deg();
-    return command_e_ / model_.params().rotor_teeth * 180.0 / kPi;
+    return command_e_ / model_.params().rotor_teeth * 180.0 / std::numbers::pi;
 }
 
 double HybridStepper::speed_rpm() const { return model_.speed() * 60.0 / kTwoPi; }
@@ -478,7 +478,7 @@ std::string HybridStepper::motion_summary() const {
 
 void HybridStepper::update_shaft() {
     // Electrical angle / (pi/2) full steps; the shaft in 1/256 of one.
-    const auto now_256 = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (kPi / 2) * 256.0));
+    const auto now_256 = static_cast<std::int64_t>(std::llround(model_.electrical_angle() / (std::numbers::pi / 2) * 256.0));
     if (now_256 == shaft_256_) return;
     const std::int64_t delta = now_256 - shaft_256_;
     shaft_256_ = now_256;

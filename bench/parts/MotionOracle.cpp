@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <utility>
 
@@ -22,7 +23,6 @@ const FindingKind MotionOracle::kToolDownOffPath = FindingKind::declare(
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr char kAxisLetters[3] = {'X', 'Y', 'Z'};
 // Accepted moves the machine may be behind by before the oracle gives up
 // (memory stays bounded on a firmware that acknowledges and never moves).
@@ -31,8 +31,8 @@ constexpr std::size_t kMaxPendingMoves = 4096;
 constexpr std::size_t kLookahead = 8;
 
 double wrap_2pi(double rad) {
-    double r = std::fmod(rad, 2 * kPi);
-    if (r < 0) r += 2 * kPi;
+    double r = std::fmod(rad, 2 * std::numbers::pi);
+    if (r < 0) r += 2 * std::numbers::pi;
     return r;
 }
 
@@ -224,7 +224,7 @@ void MotionOracle::commanded(const CommandedMove& move) {
             const double end_rad = std::atan2(end.y(), end.x());
             const bool ccw = move.kind == CommandedMove::Kind::ArcCounterClockwise;
             double sweep = ccw ? wrap_2pi(end_rad - t.start_rad) : wrap_2pi(t.start_rad - end_rad);
-            if (sweep < 1e-9) sweep = 2 * kPi;  // back to its start: a whole circle
+            if (sweep < 1e-9) sweep = 2 * std::numbers::pi;  // back to its start: a whole circle
             t.sweep_rad = ccw ? sweep : -sweep;
             t.length = std::hypot(sweep * t.radius, t.to.z() - t.from.z());
         }

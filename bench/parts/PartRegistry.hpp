@@ -66,11 +66,11 @@ const std::map<std::string, PartType>& part_types();
 // At namespace scope in a part's .cpp: the board-file type `name` builds T
 // from its parameters (T::param_specs(), T::presets() if it has them).
 #define REGISTER_PART(T, name) \
-    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __LINE__) = \
+    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __COUNTER__) = \
         ::avrbench::register_part_type(::avrbench::simple_part_type<T>(name))
 // The same for a type built some other way (a PartType expression).
 #define REGISTER_PART_TYPE(part_type) \
-    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __LINE__) = \
+    [[maybe_unused]] static const bool AVRBENCH_CONCAT(registered_part_, __COUNTER__) = \
         ::avrbench::register_part_type(part_type)
 
 }  // namespace avrbench

@@ -11,7 +11,7 @@
 #include "support/Paths.hpp"
 
 namespace avrbench {
-namespace {
+namespace board_variants_test {
 
 struct TempDir {
     std::filesystem::path path;
@@ -103,5 +103,5 @@ TEST(BoardVariants, OpticalEndstopRampsIsRampsWithPushPullSwitches) {
     }
 }
 
-}  // namespace
+}  // namespace board_variants_test
 }  // namespace avrbench

@@ -6,7 +6,7 @@
 #include "parts/Params.hpp"
 
 namespace avrbench {
-namespace {
+namespace params_test {
 
 const std::vector<ParamSpec> kSpecs = {
     {.name = "pulse", .type = ParamType::Quantity, .dimension = Dimension::Time, .default_value = "2us",
@@ -48,5 +48,5 @@ TEST(Params, ErrorsNameTheLineAndTheProblem) {
               "b.yaml:7: part 'p': unknown parameter 'puls' (known: pulse, count, mode, to)");
 }
 
-}  // namespace
+}  // namespace params_test
 }  // namespace avrbench

@@ -10,7 +10,7 @@
 #include "conformance_timers/TimerTestSupport.hpp"
 
 namespace avrbench::test::timers {
-namespace {
+namespace normal_test {
 
 struct Channel {
     const char* pin;
@@ -81,5 +81,5 @@ TEST(TimerClockSource, Timer1CountsRisingEdgesOnT1Atmega328p) {
     EXPECT_EQ(mcu.read_ram_u16("tcnt1"), 5);
 }
 
-}  // namespace
+}  // namespace normal_test
 }  // namespace avrbench::test::timers

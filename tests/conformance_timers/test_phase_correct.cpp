@@ -16,7 +16,7 @@
 #include "conformance_timers/TimerTestSupport.hpp"
 
 namespace avrbench::test::timers {
-namespace {
+namespace phase_correct_test {
 
 struct Pwm {
     const char* pin;
@@ -118,5 +118,5 @@ TEST(TimerPhaseCorrectPwm, DutyBottomTopAndDoubleBufferAtmega32) {
             "PD5");
 }
 
-}  // namespace
+}  // namespace phase_correct_test
 }  // namespace avrbench::test::timers

@@ -24,7 +24,7 @@ extern "C" {
 #include "trace/Timeline.hpp"
 
 namespace avrbench {
-namespace {
+namespace run_loop_test {
 
 using test::all_firmware;
 using test::expect_same_end;
@@ -106,11 +106,11 @@ TEST(RunLoop, CoveringRunEndsWhereThePlainRunEndsAndCountsEdges) {
     }
 }
 
-}  // namespace
+}  // namespace run_loop_test
 }  // namespace avrbench
 
 namespace avrbench {
-namespace {
+namespace run_loop_test {
 
 // run_until_sleep on the fast path (issue 37) against the general step of
 // simavr's avr_run: on every firmware the build makes, 20 ms or up to the
@@ -150,5 +150,5 @@ TEST(RunLoop, RunUntilSleepStopsWhereTheGeneralStepStopsOnEveryFirmware) {
     EXPECT_GT(slept, 3u);  // sleep_idle and the Arduino sketches that sleep, at least
 }
 
-}  // namespace
+}  // namespace run_loop_test
 }  // namespace avrbench

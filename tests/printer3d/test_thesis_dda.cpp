@@ -16,7 +16,7 @@
 #include "support/PinLog.hpp"
 
 namespace avrbench {
-namespace {
+namespace thesis_dda_test {
 
 constexpr double kCyclesPerUs = 16.0;
 const char* const kLiteral = "printer3d_interp_thesis_dda";
@@ -128,5 +128,5 @@ TEST(Printer3dThesisDda, TheDtProfilesSixteenBitDefects) {
     EXPECT_NEAR(slow_fixed[2], 50000, 2);
 }
 
-}  // namespace
+}  // namespace thesis_dda_test
 }  // namespace avrbench

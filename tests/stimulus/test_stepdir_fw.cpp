@@ -21,7 +21,7 @@
 #include "support/Paths.hpp"
 
 namespace avrbench {
-namespace {
+namespace stepdir_fw_test {
 
 constexpr Cycle kCyclesPerUs = 16;  // 16 MHz
 
@@ -178,5 +178,5 @@ TEST(StepDirFw, BadCommandsGetGrblStyleErrors) {
     EXPECT_TRUE(r.step.empty());
 }
 
-}  // namespace
+}  // namespace stepdir_fw_test
 }  // namespace avrbench

@@ -19,7 +19,7 @@
 #endif
 
 namespace avrbench {
-namespace {
+namespace vcd_writer_test {
 
 using trace_test::ScratchDir;
 
@@ -421,5 +421,5 @@ TEST(VcdWriter, WritesMillionsOfEventsInSeconds) {
     EXPECT_LT(seconds, 10.0) << "1M events took " << seconds << " s";
 }
 
-}  // namespace
+}  // namespace vcd_writer_test
 }  // namespace avrbench

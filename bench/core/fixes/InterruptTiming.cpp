@@ -41,7 +41,7 @@ constexpr unsigned kSleepOpcode = 0x9588;
 class InterruptTiming;
 
 // The sleep callback carries no parameter: find the fix by its core.
-Registry<avr_t, InterruptTiming>& registry() {
+Registry<avr_t, InterruptTiming>& interrupt_timing_registry() {
     static Registry<avr_t, InterruptTiming> r;
     return r;
 }
@@ -60,7 +60,7 @@ public:
         }
         avr_irq_register_notify(avr->interrupts.irq + AVR_INT_IRQ_PENDING, &on_pending, this);
         sreg_hook_ = std::make_unique<IoWriteHook>(avr, R_SREG, &on_sreg_write, this);
-        registry().add(avr, this);
+        interrupt_timing_registry().add(avr, this);
         generation().fetch_add(1);
         avr->sleep = &on_sleep;
     }
@@ -71,7 +71,7 @@ public:
         }
         avr_irq_unregister_notify(avr_->interrupts.irq + AVR_INT_IRQ_PENDING, &on_pending, this);
         avr_cycle_timer_cancel(avr_, &sei_watch, this);
-        registry().remove(avr_);
+        interrupt_timing_registry().remove(avr_);
         generation().fetch_add(1);
     }
 
@@ -161,7 +161,7 @@ private:
         if (avr == cached_avr && cached_generation == generation().load(std::memory_order_relaxed)) {
             self = cached_self;
         } else {
-            self = registry().find(avr);
+            self = interrupt_timing_registry().find(avr);
             cached_avr = avr;
             cached_self = self;
             cached_generation = generation().load(std::memory_order_relaxed);

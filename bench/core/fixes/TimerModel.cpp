@@ -274,8 +274,8 @@ avr_irq_t* pin_irq(avr_t* avr, avr_regbit_t pin) {
 class TimerModel;
 
 // simavr's io reset callback has no parameter.
-std::mutex registry_mutex;
-std::map<const avr_io_t*, TimerModel*>& registry() {
+std::mutex timer_model_registry_mutex;
+std::map<const avr_io_t*, TimerModel*>& timer_model_registry() {
     static std::map<const avr_io_t*, TimerModel*> r;
     return r;
 }
@@ -327,14 +327,14 @@ public:
 
         original_reset_ = t_->io.reset;
         t_->io.reset = &on_io_reset;
-        std::lock_guard<std::mutex> lock(registry_mutex);
-        registry()[&t_->io] = this;
+        std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
+        timer_model_registry()[&t_->io] = this;
     }
 
     ~TimerModel() {
         {
-            std::lock_guard<std::mutex> lock(registry_mutex);
-            registry().erase(&t_->io);
+            std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
+            timer_model_registry().erase(&t_->io);
         }
         t_->io.reset = original_reset_;
         avr_cycle_timer_cancel(avr_, &on_event, this);
@@ -1182,9 +1182,9 @@ private:
     static void on_io_reset(avr_io_t* io) {
         TimerModel* self = nullptr;
         {
-            std::lock_guard<std::mutex> lock(registry_mutex);
-            auto it = registry().find(io);
-            if (it != registry().end()) self = it->second;
+            std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
+            auto it = timer_model_registry().find(io);
+            if (it != timer_model_registry().end()) self = it->second;
         }
         if (self == nullptr) return;
         if (self->original_reset_ != nullptr) self->original_reset_(io);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -34,9 +35,8 @@ std::vector<Point3> merge_path(const std::vector<Series>& axes) {
 }
 
 double wrap_angle(double a) {
-    constexpr double kPi = 3.14159265358979323846;
-    while (a > kPi) a -= 2 * kPi;
-    while (a < -kPi) a += 2 * kPi;
+    while (a > std::numbers::pi) a -= 2 * std::numbers::pi;
+    while (a < -std::numbers::pi) a += 2 * std::numbers::pi;
     return a;
 }
 
