@@ -502,8 +502,8 @@ VcdStream::~VcdStream() = default;
 
 void VcdStream::drain(Timeline& timeline, Picoseconds settled_ps) {
     impl_->take(timeline);
-    __extension__ typedef unsigned __int128 Uint128;
-    const Uint128 units = static_cast<Uint128>(settled_ps) *
+    __extension__ typedef unsigned __int128 WideUnits;  // ps x units/s passes 2^64 after 18.4 ms at 1 ns
+    const WideUnits units = static_cast<WideUnits>(settled_ps) *
                                     impl_->emitter.timescale().units_per_second() / kPsPerSecond;
     impl_->write_up_to(units > std::numeric_limits<std::uint64_t>::max() ? std::numeric_limits<std::uint64_t>::max()
                                                                           : static_cast<std::uint64_t>(units));
