@@ -178,7 +178,7 @@ TEST(BoardFileErrors, CliSaysItInOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("board-cli");
     const auto path = dir / "bad.yaml";
     std::ofstream(path) << board_with(8, "  x_step: [uno.PD9, x_driver.step]");
-    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " run --board " + path.string() + " " +
+    const auto r = test::run_command(std::string(::avrbench::test::cli()) + " run --board " + path.string() + " " +
                                          test::firmware("step_pattern"), dir);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, "avrbench: error: " + path.string() + ":8: unknown pin 'PD9': atmega328p has no such pin\n");

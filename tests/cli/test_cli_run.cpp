@@ -15,7 +15,7 @@ namespace {
 
 using test::quoted;
 
-const std::string kCli = AVRBENCH_CLI;
+const std::string kCli = ::avrbench::test::cli();
 
 std::size_t line_count(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
 
@@ -68,7 +68,7 @@ TEST(CliRun, SimavrCoreGivesTheSameVcdAsThePredecodedCore) {
                                                " --for 5ms --uart-in " + quoted(test::source_path("tests/cli/echo_input.txt")) +
                                                " --vcd " + quoted((dir / (tag + "-one.vcd")).string()) + core, dir);
         ASSERT_EQ(one.exit_code, 0) << one.err;
-        const std::string fw = std::string(AVRBENCH_FIRMWARE_DIR) + "/";
+        const std::string fw = std::string(::avrbench::test::firmware_dir()) + "/";
         const auto board = test::run_command(
             kCli + " run " + quoted(fw + "printer3d_interp.elf") + " --board " +
                 quoted(test::source_path("bench/boards/printer3d-seed001.yaml")) + " --firmware drive_x=" +
@@ -184,7 +184,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInputCase{"missing_file", "run /nonexistent/fw.elf", "/nonexistent/fw.elf: no such file"},
         BadInputCase{"not_elf", "run " + test::source_path("tests/cli/echo_input.txt"), "echo_input.txt: not an ELF file"},
-        BadInputCase{"not_avr", "run " + std::string(AVRBENCH_CLI), "not an AVR ELF"},
+        BadInputCase{"not_avr", "run " + std::string(::avrbench::test::cli()), "not an AVR ELF"},
         BadInputCase{"unknown_mcu", "run " + test::firmware("blink_timer1") + " --mcu atmega9999",
                      "unknown MCU 'atmega9999'"},
         // Both options missing are named in one message, so one correction suffices.
@@ -248,7 +248,7 @@ namespace {
 TEST(CliRunPeriodicWaves, ADutyZeroBedHeatsWithItsMeanPowerUnlessWavesAreOff) {
     const auto dir = test::scratch_dir("periodic-waves");
     const std::string base =
-        AVRBENCH_CLI + std::string(" run -q --board ramps-1.4 ") + test::firmware("heat_wait") + " --for 1s";
+        ::avrbench::test::cli() + std::string(" run -q --board ramps-1.4 ") + test::firmware("heat_wait") + " --for 1s";
     const auto waves = test::run_command(base, dir);
     const auto edges = test::run_command(base + " --no-periodic-waves", dir);
     ASSERT_EQ(waves.exit_code, 0) << waves.out << waves.err;

@@ -15,8 +15,8 @@ namespace avrbench {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kCli = AVRBENCH_CLI;
-const std::string kFw = std::string(" --firmware-dir ") + AVRBENCH_FIRMWARE_DIR;
+const std::string kCli = ::avrbench::test::cli();
+const std::string kFw = std::string(" --firmware-dir ") + ::avrbench::test::firmware_dir();
 
 fs::path write(const fs::path& path, const std::string& text) {
     std::ofstream(path) << text;

@@ -33,7 +33,7 @@ constexpr int kCampaignGuardSeconds = 600;
 
 std::string fuzz(const std::string& elf, const std::string& board, const std::string& runs, const std::filesystem::path& dir,
                  int* exit_code, const std::string& engine = "libfuzzer") {
-    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --engine " + engine + " --elf " + test::firmware(elf) +
+    const std::string command = std::string(::avrbench::test::cli()) + " fuzz --engine " + engine + " --elf " + test::firmware(elf) +
                                 " --board " + test::source_path("tests/fixtures/fuzz/firmware/" + board) + " --runs " + runs +
                                 " --for " + std::to_string(kCampaignGuardSeconds) + "s --seed 1 --out " + (dir / "out").string();
     const auto r = test::run_command(command, dir, kCampaignGuardSeconds + 60);
@@ -109,7 +109,7 @@ TEST(Fuzz, AflFindsTheThesisParsersPlantedBugs) {
 // target) and may be a reproducer's first finding, so the reproducers' runs
 // (finding-N.txt, every finding of the run) are searched too.
 std::string fuzz_delta(const std::string& elf, const std::string& runs, const std::filesystem::path& dir, int* exit_code) {
-    const std::string command = std::string(AVRBENCH_CLI) + " fuzz --engine afl --elf " + test::firmware(elf) + " --board " +
+    const std::string command = std::string(::avrbench::test::cli()) + " fuzz --engine afl --elf " + test::firmware(elf) + " --board " +
                                 test::source_path("bench/boards/delta-seed004.yaml") + " --corpus " +
                                 test::source_path("tests/fixtures/fuzz/firmware/delta-seed004-corpus") + " --runs " + runs +
                                 " --for " + std::to_string(kCampaignGuardSeconds) + "s --seed 1 --out " + (dir / "out").string();
@@ -158,7 +158,7 @@ TEST(Fuzz, TargetReadsItsSettingsFromTheFileBesideIt) {
     namespace fs = std::filesystem;
     const auto dir = test::scratch_dir("fuzz-config");
     const fs::path target = dir / "fuzz_firmware_x";
-    fs::copy_file(fs::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl", target,
+    fs::copy_file(fs::path(::avrbench::test::cli()).parent_path() / "avrbench-fuzz-firmware-afl", target,
                   fs::copy_options::overwrite_existing);
     fs::copy_file(test::firmware("printer3d_interp_thesis_parser"), dir / "fw.elf", fs::copy_options::overwrite_existing);
     const std::string board = test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-thesis.yaml");
@@ -196,7 +196,7 @@ TEST(Fuzz, TargetRunsTheOtherMcusOfAMultiMcuBoard) {
     const std::string env = "env AVRBENCH_FUZZ_BOARD=printer3d-seed001 AVRBENCH_FUZZ_ELF=" + test::firmware("printer3d_interp") +
                             " 'AVRBENCH_FUZZ_FIRMWARE=drive_x=" + drive + ";drive_y=" + drive + ";drive_z=" + drive +
                             ";drive_e=" + drive + ";heater=" + test::firmware("printer3d_heater") + "' " +
-                            (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
+                            (std::filesystem::path(::avrbench::test::cli()).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
     std::ofstream(dir / "circle") << "G2 I-5 J0 F300\nM400\n";
     const auto circle = test::run_command(env + (dir / "circle").string(), dir, 60);
     EXPECT_NE(circle.exit_code, 0) << circle.err;
@@ -219,7 +219,7 @@ TEST(Fuzz, TheMotionOracleJudgesEachInput) {
         return "env AVRBENCH_FUZZ_BOARD=printer3d-seed001 AVRBENCH_FUZZ_ELF=" + test::firmware(interp) +
                " 'AVRBENCH_FUZZ_FIRMWARE=drive_x=" + drive + ";drive_y=" + drive + ";drive_z=" + drive + ";drive_e=" + drive +
                ";heater=" + test::firmware("printer3d_heater") + "' " +
-               (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
+               (std::filesystem::path(::avrbench::test::cli()).parent_path() / "avrbench-fuzz-firmware-afl").string() + " ";
     };
     std::ofstream(dir / "long_line") << "G1 X3 F600\nM400\n";
     const auto literal = test::run_command(env("printer3d_interp_thesis_dda") + (dir / "long_line").string(), dir, 60);
@@ -241,7 +241,7 @@ TEST(Fuzz, ALineUnansweredAtTheBoundIsAHangOnlyWhenAsked) {
     const std::string run = "AVRBENCH_FUZZ_BOUND=2 AVRBENCH_FUZZ_BOARD=" +
                             test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
                             " AVRBENCH_FUZZ_ELF=" + test::firmware("printer3d_interp") + " " +
-                            (std::filesystem::path(AVRBENCH_CLI).parent_path() / "avrbench-fuzz-firmware-afl").string() + " " +
+                            (std::filesystem::path(::avrbench::test::cli()).parent_path() / "avrbench-fuzz-firmware-afl").string() + " " +
                             (dir / "dwell").string();
     const auto plain = test::run_command("env AVRBENCH_FUZZ_HANG=0 " + run, dir, 60);
     EXPECT_EQ(plain.exit_code, 0) << plain.err;
@@ -256,24 +256,24 @@ TEST(Fuzz, ALineUnansweredAtTheBoundIsAHangOnlyWhenAsked) {
 
 TEST(Fuzz, BadArgumentsAreOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("fuzz-bad");
-    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
+    const auto r = test::run_command(std::string(::avrbench::test::cli()) + " fuzz --elf /nonexistent.elf --board arduino-uno --for 5s", dir, 30);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("/nonexistent.elf"), std::string::npos) << r.err;
-    const auto no_target = test::run_command("AVRBENCH_FUZZ_TARGET=/nonexistent " + std::string(AVRBENCH_CLI) +
+    const auto no_target = test::run_command("AVRBENCH_FUZZ_TARGET=/nonexistent " + std::string(::avrbench::test::cli()) +
                                                  " fuzz --elf " + test::firmware("printer3d_interp") + " --board " +
                                                  test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
                                                  " --for 5s --out " + (dir / "out").string(),
                                              dir, 30);
     EXPECT_EQ(no_target.exit_code, 2) << no_target.out << no_target.err;
     EXPECT_NE(no_target.err.find("/nonexistent: cannot start"), std::string::npos) << no_target.err;
-    const auto no_afl = test::run_command("PATH=/nonexistent " + std::string(AVRBENCH_CLI) + " fuzz --engine afl --elf " +
+    const auto no_afl = test::run_command("PATH=/nonexistent " + std::string(::avrbench::test::cli()) + " fuzz --engine afl --elf " +
                                               test::firmware("printer3d_interp") + " --board " +
                                               test::source_path("tests/fixtures/fuzz/firmware/printer3d-interp-alone.yaml") +
                                               " --for 5s --out " + (dir / "out-afl").string(),
                                           dir, 30);
     EXPECT_EQ(no_afl.exit_code, 2) << no_afl.out << no_afl.err;
     EXPECT_NE(no_afl.err.find("afl-fuzz not found on PATH; install Debian's afl++"), std::string::npos) << no_afl.err;
-    const auto bad_engine = test::run_command(std::string(AVRBENCH_CLI) + " fuzz --engine honggfuzz --elf x --board y", dir, 30);
+    const auto bad_engine = test::run_command(std::string(::avrbench::test::cli()) + " fuzz --engine honggfuzz --elf x --board y", dir, 30);
     EXPECT_EQ(bad_engine.exit_code, 2) << bad_engine.out << bad_engine.err;
 }
 

@@ -109,7 +109,7 @@ TEST(Cam, BadFilesAreOneLineErrors) {
 TEST(Cam, CliWritesTheProgramAndSaysWhatItSaved) {
     const auto dir = test::scratch_dir("cam-cli");
     const auto out = (dir / "three.nc").string();
-    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " cam " + fixture("three_lines.dxf") + " -o " + out, dir);
+    const auto r = test::run_command(std::string(::avrbench::test::cli()) + " cam " + fixture("three_lines.dxf") + " -o " + out, dir);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("commands   6 -> 4 (rapids 3 -> 1)"), std::string::npos) << r.out;
     // The default feed is run --dxf's, 120 mm/min (one default for both, issue 40).
@@ -117,7 +117,7 @@ TEST(Cam, CliWritesTheProgramAndSaysWhatItSaved) {
     const std::string program((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
     EXPECT_NE(program.find(" F120\n"), std::string::npos) << program;
     EXPECT_EQ(program.find("F600"), std::string::npos) << program;
-    const auto missing = test::run_command(std::string(AVRBENCH_CLI) + " cam " + (dir / "nope.dxf").string(), dir);
+    const auto missing = test::run_command(std::string(::avrbench::test::cli()) + " cam " + (dir / "nope.dxf").string(), dir);
     EXPECT_EQ(missing.exit_code, 2);
     EXPECT_EQ(missing.err, "avrbench: error: DXF drawing: " + (dir / "nope.dxf").string() + ": no such file\n");
 }

@@ -165,7 +165,7 @@ TEST(CncEndToEnd, GcodeTheConverterCannotUseIsALineError) {
 
 TEST(CncEndToEnd, OneCommandPlotsADxfOnTheBoard) {
     const auto dir = test::scratch_dir("cnc-plot");
-    const std::string cmd = std::string(AVRBENCH_CLI) + " run -q " + test::firmware("cnc2axis_improved") +
+    const std::string cmd = std::string(::avrbench::test::cli()) + " run -q " + test::firmware("cnc2axis_improved") +
                             " --board " + test::source_path("bench/boards/cnc2axis-seed002.yaml") + " --dxf " +
                             test::source_path("tests/fixtures/dxf/line_arc_circle.dxf") +
                             " --records improved --vcd " + (dir / "plot.vcd").string() + " --nc " + (dir / "plot.nc").string();
@@ -176,7 +176,7 @@ TEST(CncEndToEnd, OneCommandPlotsADxfOnTheBoard) {
     EXPECT_TRUE(std::filesystem::exists(dir / "plot.vcd"));
     EXPECT_TRUE(std::filesystem::exists(dir / "plot.nc"));
     // Without a board there is no serial port to stream to.
-    const auto bad = test::run_command(std::string(AVRBENCH_CLI) + " run " + test::firmware("cnc2axis") + " --dxf x.dxf", dir);
+    const auto bad = test::run_command(std::string(::avrbench::test::cli()) + " run " + test::firmware("cnc2axis") + " --dxf x.dxf", dir);
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(bad.err, "avrbench: error: --dxf needs --board (the board file names the serial port)\n");
 }

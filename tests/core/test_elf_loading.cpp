@@ -106,7 +106,7 @@ TEST(ElfLoading, MalformedFilesAreOneLineWithExitCode2) {
         m.apply(bytes);
         const fs::path path = dir / (std::string(m.name) + ".elf");
         std::ofstream(path, std::ios::binary) << bytes;
-        const auto r = test::run_command(std::string(AVRBENCH_CLI) + " run -q " + path.string() + " --for 1ms", dir, 20);
+        const auto r = test::run_command(std::string(::avrbench::test::cli()) + " run -q " + path.string() + " --for 1ms", dir, 20);
         EXPECT_EQ(r.exit_code, 2) << m.name << ": " << r.out << r.err;
         EXPECT_EQ(r.err.rfind("avrbench: error: " + path.string() + ": ", 0), 0u) << m.name << ": " << r.err;
         EXPECT_NE(r.err.find(m.message), std::string::npos) << m.name << ": " << r.err;

@@ -110,7 +110,7 @@ TEST(RunLoopsTerminate, TwoMcusWithUnrelatedClocks) {
 // The exact commands that hung, through the CLI, each under a wall-clock limit.
 TEST(RunLoopsTerminate, CliRunsThatUsedToHang) {
     const auto dir = test::scratch_dir("cli-hang");
-    const std::string cli = AVRBENCH_CLI;
+    const std::string cli = ::avrbench::test::cli();
     const std::string board = test::source_path("bench/boards/arduino-uno.yaml");
     for (const char* t : {"50ms", "100ms", "200ms", "700ms"}) {
         const auto r = test::run_command(cli + " run -q --board " + board + " " + test::firmware("busy_poll") + " --for " + t, dir, 60);
@@ -123,7 +123,7 @@ TEST(RunLoopsTerminate, CliRunsThatUsedToHang) {
                             << "firmware: {uno: busy_poll}\n"
                             << "time_limit: 100ms\n"
                             << "steps:\n  - wait_for_text: never\n";
-    const auto r = test::run_command(cli + " check " + scenario.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir, 60);
+    const auto r = test::run_command(cli + " check " + scenario.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir, 60);
     EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
     EXPECT_NE(r.out.find("the firmware sent no line containing 'never' by 0.100000 s"), std::string::npos) << r.out;
 }

@@ -39,12 +39,12 @@ class Avrdude : public ::testing::TestWithParam<const Upload*> {};
 TEST_P(Avrdude, FlashesAndVerifiesThroughTheBootLoaderAndTheNewApplicationRuns) {
     const Upload& u = *GetParam();
     const auto dir = test::scratch_dir(std::string("avrdude-") + u.name);
-    const std::string fw = std::string(AVRBENCH_FIRMWARE_DIR) + "/";
+    const std::string fw = std::string(::avrbench::test::firmware_dir()) + "/";
     const std::string hex = fw + u.image + ".hex";
     std::size_t image_bytes = 0;
     for (const auto& chunk : read_intel_hex(hex)) image_bytes += chunk.bytes.size();
 
-    const std::string bench = std::string(AVRBENCH_CLI) + " run " + fw + u.initial + ".elf --board " + u.board +
+    const std::string bench = std::string(::avrbench::test::cli()) + " run " + fw + u.initial + ".elf --board " + u.board +
                               " --pty host --pty-link tty --reset-on-open --pace realtime"
                               " --uart-out host=firmware.txt --vcd run.vcd --for 6s";
     const std::string avrdude = std::string("timeout 60 avrdude ") + u.avrdude + " -P tty -b 115200 -U flash:w:" + hex + ":i";
@@ -86,7 +86,7 @@ TEST(AvrdudeLockBits, CannotOverwriteTheBootLoader) {
         }
         hex << ":00000001FF\n";
     }
-    const std::string bench = std::string(AVRBENCH_CLI) + " run " + test::firmware("blink_timer1") +
+    const std::string bench = std::string(::avrbench::test::cli()) + " run " + test::firmware("blink_timer1") +
                               " --board arduino-uno-optiboot --pty host --pty-link tty --reset-on-open --pace realtime --for 4s";
     const auto r = test::run_command("cd " + test::quoted(dir.string()) + " || exit 1; " + bench +
                                          " > bench.out 2>&1 & b=$!; i=0; while [ ! -e tty ] && [ $i -lt 100 ]; do "

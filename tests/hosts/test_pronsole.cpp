@@ -31,8 +31,8 @@ TEST(Pronsole, PrintsAJobOnTheEmulatedPrinterThroughThePty) {
         std::ofstream job(dir / "job.gcode");
         job << "G28\nG1 X2 Y2 F500\nG1 Z0.2\nM105\nM400\nM114\n";
     }
-    const std::string fw = std::string(AVRBENCH_FIRMWARE_DIR) + "/";
-    const std::string bench = std::string(AVRBENCH_CLI) + " run " + fw + "printer3d_interp.elf --board " +
+    const std::string fw = std::string(::avrbench::test::firmware_dir()) + "/";
+    const std::string bench = std::string(::avrbench::test::cli()) + " run " + fw + "printer3d_interp.elf --board " +
                               test::source_path("bench/boards/printer3d-seed001.yaml") + " --firmware drive_x=" + fw +
                               "printer3d_drive.elf --firmware drive_y=" + fw + "printer3d_drive.elf --firmware drive_z=" +
                               fw + "printer3d_drive.elf --firmware drive_e=" + fw +

@@ -47,7 +47,7 @@ TEST(GcodeInput, TheCliSaysItInOneLineWithExitCode2) {
     const auto dir = test::scratch_dir("gcode-bytes");
     const auto job = dir / "nul.gcode";
     std::ofstream(job, std::ios::binary) << "G21\nG1 X1\0" "0\n"s;
-    const auto r = test::run_command(std::string(AVRBENCH_CLI) + " run -q --board " +
+    const auto r = test::run_command(std::string(::avrbench::test::cli()) + " run -q --board " +
                                          test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml") + " " +
                                          test::firmware("stepdir_test") + " --gcode " + job.string(), dir, 30);
     EXPECT_EQ(r.exit_code, 2);

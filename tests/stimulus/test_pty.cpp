@@ -52,7 +52,7 @@ TEST(Pty, BytesGoBothWaysThroughThePseudoTerminal) {
 
 TEST(Pty, TheCliPrintsThePathAtOnceAndCountsTheBytes) {
     const auto dir = test::scratch_dir("pty-cli");
-    const std::string cli = std::string(AVRBENCH_CLI) + " run " + test::firmware("uart_echo") + " --board " +
+    const std::string cli = std::string(::avrbench::test::cli()) + " run " + test::firmware("uart_echo") + " --board " +
                             test::source_path("bench/boards/arduino-uno.yaml");
     const auto r = test::run_command(cli + " --pty host --for 10ms", dir);
     EXPECT_EQ(r.exit_code, 0) << r.err;

@@ -27,7 +27,7 @@ namespace avrbench::test {
 // Names (without .elf) of every ELF in the build's firmware folder, sorted.
 inline std::vector<std::string> all_firmware() {
     std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(AVRBENCH_FIRMWARE_DIR)) {
+    for (const auto& entry : std::filesystem::directory_iterator(::avrbench::test::firmware_dir())) {
         if (entry.path().extension() == ".elf") names.push_back(entry.path().stem().string());
     }
     std::sort(names.begin(), names.end());

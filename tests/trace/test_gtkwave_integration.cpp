@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "support/Paths.hpp"
 #include "trace/GtkwWriter.hpp"
 #include "trace/Timeline.hpp"
 #include "trace/TraceTestSupport.hpp"
@@ -221,9 +222,9 @@ TEST(GtkwaveAcceptsOurFiles, CliRunOpensFromAnyFolderWithLabelsAndUartText) {
     ScratchDir dir;
     std::filesystem::create_directories(dir.file("traces"));
     trace_test::write_text(dir.file("in.txt"), "hi\n");
-    trace_test::run_command("cd " + quoted(dir.file("")) + " && " + quoted(AVRBENCH_CLI) + " run -q --board " +
-                                quoted(std::string(AVRBENCH_SOURCE_DIR) + "/bench/boards/arduino-uno.yaml") + " " +
-                                quoted(std::string(AVRBENCH_FIRMWARE_DIR) + "/uart_echo.elf") +
+    trace_test::run_command("cd " + quoted(dir.file("")) + " && " + quoted(::avrbench::test::cli()) + " run -q --board " +
+                                quoted(std::string(::avrbench::test::source_dir()) + "/bench/boards/arduino-uno.yaml") + " " +
+                                quoted(std::string(::avrbench::test::firmware_dir()) + "/uart_echo.elf") +
                                 " --for 5ms --uart-in in.txt --vcd traces/u.vcd",
                             dir.file("run.log"));
     // uart_echo's banner "avrbench uart_echo\r\n" goes out one frame per

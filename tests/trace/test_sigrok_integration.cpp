@@ -66,7 +66,7 @@ TEST(SigrokReadsOurVcd, UartDecoderOnTxdAndRxdMatchesTheBytes) {
     const std::string input = "hello, sigrok\n";
     trace_test::write_text(dir.file("in.txt"), input);
     const int status = trace_test::run_command(
-        quoted(AVRBENCH_CLI) + " run -q " + quoted(test::firmware("uart_echo")) + " --for 5ms --uart-in " +
+        quoted(::avrbench::test::cli()) + " run -q " + quoted(test::firmware("uart_echo")) + " --for 5ms --uart-in " +
             quoted(dir.file("in.txt")) + " --uart-out " + quoted(dir.file("out.txt")) + " --vcd " + quoted(dir.file("u.vcd")),
         dir.file("run.log"));
     ASSERT_EQ(status, 0) << read_text(dir.file("run.log"));
@@ -96,7 +96,7 @@ TEST(SigrokReadsOurVcd, I2cDecoderOnTheBoardNetsFindsTheSketchesTransactions) {
                            "  sda: [uno.PC4, mega.PD1]\n"
                            "  scl: [uno.PC5, mega.PD0]\n");
     const int status = trace_test::run_command(
-        quoted(AVRBENCH_CLI) + " run -q --board " + quoted(dir.file("wire.yaml")) + " " +
+        quoted(::avrbench::test::cli()) + " run -q --board " + quoted(dir.file("wire.yaml")) + " " +
             quoted(test::firmware("ard_wire_master")) + " --firmware mega=" + quoted(test::firmware("ard_wire_slave_mega")) +
             " --for 70ms --vcd " + quoted(dir.file("w.vcd")),
         dir.file("run.log"));

@@ -19,7 +19,7 @@ namespace avrbench {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kCli = AVRBENCH_CLI;
+const std::string kCli = ::avrbench::test::cli();
 
 // A blink scenario in `dir` running `firmware`, with its golden in `dir`.
 fs::path write_blink_scenario(const fs::path& dir, const std::string& name, const std::string& firmware) {
@@ -34,7 +34,7 @@ fs::path write_blink_scenario(const fs::path& dir, const std::string& name, cons
 }
 
 std::string check(const fs::path& scenario, const fs::path& dir, int* exit_code, const std::string& extra = "") {
-    const auto r = test::run_command(kCli + " check " + scenario.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR +
+    const auto r = test::run_command(kCli + " check " + scenario.string() + " --firmware-dir " + ::avrbench::test::firmware_dir() +
                                          " --report-dir " + (dir / "reports").string() + extra, dir);
     *exit_code = r.exit_code;
     return r.out + r.err;
@@ -75,7 +75,7 @@ TEST(Scenarios, ShiftedTimerFailsNamingTheChannelAndFirstEdgeThenGoldenUpdateAcc
 
     // Accept the change explicitly; the check passes afterwards.
     const auto update = test::run_command(kCli + " golden update " + scenario.string() + " --firmware-dir " +
-                                              AVRBENCH_FIRMWARE_DIR, dir);
+                                              ::avrbench::test::firmware_dir(), dir);
     ASSERT_EQ(update.exit_code, 0) << update.out << update.err;
     // The new golden toggles every (250 + 1) * 64 = 16064 cycles.
     EXPECT_NE(test::slurp(dir / "blink.timeline").find("*9 +16064 0 +16064 1"), std::string::npos)
@@ -93,7 +93,7 @@ TEST(Scenarios, AStreamedCheckJudgesAsTheRunHeldWhole) {
     fs::copy_file(test::source_path("golden/blink_timer1.timeline"), dir / "blink.timeline");
     for (const std::string firmware : {"blink_timer1", "blink_timer1_ocr250"}) {
         const fs::path path = write_blink_scenario(dir, "blink", firmware);
-        const ScenarioSpec spec = load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+        const ScenarioSpec spec = load_scenario(path.string(), ::avrbench::test::firmware_dir());
         ScenarioRunOptions streamed_options;
         streamed_options.vcd_dir = (dir / "streamed").string();
         fs::create_directories(streamed_options.vcd_dir);
@@ -131,7 +131,7 @@ TEST(Scenarios, AStreamedCheckJudgesAsTheRunHeldWhole) {
 TEST(Scenarios, AStreamedGoldenUpdateWritesTheSameFileAsTheRunHeldWhole) {
     const auto dir = test::scratch_dir("scenario-streamed-update");
     const fs::path path = write_blink_scenario(dir, "blink", "blink_timer1");
-    const ScenarioSpec spec = load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+    const ScenarioSpec spec = load_scenario(path.string(), ::avrbench::test::firmware_dir());
     ScenarioRunOptions update;
     update.update_golden = true;
     const ScenarioResult streamed = run_scenario(spec, update);
@@ -163,12 +163,12 @@ TEST(Scenarios, ShardingSplitsTheScenarioList) {
     const fs::path a = write_blink_scenario(dir, "first", "blink_timer1");
     const fs::path b = write_blink_scenario(dir, "second", "blink_timer1");
     for (const auto& s : {a, b}) {
-        ASSERT_EQ(test::run_command(kCli + " golden update " + s.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir)
+        ASSERT_EQ(test::run_command(kCli + " golden update " + s.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir)
                       .exit_code,
                   0);
     }
     const auto shard1 = test::run_command("GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=1 " + kCli + " check " + a.string() +
-                                              " " + b.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir);
+                                              " " + b.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
     EXPECT_EQ(shard1.exit_code, 0) << shard1.out;
     EXPECT_EQ(shard1.out.find("first"), std::string::npos) << shard1.out;
     EXPECT_NE(shard1.out.find("PASS second"), std::string::npos) << shard1.out;
@@ -181,7 +181,7 @@ TEST(Scenarios, MalformedScenarioIsOneLineWithExitCode2) {
     std::ofstream(path) << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
                         << "firmware: {uno: blink_timer1}\n"
                         << "steps:\n  - dance: 3\n";
-    const auto r = test::run_command(kCli + " check " + path.string() + " --firmware-dir " + AVRBENCH_FIRMWARE_DIR, dir);
+    const auto r = test::run_command(kCli + " check " + path.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, "avrbench: error: " + path.string() +
                          ":4: unknown step 'dance' (known: delay, inject_fault, release_input, send, send_file, set_input, "
@@ -212,7 +212,7 @@ TEST(Scenarios, WaitPinEndsAtTheEdgesCycle) {
     const long pb1 = golden.timeline.find("uno", "PB1");
     ASSERT_GE(pb1, 0);
     const Cycle edge = changes_of(golden.timeline, static_cast<SignalId>(pb1)).at(1).cycle;
-    const ScenarioResult r = run_scenario(load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR), {});
+    const ScenarioResult r = run_scenario(load_scenario(path.string(), ::avrbench::test::firmware_dir()), {});
     ASSERT_TRUE(r.passed) << r.text();
     const auto end_cycle = static_cast<Cycle>(std::llround(r.simulated_s * 16e6));
     EXPECT_GE(end_cycle, edge);
@@ -236,7 +236,7 @@ TEST(Scenarios, AnIsrOverItsCycleBoundFailsWithTheMeasuredTime) {
                         << "firmware: {uno: blink_timer1}\n"
                         << "steps:\n  - delay: 10ms\n"
                         << "expect:\n  - isr: {vector: 11, max_cycles: 27}\n  - stack: {min_headroom_bytes: 2041}\n";
-    const ScenarioResult r = run_scenario(load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR), {});
+    const ScenarioResult r = run_scenario(load_scenario(path.string(), ::avrbench::test::firmware_dir()), {});
     EXPECT_FALSE(r.passed);
     ASSERT_EQ(r.expectation_failures.size(), 2u) << r.text();
     EXPECT_NE(r.expectation_failures[0].find("vector 11 (TIMER1_COMPA) took up to 28 cycles (median 28), expected at most 27"),
@@ -253,7 +253,7 @@ TEST(Scenarios, ATimingBoundForAnUnknownMcuIsAFileLineError) {
                         << "firmware: {uno: blink_timer1}\n"
                         << "expect:\n  - isr: {vector: 11, mcu: mega, max_cycles: 27}\n";
     try {
-        load_scenario(path.string(), AVRBENCH_FIRMWARE_DIR);
+        load_scenario(path.string(), ::avrbench::test::firmware_dir());
         FAIL() << "no error";
     } catch (const BadInput& e) {
         EXPECT_NE(std::string(e.what()).find("isr.yaml:5"), std::string::npos) << e.what();
