@@ -8,6 +8,21 @@
 
 namespace avrbench {
 
+namespace {
+// The read callback simavr's I/O ports register on their PIN registers
+// (avr_ioport_read, static in avr_ioport.c): found through a port, as the
+// callback whose parameter is that port. Null on a core without ports.
+avr_io_read_t find_port_read(const avr_t* avr) {
+    for (const avr_io_t* io = avr->io_port; io != nullptr; io = io->next) {
+        if (io->kind == nullptr || std::strcmp(io->kind, "port") != 0) continue;
+        const auto* port = reinterpret_cast<const avr_ioport_t*>(io);
+        const auto& pin = avr->io[AVR_DATA_TO_IO(port->r_pin)];
+        if (pin.r.param == port) return pin.r.c;
+    }
+    return nullptr;
+}
+}  // namespace
+
 PredecodedCore::PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc) {
     // One slot per flash word; calloc leaves untouched pages unmapped and
     // zero is kUndecoded, so only the code that runs costs memory.
@@ -21,6 +36,7 @@ PredecodedCore::PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_on
     checked_for_.reset(static_cast<CheckedFor*>(std::malloc(sizeof(CheckedFor))));
     if (!slots_ || !checked_for_) throw std::bad_alloc();
     *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc};
+    port_read_ = find_port_read(avr);
 }
 
 PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc) const {
@@ -267,7 +283,7 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // simavr's GDB stub watches data accesses: run_one (the general step)
     // hands each of them to avr_run_one.
     if (avr->gdb != nullptr) return batch;
-    const Machine m(avr, false);
+    const Machine m(avr, false, port_read_);
     // With SP already below the floor (a half-written SP, which the oracle
     // lets pass) every step needs the oracle: the general step takes them.
     if (sp_of(m.data) < limits.stack_floor) return batch;

@@ -34,6 +34,7 @@
 #include <memory>
 
 extern "C" {
+#include <avr_ioport.h>
 #include <sim_avr.h>
 #include <sim_core.h>
 }
@@ -175,6 +176,7 @@ private:
     };
     std::unique_ptr<CheckedFor, FreeDeleter> checked_for_;
     std::uint64_t handed_ = 0;
+    avr_io_read_t port_read_ = nullptr;  // Machine::port_read
 };
 
 namespace predecoded_detail {
@@ -189,11 +191,15 @@ struct Machine {
     explicit Machine(avr_t* a) : Machine(a, a->gdb != nullptr) {}
     // `watched` false where the caller has seen that no GDB stub is attached
     // (a constant the compiler folds into every access check).
-    Machine(avr_t* a, bool is_watched) : avr(a), data(a->data), sreg(a->sreg), flash(a->flash), watched(is_watched) {}
+    Machine(avr_t* a, bool is_watched, avr_io_read_t port_read_callback = nullptr)
+        : avr(a), data(a->data), sreg(a->sreg), flash(a->flash), port_read(port_read_callback), watched(is_watched) {}
     avr_t* avr;
     std::uint8_t* data;
     std::uint8_t* sreg;
     const std::uint8_t* flash;
+    // simavr's avr_ioport_read, the read callback of every PINx register
+    // (find_port_read); null: PIN reads go through the callback.
+    avr_io_read_t port_read;
     bool watched;  // simavr's GDB stub is attached (its watchpoints see data accesses)
     std::uint32_t ramend() const { return avr->ramend; }
     std::uint32_t flashend() const { return avr->flashend; }
@@ -277,6 +283,31 @@ __attribute__((always_inline)) inline std::uint8_t io_read(const Machine& m, std
     if (io.r.c) m.data[addr] = io.r.c(m.avr, addr, io.r.param);
     if (io.irq) io_raise(io.irq, m.data[addr]);
     return m.data[addr];
+}
+
+// avr_ioport_read (simavr 1.6, avr_ioport.c), the read callback of a PINx
+// register, done here while nothing but the data space can observe it: no
+// hook on the port's REG_PIN IRQ and no IRQs made on the register itself
+// (io_read's io_raise). Then the callback only stores the pins' value -
+// PIN's bits where DDR has an input, PORT's where it has an output - in
+// the register, raises REG_PIN with it (raise_irq's inline store) and
+// returns it through avr_core_watch_read, which with no GDB stub
+// (io_callable) is a read of the byte. Nothing that the checks after a
+// callback look at (timers, the core's state, interrupts) changes, so the
+// batch goes on as after a plain read. False, with nothing done, where
+// the register is not a port's PIN or something observes the read.
+__attribute__((always_inline)) inline bool port_pin_read(const Machine& m, std::uint16_t addr, std::uint8_t& value) {
+    const auto& io = m.avr->io[AVR_DATA_TO_IO(addr)];
+    if (io.r.c != m.port_read || io.r.c == nullptr || io.irq != nullptr) return false;
+    const auto* port = static_cast<const avr_ioport_t*>(io.r.param);
+    avr_irq_t* const reg_pin = port->io.irq + IOPORT_IRQ_REG_PIN;
+    if (reg_pin->hook != nullptr) return false;
+    const std::uint8_t ddr = m.data[port->r_ddr];
+    const auto v = static_cast<std::uint8_t>((m.data[port->r_pin] & ~ddr) | (m.data[port->r_port] & ddr));
+    m.data[addr] = v;
+    raise_irq(reg_pin, v);
+    value = v;
+    return true;
 }
 
 // _avr_set_r(addr, v) for an io_callable address.
