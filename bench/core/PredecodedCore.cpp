@@ -276,6 +276,14 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
 // Labels as values are a GNU extension (GCC and clang).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
+// GCC's SLP vectoriser (-O3) packs a handler's SREG flag bytes into one
+// 32-bit store, built with shifts and ORs and a spilled SETcc: more host
+// instructions than the byte stores (busy_poll: 47.6 per AVR instruction
+// with it, 46.5 without; docs/PERFORMANCE.md).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("no-tree-slp-vectorize")
+#endif
 template <bool kCover>
 PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& limits, PcEdgeMap* edges) {
     using namespace predecoded_detail;
@@ -421,6 +429,9 @@ out:
     avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(budget);
     return batch;
 }
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
 #pragma GCC diagnostic pop
 
 template PredecodedCore::Batch PredecodedCore::run_batch<false>(avr_t*, const BatchLimits&, PcEdgeMap*);
