@@ -319,44 +319,72 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     Slot* const slots = slots_.get();
     std::uint8_t* const data = m.data;
     std::uint8_t* const sreg = m.sreg;
-    // The oracles' limits are read from `limits` in the (cold) check.
-    const std::uint32_t max_steps = limits.max_steps;
+    // What only the paths off the dispatch read - the oracles' limits, the
+    // step limit, the core - is kept in memory (volatile: GCC held `this`,
+    // `limits` and max_steps in three of the six callee-saved registers
+    // and so kept the fuel, the slot and the tables on the stack).
+    struct Cold {
+        PredecodedCore* core;
+        std::uint32_t max_steps;
+        std::uint32_t code_end_minus_one;
+        std::uint32_t bad_interrupt_pc;
+        std::uint16_t stack_floor;
+    };
+    volatile Cold cold{this, limits.max_steps, limits.code_end_minus_one, limits.bad_interrupt_pc, limits.stack_floor};
     // The PC and the cycle count live in registers until the batch ends;
     // AVRBENCH_BEFORE_CALLBACKS stores them before simavr's I/O callbacks.
-    // The count is kept as the cycles left to the first timer (`budget`,
-    // counted down): the timer test is then one subtraction.
-    avr_flashaddr_t pc = avr->pc;
+    // One PC: `new_pc` is, at the dispatch, the instruction to fetch, and
+    // in its handler where it goes next; its own PC, wanted only on the way
+    // out and before callbacks, follows from the slot's address (slot_pc).
+    // The count is kept as the cycles left to the first timer, counted
+    // down, with the step limit folded into the same countdown: `fuel` is
+    // that budget, or less where max_steps is smaller - every instruction
+    // takes at least one cycle, so running out of it never passes
+    // max_steps -, with the rest held back in `reserve` (budget = fuel +
+    // reserve). When the fuel is out but not the budget, the batch ends
+    // with Ended::Count, perhaps before max_steps, and Mcu::run_until runs
+    // another. So one counter and one test per instruction.
+    avr_flashaddr_t new_pc = avr->pc;
     avr_cycle_count_t cycle_limit = limits.cycle;
-    std::int64_t budget = static_cast<std::int64_t>(cycle_limit - avr->cycle);
-    std::uint32_t remaining = max_steps;  // steps left
+    std::uint32_t steps = 0;
+    std::int64_t fuel;
+    std::int64_t reserve;
+    const auto refuel = [&](std::int64_t budget) {
+        const std::int64_t steps_left = cold.max_steps - steps;
+        reserve = budget > steps_left ? budget - steps_left : 0;
+        fuel = budget - reserve;
+    };
+    refuel(static_cast<std::int64_t>(cycle_limit - avr->cycle));
     const Slot* slot;
-    avr_flashaddr_t new_pc;
+    // The slot of byte address pc is at byte offset pc * 8.
+    const auto slot_pc = [&] {
+        return static_cast<avr_flashaddr_t>((reinterpret_cast<const char*>(slot) - reinterpret_cast<const char*>(slots)) / 8);
+    };
     int cycle;
 
 #define AVRBENCH_DISPATCH()                                                                       \
     do {                                                                                          \
-        slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + std::size_t{pc} * 8); \
-        if (__builtin_expect(slot->word != flash16(m.flash, pc), 0)) goto decode_slot;            \
-        new_pc = pc + 2;                                                                          \
+        slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + std::size_t{new_pc} * 8); \
+        if (__builtin_expect(slot->word != flash16(m.flash, new_pc), 0)) goto decode_slot;        \
+        new_pc += 2;                                                                              \
         cycle = 1;                                                                                \
         goto* kHandlers[slot->kind];                                                              \
     } while (0)
     // What Mcu::run_until's fast path checks after an instruction, then the
-    // next one: the first cycle timer due, the crash oracles (only after
-    // the slots that can trip them), the step count.
+    // next one: the first cycle timer due or the step count (the fuel), the
+    // crash oracles (only after the slots that can trip them).
 #define AVRBENCH_NEXT()                                                                           \
     do {                                                                                          \
-        --remaining;                                                                              \
-        budget -= cycle;                                                                          \
-        if (__builtin_expect(budget <= 0, 0)) goto timer_due;                                     \
+        ++steps;                                                                                  \
+        fuel -= cycle;                                                                            \
+        if (__builtin_expect(fuel <= 0, 0)) goto out_of_fuel;                                     \
         if (__builtin_expect(slot->check != 0, 0)) goto check_oracles;                            \
-        pc = new_pc;                                                                              \
-        if constexpr (kCover) edges->hit(pc);                                                     \
-        if (__builtin_expect(remaining == 0, 0)) goto count_reached;                              \
+        if constexpr (kCover) edges->hit(new_pc);                                                 \
         AVRBENCH_DISPATCH();                                                                      \
     } while (0)
 #define AVRBENCH_NEXT_CALLED() goto after_callbacks
-#define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(budget))
+#define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(fuel + reserve))
+#define AVRBENCH_PC slot_pc()
 #define AVRBENCH_HAND_OVER() goto hand_over
     // Each handler is a block with the slot's operands; it begins by
     // closing the one before (which never falls through: every handler
@@ -372,61 +400,74 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
 #include "core/PredecodedOps.inc"
     }
 op_kUndecoded:  // a calloc'd slot, whose word 0 matched a NOP in flash
-decode_slot:
-    slots[pc >> 1] = decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
+decode_slot : {
+    // From the dispatch's opcode check, or from a calloc'd slot's handler
+    // (new_pc already past it): the slot's own PC either way.
+    const avr_flashaddr_t pc = slot_pc();
+    slots[pc >> 1] = cold.core->decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
     new_pc = pc + 2;
     cycle = 1;
     goto* kHandlers[slot->kind];
+}
 op_kSimavr:
 hand_over:
     batch.ended = Ended::HandOver;
+    avr->pc = slot_pc();
     goto out;
 after_callbacks : {
-    --remaining;
+    ++steps;
     // A callback may move the cycle count itself (fixes/EepromTiming
     // halts the core 4 cycles on a read that way): count on from it.
     const avr_cycle_count_t cycle_now = avr->cycle + static_cast<avr_cycle_count_t>(cycle);
     avr->cycle = cycle_now;
     cycle_limit = cycle_now;
-    budget = 0;
+    fuel = 0;
+    reserve = 0;
     // What the fast path checks after avr_run_one: a timer the callbacks
     // made due, a core no longer running, an interrupt on its way.
     const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
     if (first == nullptr || first->when <= cycle_now || avr->state != cpu_Running || avr->interrupt_state != 0) goto timer_due;
     cycle_limit = first->when;
-    budget = static_cast<std::int64_t>(cycle_limit - cycle_now);
+    refuel(static_cast<std::int64_t>(cycle_limit - cycle_now));
     if (slot->check == 0) goto advance;
+    goto check_oracles;
 }
+out_of_fuel:
+    if (fuel + reserve <= 0) goto timer_due;
+    // Only the step limit's share is out: this instruction ends the batch.
+    if (slot->check == 0) goto advance;
 check_oracles:
     // SP only changes through the kinds that may store to the data space.
-    if (new_pc - 1 >= limits.code_end_minus_one || new_pc == limits.bad_interrupt_pc ||
-        ((slot->flags & kMovesSp) && sp_of(data) < limits.stack_floor)) {
+    if (new_pc - 1 >= cold.code_end_minus_one || new_pc == cold.bad_interrupt_pc ||
+        ((slot->flags & kMovesSp) && sp_of(data) < cold.stack_floor)) {
         batch.ended = Ended::CheckPc;
         batch.new_pc = new_pc;
+        avr->pc = slot_pc();
         goto out;
     }
 advance:
-    pc = new_pc;
-    if constexpr (kCover) edges->hit(pc);
-    if (remaining == 0) goto count_reached;
+    if constexpr (kCover) edges->hit(new_pc);
+    if (fuel <= 0) {
+        batch.ended = Ended::Count;
+        avr->pc = new_pc;
+        goto out;
+    }
     AVRBENCH_DISPATCH();
 timer_due:
     // avr->pc stays at the last instruction; Mcu finishes it (SimavrStepper::finish).
     batch.ended = Ended::TimerDue;
     batch.new_pc = new_pc;
-    goto out;
-count_reached:
-    batch.ended = Ended::Count;
+    avr->pc = slot_pc();
 out:
 #undef AVRBENCH_OP
 #undef AVRBENCH_CYCLE_BEFORE
+#undef AVRBENCH_PC
 #undef AVRBENCH_HAND_OVER
 #undef AVRBENCH_NEXT_CALLED
 #undef AVRBENCH_NEXT
 #undef AVRBENCH_DISPATCH
-    batch.steps = max_steps - remaining;
-    avr->pc = pc;
-    avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(budget);
+    batch.steps = steps;
+    avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(fuel + reserve);
     return batch;
 }
 #if defined(__GNUC__) && !defined(__clang__)

@@ -89,7 +89,7 @@ public:
         HandOver,  // in front of an instruction avr_run_one must execute (or a PC past the flash)
         TimerDue,  // the last instruction reached limits.cycle: avr->pc is still its PC, new_pc where it goes
         CheckPc,   // the last instruction's new PC or SP needs the crash oracles: avr->pc is still its PC
-        Count,     // max_steps executed
+        Count,     // max_steps executed, or fewer: the step limit is counted as cycles (one at least per instruction)
     };
     struct Batch {
         std::uint32_t steps = 0;
@@ -462,6 +462,7 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
     int cycle = 1;
     // The handlers' endings (PredecodedOps.inc).
 #define AVRBENCH_CYCLE_BEFORE cycle_before
+#define AVRBENCH_PC pc
 #define AVRBENCH_OP(kind) case kind:
 #define AVRBENCH_NEXT() goto plain
 #define AVRBENCH_NEXT_CALLED() goto called_simavr
@@ -476,6 +477,7 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
     }
 #undef AVRBENCH_OP
 #undef AVRBENCH_CYCLE_BEFORE
+#undef AVRBENCH_PC
 #undef AVRBENCH_NEXT
 #undef AVRBENCH_NEXT_CALLED
 #undef AVRBENCH_HAND_OVER

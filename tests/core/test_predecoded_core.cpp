@@ -234,9 +234,17 @@ TEST(PredecodedCore, BatchStopsWhereTheOraclesLimitsSayEvenWhenTheyChange) {
     EXPECT_EQ(b.ended, PredecodedCore::Ended::CheckPc);
     EXPECT_EQ(b.steps, 1u);  // the first NOP, whose next PC is __bad_interrupt
     EXPECT_EQ(b.new_pc, at + 2);
-    b = batch(~0u);  // no __bad_interrupt: the count ends it
+    // No __bad_interrupt: the step limit ends it, counted in cycles (each
+    // instruction takes at least one): 100 cycles are 25 passes of NOP,
+    // NOP, RJMP (1 + 1 + 2 cycles, ATmega328P datasheet's instruction set
+    // summary), 75 instructions. Mcu::run_until runs another batch for the
+    // other 25.
+    const avr_cycle_count_t cycle_before = avr->cycle;
+    b = batch(~0u);
     EXPECT_EQ(b.ended, PredecodedCore::Ended::Count);
-    EXPECT_EQ(b.steps, 100u);
+    EXPECT_EQ(b.steps, 75u);
+    EXPECT_EQ(avr->cycle - cycle_before, 100u);
+    EXPECT_EQ(avr->pc, at);
     b = batch(at + 4);
     EXPECT_EQ(b.ended, PredecodedCore::Ended::CheckPc);
     EXPECT_EQ(b.steps, 2u);
