@@ -16,16 +16,14 @@ extern "C" {
 #include <sim_avr.h>
 }
 
+#include "CpuTime.hpp"
 #include "boards/Board.hpp"
 #include "verify/Bench.hpp"
 
 namespace {
 
-double cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using avrbench_perf::median;
+using avrbench_perf::thread_cpu_seconds;
 
 struct Workload {
     const char* label;
@@ -49,14 +47,14 @@ struct Sample {
 };
 
 Sample run_untraced(const Workload& w, const std::string& fw, const std::string& src, bool skip, double seconds) {
-    const double start = cpu_seconds();
+    const double start = thread_cpu_seconds();
     auto board = avrbench::Board::from_file(src + "/bench/boards/" + w.board + ".yaml",
                                             {{w.mcu, fw + "/" + w.firmware + ".elf"}});
     avrbench::Mcu& mcu = board->mcu(w.mcu);
     mcu.set_skip_idle_loops(skip);
     board->run_for_seconds(seconds);
     Sample s;
-    s.cpu_s = cpu_seconds() - start;
+    s.cpu_s = thread_cpu_seconds() - start;
     mcu.settle_periodic_outputs();
     s.end.cycle = mcu.cycle();
     const avr_t* avr = mcu.avr();
@@ -82,11 +80,6 @@ bool same_events(const std::vector<avrbench::TimelineEvent>& a, const std::vecto
         if (a[i].cycle != b[i].cycle || a[i].signal != b[i].signal || a[i].value.bits != b[i].value.bits) return false;
     }
     return true;
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ extern "C" {
 #include <sim_elf.h>
 }
 
+#include "CpuTime.hpp"
 #include "boards/Board.hpp"
 #include "boards/BoardFile.hpp"
 #include "core/Adc.hpp"
@@ -61,11 +62,7 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using avrbench_perf::thread_cpu_seconds;
 
 // (a) bare simavr, as run_avr drives it, strict level polling off. Returns CPU seconds.
 __attribute__((noinline)) double run_bare_simavr(const avrbench::ElfImage& elf, avr_cycle_count_t cycles,
@@ -121,10 +118,7 @@ __attribute__((noinline)) double run_avrbench(const avrbench::ElfImage& elf, avr
     return thread_cpu_seconds() - start;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 == 1 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using avrbench_perf::median;
 
 // The thermal plant's overhead: one board run, from building the board to
 // tearing it down. The firmware must execute the same instructions on both

@@ -12,6 +12,7 @@
 #include <ctime>
 #include <string>
 
+#include "CpuTime.hpp"
 #include "boards/Board.hpp"
 #include "parts/HybridStepper.hpp"
 
@@ -19,11 +20,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using avrbench_perf::thread_cpu_seconds;
 
 struct Times {
     double wall, cpu;
@@ -51,13 +48,13 @@ avrbench::BoardSpec shield(const std::string& source_dir, bool with_motor) {
 Times run(const std::string& source_dir, const std::string& elf, bool with_motor, double simulated_s,
           std::uint64_t* rk4_steps) {
     const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
+    const double cpu_start = thread_cpu_seconds();
     {
         avrbench::Board board(shield(source_dir, with_motor), {{"uno", elf}});
         board.run_until_seconds(simulated_s);
         if (with_motor) *rk4_steps = board.part_as<avrbench::HybridStepper>("motor").model().rk4_steps();
     }
-    return {std::chrono::duration<double>(Clock::now() - start).count(), cpu_seconds() - cpu_start};
+    return {std::chrono::duration<double>(Clock::now() - start).count(), thread_cpu_seconds() - cpu_start};
 }
 
 }  // namespace

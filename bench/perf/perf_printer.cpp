@@ -26,16 +26,13 @@
 #include <sstream>
 #include <string>
 
+#include "CpuTime.hpp"
 #include "boards/Board.hpp"
 #include "verify/Bench.hpp"
 
 namespace {
 
-double cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
+using avrbench_perf::thread_cpu_seconds;
 
 std::string read_job(const std::string& path, bool drop_homing) {
     std::ifstream in(path);
@@ -55,7 +52,7 @@ struct Sample {
 // What a run cost since `start_cpu_s`, how far it went, and its MCUs' steps.
 Sample sample_of(avrbench::Bench& bench, double start_cpu_s) {
     Sample s;
-    s.cpu_s = cpu_seconds() - start_cpu_s;
+    s.cpu_s = thread_cpu_seconds() - start_cpu_s;
     s.simulated_s = bench.now_seconds();
     for (const avrbench::Mcu* m : bench.board().mcus()) s.avr_instructions += m->steps();
     return s;
@@ -69,7 +66,7 @@ std::string job_text(const std::string& src, Job job) {
 }
 
 Sample run_printer(const std::string& fw, const std::string& src, Job job, bool lookahead) {
-    const double start = cpu_seconds();
+    const double start = thread_cpu_seconds();
     avrbench::Bench bench(src + "/bench/boards/printer3d-seed001.yaml",
                           {{"interp", fw + "/printer3d_interp.elf"},
                            {"drive_x", fw + "/printer3d_drive.elf"},
@@ -95,7 +92,7 @@ nets:
 )";
 
 Sample run_interp_alone(const std::string& fw, const std::string& src) {
-    const double start = cpu_seconds();
+    const double start = thread_cpu_seconds();
     avrbench::Bench bench(avrbench::parse_board_text(kBareMega, "bare-mega.yaml"),
                           {{"interp", fw + "/printer3d_interp.elf"}});
     bench.host().add_lines(read_job(src + "/examples/printer3d/seed001_part.gcode", true));
