@@ -344,7 +344,8 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // reserve). When the fuel is out but not the budget, the batch ends
     // with Ended::Count, perhaps before max_steps, and Mcu::run_until runs
     // another. So one counter and one test per instruction.
-    avr_flashaddr_t new_pc = avr->pc;
+    // (64-bit: it indexes the slots and flash with no zero-extension first.)
+    std::size_t new_pc = avr->pc;
     avr_cycle_count_t cycle_limit = limits.cycle;
     std::uint32_t steps = 0;
     std::int64_t fuel;
@@ -364,7 +365,7 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
 
 #define AVRBENCH_DISPATCH()                                                                       \
     do {                                                                                          \
-        slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + std::size_t{new_pc} * 8); \
+        slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + new_pc * 8); \
         if (__builtin_expect(slot->word != flash16(m.flash, new_pc), 0)) goto decode_slot;        \
         new_pc += 2;                                                                              \
         cycle = 1;                                                                                \
@@ -379,7 +380,7 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         fuel -= cycle;                                                                            \
         if (__builtin_expect(fuel <= 0, 0)) goto out_of_fuel;                                     \
         if (__builtin_expect(slot->check != 0, 0)) goto check_oracles;                            \
-        if constexpr (kCover) edges->hit(new_pc);                                                 \
+        if constexpr (kCover) edges->hit(static_cast<std::uint32_t>(new_pc));                     \
         AVRBENCH_DISPATCH();                                                                      \
     } while (0)
 #define AVRBENCH_NEXT_CALLED() goto after_callbacks
@@ -441,22 +442,22 @@ check_oracles:
     if (new_pc - 1 >= cold.code_end_minus_one || new_pc == cold.bad_interrupt_pc ||
         ((slot->flags & kMovesSp) && sp_of(data) < cold.stack_floor)) {
         batch.ended = Ended::CheckPc;
-        batch.new_pc = new_pc;
+        batch.new_pc = static_cast<avr_flashaddr_t>(new_pc);
         avr->pc = slot_pc();
         goto out;
     }
 advance:
-    if constexpr (kCover) edges->hit(new_pc);
+    if constexpr (kCover) edges->hit(static_cast<std::uint32_t>(new_pc));
     if (fuel <= 0) {
         batch.ended = Ended::Count;
-        avr->pc = new_pc;
+        avr->pc = static_cast<avr_flashaddr_t>(new_pc);
         goto out;
     }
     AVRBENCH_DISPATCH();
 timer_due:
     // avr->pc stays at the last instruction; Mcu finishes it (SimavrStepper::finish).
     batch.ended = Ended::TimerDue;
-    batch.new_pc = new_pc;
+    batch.new_pc = static_cast<avr_flashaddr_t>(new_pc);
     avr->pc = slot_pc();
 out:
 #undef AVRBENCH_OP

@@ -206,7 +206,7 @@ struct Machine {
     int address_size() const { return avr->address_size; }
 };
 
-__attribute__((always_inline)) inline std::uint16_t flash16(const std::uint8_t* flash, avr_flashaddr_t addr) {
+__attribute__((always_inline)) inline std::uint16_t flash16(const std::uint8_t* flash, std::size_t addr) {
 #if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     std::uint16_t word;  // one load: flash is little-endian, like this host
     std::memcpy(&word, flash + addr, sizeof word);
@@ -217,7 +217,7 @@ __attribute__((always_inline)) inline std::uint16_t flash16(const std::uint8_t* 
 }
 
 // _avr_is_instruction_32_bits (sim_core.c).
-__attribute__((always_inline)) inline bool is_32_bit(const std::uint8_t* flash, avr_flashaddr_t pc) {
+__attribute__((always_inline)) inline bool is_32_bit(const std::uint8_t* flash, std::size_t pc) {
     const std::uint16_t o = flash16(flash, pc) & 0xfc0f;
     return o == 0x9200 || o == 0x9000 || o == 0x940c || o == 0x940d || o == 0x940e || o == 0x940f;
 }
