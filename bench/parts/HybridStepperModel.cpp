@@ -76,11 +76,12 @@ HybridStepperModel::Modes HybridStepperModel::choose_modes(const State& x) const
     return modes;
 }
 
-HybridStepperModel::State HybridStepperModel::derivative(const State& x, const Modes& modes) const {
+HybridStepperModel::State HybridStepperModel::derivative(const State& x, const Modes& modes, bool at_state) const {
     State dx = State::Zero();
     const double omega = x[kMaxWindings];
     double s = 0, c = 0;
-    sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
+    if (at_state) sin_cos(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
+    else sin_cos_uncached(params_.rotor_teeth * x[kMaxWindings + 1], s, c);
     const double g[2] = {-s, c};
     const double r = params_.resistance_ohm;
     double torque_sum = 0;
@@ -107,7 +108,7 @@ HybridStepperModel::State HybridStepperModel::derivative(const State& x, const M
     // sin(4e) from sin(e), cos(e): sin 2e = 2sc, cos 2e = c^2 - s^2.
     const double sin4 = 2.0 * (2.0 * s * c) * (c * c - s * s);
     const double torque = params_.torque_constant_nm_per_a * torque_sum - params_.detent_torque_nm * sin4 -
-                          params_.viscous_nm_s_per_rad * omega - params_.coulomb_nm * std::tanh(omega / params_.coulomb_speed_rad_s) -
+                          params_.viscous_nm_s_per_rad * omega - params_.coulomb_nm * friction_shape(omega, at_state) -
                           params_.load_torque_nm;
     dx[kMaxWindings] = torque * inv_j_;
     dx[kMaxWindings + 1] = omega;
@@ -115,10 +116,10 @@ HybridStepperModel::State HybridStepperModel::derivative(const State& x, const M
 }
 
 HybridStepperModel::State HybridStepperModel::rk4(const State& x, double h, const Modes& modes) const {
-    const State k1 = derivative(x, modes);
-    const State k2 = derivative(x + 0.5 * h * k1, modes);
-    const State k3 = derivative(x + 0.5 * h * k2, modes);
-    const State k4 = derivative(x + h * k3, modes);
+    const State k1 = derivative(x, modes, true);
+    const State k2 = derivative(x + 0.5 * h * k1, modes, false);
+    const State k3 = derivative(x + 0.5 * h * k2, modes, false);
+    const State k4 = derivative(x + h * k3, modes, false);
     return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
 }
 
@@ -248,8 +249,15 @@ void HybridStepperModel::advance(double seconds) {
 }
 
 void HybridStepperModel::check_settled() {
+    // A turning rotor is not settled, whatever its acceleration (the test
+    // below, without working the derivative out: most checks are made while
+    // the motor moves).
+    if (!(std::abs(x_[kMaxWindings]) < 1e-7)) {
+        settled_ = false;
+        return;
+    }
     const Modes modes = choose_modes(x_);
-    const State dx = derivative(x_, modes);
+    const State dx = derivative(x_, modes, true);
     // Nothing will move: the rotor at rest without acceleration, every current
     // within 1 nA of its end value (|di/dt| * L/R).
     const double tau = params_.inductance_h / params_.resistance_ohm;

@@ -101,7 +101,11 @@ private:
     using Modes = std::array<Mode, kMaxWindings>;
 
     Modes choose_modes(const State& x) const;
-    State derivative(const State& x, const Modes& modes) const;
+    // dx/dt at x. `at_state`: x is a state the model stops at (x_, a step's
+    // end, a located event), whose sin, cos and friction term are asked for
+    // again by the mode choice, the events and the settled check; an RK4
+    // stage point is not, and must not push them out of the cache.
+    State derivative(const State& x, const Modes& modes, bool at_state) const;
     State rk4(const State& x, double h, const Modes& modes) const;
     double event_value(const State& x, std::size_t winding, Mode mode) const;
     Mode conducting_mode(const State& x, std::size_t winding) const;
@@ -109,13 +113,13 @@ private:
     // a winding current reached zero).
     double step(double h);
     void check_settled();
-    // sin and cos of the electrical angle `e`, remembered for the last angle:
-    // a step's mode choice and first RK4 stage, and the settled check after
-    // it, all ask at the same state (the same values as computing them anew).
+    // sin and cos of the electrical angle `e`, remembered for the last state
+    // asked: a step's mode choice and first RK4 stage, its events and the
+    // settled check after it all ask at the same state (the same values as
+    // computing them anew: one function, one argument).
     void sin_cos(double e, double& s, double& c) const {
         if (e != trig_angle_) {
-            s = std::sin(e);
-            c = std::cos(e);
+            sin_cos_uncached(e, s, c);
             trig_angle_ = e;
             trig_sin_ = s;
             trig_cos_ = c;
@@ -123,6 +127,19 @@ private:
         }
         s = trig_sin_;
         c = trig_cos_;
+    }
+    static void sin_cos_uncached(double e, double& s, double& c) {
+        s = std::sin(e);
+        c = std::cos(e);
+    }
+    // The Coulomb friction's tanh at speed `omega` (rad/s), remembered like sin_cos.
+    double friction_shape(double omega, bool at_state) const {
+        if (!at_state) return std::tanh(omega / params_.coulomb_speed_rad_s);
+        if (omega != friction_omega_) {
+            friction_omega_ = omega;
+            friction_tanh_ = std::tanh(omega / params_.coulomb_speed_rad_s);
+        }
+        return friction_tanh_;
     }
 
     Params params_;
@@ -134,6 +151,7 @@ private:
     std::uint64_t rk4_steps_ = 0;
     std::uint64_t zero_crossings_ = 0;
     mutable double trig_angle_ = std::numeric_limits<double>::quiet_NaN(), trig_sin_ = 0, trig_cos_ = 0;  // sin_cos
+    mutable double friction_omega_ = std::numeric_limits<double>::quiet_NaN(), friction_tanh_ = 0;        // friction_shape
 };
 
 }  // namespace avrbench
