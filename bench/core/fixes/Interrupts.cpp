@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstring>
 #include <mutex>
 #include <string_view>
@@ -155,12 +156,16 @@ std::vector<SleepListener>& sleep_listeners() {
     static std::vector<SleepListener> v;
     return v;
 }
+// Bumped on every change of the list (under the mutex): a thread's copy of
+// one MCU's listeners stays good while it is unchanged.
+std::atomic<std::uint64_t> sleep_listeners_generation{1};
 
 }  // namespace
 
 void add_sleep_entry_listener(avr_t* avr, SleepEntryListener fn, void* context) {
     std::lock_guard<std::mutex> lock(sleep_listeners_mutex);
     sleep_listeners().push_back({avr, fn, context});
+    sleep_listeners_generation.fetch_add(1, std::memory_order_release);
 }
 
 void remove_sleep_entry_listener(avr_t* avr, void* context) {
@@ -168,34 +173,44 @@ void remove_sleep_entry_listener(avr_t* avr, void* context) {
     auto& v = sleep_listeners();
     v.erase(std::remove_if(v.begin(), v.end(), [&](const SleepListener& l) { return l.avr == avr && l.context == context; }),
             v.end());
+    sleep_listeners_generation.fetch_add(1, std::memory_order_release);
 }
 
 avr_cycle_count_t notify_sleep_entry(avr_t* avr, std::uint8_t mode) {
-    // This MCU's listeners copied out (a listener may add or remove one while
-    // it runs, and the lock is not held across the calls) into a buffer on
-    // the stack: a sleep entry allocates nothing. An MCU has a handful.
-    constexpr std::size_t kInPlace = 8;
-    std::array<SleepListener, kInPlace> mine;
-    std::vector<SleepListener> more;  // only past kInPlace (never in our boards)
-    std::size_t count = 0;
-    {
+    // This MCU's listeners, copied out under the lock once per change of the
+    // list and kept per thread (a core sleeps ~10^5 times a simulated
+    // second on the five-MCU board: no lock, no scan of the other MCUs'
+    // listeners per sleep).
+    thread_local const avr_t* cached_avr = nullptr;
+    thread_local std::uint64_t cached_generation = 0;
+    thread_local std::vector<SleepListener> mine;
+    const std::uint64_t generation = sleep_listeners_generation.load(std::memory_order_acquire);
+    if (avr != cached_avr || generation != cached_generation) {
         std::lock_guard<std::mutex> lock(sleep_listeners_mutex);
+        mine.clear();
         for (const auto& l : sleep_listeners()) {
-            if (l.avr != avr) continue;
-            if (count < kInPlace) {
-                mine[count++] = l;
-            } else {
-                more.push_back(l);
-            }
+            if (l.avr == avr) mine.push_back(l);
         }
+        cached_avr = avr;
+        cached_generation = sleep_listeners_generation.load(std::memory_order_relaxed);
     }
     avr_cycle_count_t earliest = 0;
     const auto call = [&](const SleepListener& l) {
         const avr_cycle_count_t at = l.fn(l.context, avr, mode);
         if (at != 0 && (earliest == 0 || at < earliest)) earliest = at;
     };
-    for (std::size_t i = 0; i < count; ++i) call(mine[i]);
-    for (const auto& l : more) call(l);
+    // The calls run on a copy on the stack: a listener may add or remove one,
+    // or make another MCU sleep (which refills `mine`). An MCU has a handful.
+    constexpr std::size_t kInPlace = 8;
+    if (mine.size() > kInPlace) {
+        const std::vector<SleepListener> calling = mine;  // never in our boards
+        for (const auto& l : calling) call(l);
+        return earliest;
+    }
+    std::array<SleepListener, kInPlace> calling;
+    const std::size_t count = mine.size();
+    std::copy(mine.begin(), mine.end(), calling.begin());
+    for (std::size_t i = 0; i < count; ++i) call(calling[i]);
     return earliest;
 }
 
