@@ -556,7 +556,7 @@ int perf_main(int argc, char** argv) {
     bool only_printer = false;
     app.add_flag("--printer", only_printer, "only seed 001's five-MCU printer (lookahead, strict, one MCU, the CLI)");
     bool no_strict = false;
-    app.add_flag("--no-strict", no_strict, "with --printer: leave out the strict-lockstep row (about a minute a run)");
+    app.add_flag("--no-strict", no_strict, "with --printer: leave out the strict-lockstep row (about two minutes a run)");
     bool printer_part_once = false;
     app.add_flag("--printer-part-once", printer_part_once, "the printer's part job once, lookahead (for callgrind)");
     bool only_mips = false;
