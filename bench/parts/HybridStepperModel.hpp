@@ -33,6 +33,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <cstdint>
@@ -118,7 +119,8 @@ private:
     // settled check after it all ask at the same state (the same values as
     // computing them anew: one function, one argument).
     void sin_cos(double e, double& s, double& c) const {
-        if (e != trig_angle_) {
+        // Compared bit for bit: -0.0 == +0.0, but their sines differ in sign.
+        if (std::bit_cast<std::uint64_t>(e) != std::bit_cast<std::uint64_t>(trig_angle_)) {
             sin_cos_uncached(e, s, c);
             trig_angle_ = e;
             trig_sin_ = s;
@@ -135,7 +137,7 @@ private:
     // The Coulomb friction's tanh at speed `omega` (rad/s), remembered like sin_cos.
     double friction_shape(double omega, bool at_state) const {
         if (!at_state) return std::tanh(omega / params_.coulomb_speed_rad_s);
-        if (omega != friction_omega_) {
+        if (std::bit_cast<std::uint64_t>(omega) != std::bit_cast<std::uint64_t>(friction_omega_)) {
             friction_omega_ = omega;
             friction_tanh_ = std::tanh(omega / params_.coulomb_speed_rad_s);
         }
@@ -150,8 +152,10 @@ private:
     bool settled_ = false;
     std::uint64_t rk4_steps_ = 0;
     std::uint64_t zero_crossings_ = 0;
-    mutable double trig_angle_ = std::numeric_limits<double>::quiet_NaN(), trig_sin_ = 0, trig_cos_ = 0;  // sin_cos
-    mutable double friction_omega_ = std::numeric_limits<double>::quiet_NaN(), friction_tanh_ = 0;        // friction_shape
+    // The caches start at NaN, their values too: sin, cos and tanh of NaN.
+    static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    mutable double trig_angle_ = kNaN, trig_sin_ = kNaN, trig_cos_ = kNaN;  // sin_cos
+    mutable double friction_omega_ = kNaN, friction_tanh_ = kNaN;           // friction_shape
 };
 
 }  // namespace avrbench
