@@ -408,6 +408,92 @@ __attribute__((always_inline)) inline void flags_sub(std::uint8_t* s, std::uint8
     }
     s[S_S] = n ^ v;
 }
+
+// ADD, ADC, SUB, SBC (and their immediate and compare forms) as one
+// operation each, returning the 8-bit result and setting C, Z, N, V, S, H.
+#if defined(__x86_64__) && defined(__GNUC__)
+// On x86-64 the host's own ADD/ADC/SUB/SBB compute the flags: CF is the
+// carry (borrow) out of bit 7, AF out of bit 3, ZF a zero result, SF its
+// bit 7 and OF a signed overflow (Intel SDM vol. 1, 3.4.3.1 and appendix
+// A) - AVR's C, H, Z, N and V for ADD/ADC/SUB/SBC/CP/CPC (AVR Instruction
+// Set Manual, each instruction's "Status Register" equations, which are
+// these carries and overflows written as bit formulas; core_sweep checks
+// every operand pair against avr_run_one). LAHF puts SF:ZF:0:AF:0:PF:1:CF
+// into AH (SDM vol. 2), SETO the overflow; the table turns those nine bits
+// into SREG's byte-per-flag form (simavr's avr->sreg[8]: C Z N V S H T I),
+// stored as the six bytes C..H - about half the host instructions of the
+// bit formulas above.
+struct SregBytesFromX86Flags {
+    std::uint64_t bytes[512];  // index: OF << 8 | AH after LAHF
+    constexpr SregBytesFromX86Flags() : bytes{} {
+        for (unsigned index = 0; index < 512; ++index) {
+            const std::uint64_t c = index & 1u, z = (index >> 6) & 1u, n = (index >> 7) & 1u;
+            const std::uint64_t h = (index >> 4) & 1u, v = (index >> 8) & 1u;
+            bytes[index] = c << (8 * S_C) | z << (8 * S_Z) | n << (8 * S_N) | v << (8 * S_V) | (n ^ v) << (8 * S_S) | h << (8 * S_H);
+        }
+    }
+};
+inline constexpr SregBytesFromX86Flags kSregBytesFromX86Flags{};
+
+__attribute__((always_inline)) inline void store_sreg_c_to_h(std::uint8_t* s, std::uint32_t ah, std::uint8_t of) {
+    const std::uint64_t bytes = kSregBytesFromX86Flags.bytes[(ah & 0xFFu) | (std::uint32_t{of} << 8)];
+    const std::uint32_t c_z_n_v = static_cast<std::uint32_t>(bytes);
+    const std::uint16_t s_h = static_cast<std::uint16_t>(bytes >> 32);
+    static_assert(S_C == 0 && S_Z == 1 && S_N == 2 && S_V == 3 && S_S == 4 && S_H == 5);
+    std::memcpy(s, &c_z_n_v, 4);
+    std::memcpy(s + 4, &s_h, 2);  // T and I (bytes 6, 7) untouched
+}
+
+// kCarryIn: ADC/SBC/SBCI/CPC (the carry from SREG's C).
+template <bool kCarryIn>
+__attribute__((always_inline)) inline std::uint8_t add8(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr) {
+    std::uint8_t res = rd;
+    std::uint32_t ax;
+    std::uint8_t of;
+    if constexpr (kCarryIn) {
+        __asm__("btl $0, %k[c]\n\tadcb %[rr], %[res]\n\tlahf\n\tseto %[of]"
+                : [res] "+q"(res), "=a"(ax), [of] "=q"(of)
+                : [rr] "q"(rr), [c] "r"(std::uint32_t{s[S_C]})
+                : "cc");
+    } else {
+        __asm__("addb %[rr], %[res]\n\tlahf\n\tseto %[of]" : [res] "+q"(res), "=a"(ax), [of] "=q"(of) : [rr] "q"(rr) : "cc");
+    }
+    store_sreg_c_to_h(s, ax >> 8, of);
+    return res;
+}
+template <bool kCarryIn, ZeroFlag kZ>
+__attribute__((always_inline)) inline std::uint8_t sub8(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr) {
+    std::uint8_t res = rd;
+    std::uint32_t ax;
+    std::uint8_t of;
+    const std::uint8_t z_before = s[S_Z];
+    if constexpr (kCarryIn) {
+        __asm__("btl $0, %k[c]\n\tsbbb %[rr], %[res]\n\tlahf\n\tseto %[of]"
+                : [res] "+q"(res), "=a"(ax), [of] "=q"(of)
+                : [rr] "q"(rr), [c] "r"(std::uint32_t{s[S_C]})
+                : "cc");
+    } else {
+        __asm__("subb %[rr], %[res]\n\tlahf\n\tseto %[of]" : [res] "+q"(res), "=a"(ax), [of] "=q"(of) : [rr] "q"(rr) : "cc");
+    }
+    store_sreg_c_to_h(s, ax >> 8, of);
+    if constexpr (kZ == kKeepZ) s[S_Z] &= z_before;
+    return res;
+}
+#else
+template <bool kCarryIn>
+__attribute__((always_inline)) inline std::uint8_t add8(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr) {
+    const unsigned sum = rd + rr + (kCarryIn ? s[S_C] : 0u);
+    flags_add(s, rd, rr, sum);
+    return static_cast<std::uint8_t>(sum);
+}
+template <bool kCarryIn, ZeroFlag kZ>
+__attribute__((always_inline)) inline std::uint8_t sub8(std::uint8_t* s, std::uint8_t rd, std::uint8_t rr) {
+    const int diff = rd - rr - (kCarryIn ? s[S_C] : 0);
+    flags_sub<kZ>(s, rd, rr, diff);
+    return static_cast<std::uint8_t>(diff);
+}
+#endif
+
 __attribute__((always_inline)) inline void flags_zcvs(std::uint8_t* s, std::uint8_t res, std::uint8_t vr) {
     s[S_Z] = res == 0;
     s[S_C] = vr & 1;
