@@ -62,6 +62,7 @@ PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint1
             break;
     }
     s.check = check ? 1 : 0;
+    s.handler = static_cast<std::uint8_t>(s.kind + (check ? kKinds : 0));
     return s;
 }
 
@@ -311,8 +312,15 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         std::memset(static_cast<void*>(slots_.get()), 0, slot_count_ * sizeof(Slot));
         *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc};
     }
-    static const void* const kHandlers[kKinds] = {
+    // Each handler twice: as is, and (from kKinds on) a copy that tests the
+    // crash oracles after it - the slot's `handler` picks one, so the
+    // dispatch after the many slots that cannot trip them (`check` 0) tests
+    // nothing.
+    static const void* const kHandlers[2 * kKinds] = {
 #define AVRBENCH_HANDLER_ADDRESS(kind) &&op_##kind,
+        AVRBENCH_PREDECODED_KINDS(AVRBENCH_HANDLER_ADDRESS)
+#undef AVRBENCH_HANDLER_ADDRESS
+#define AVRBENCH_HANDLER_ADDRESS(kind) &&checked_##kind,
         AVRBENCH_PREDECODED_KINDS(AVRBENCH_HANDLER_ADDRESS)
 #undef AVRBENCH_HANDLER_ADDRESS
     };
@@ -369,17 +377,17 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         if (__builtin_expect(slot->word != flash16(m.flash, new_pc), 0)) goto decode_slot;        \
         new_pc += 2;                                                                              \
         cycle = 1;                                                                                \
-        goto* kHandlers[slot->kind];                                                              \
+        goto* kHandlers[slot->handler];                                                           \
     } while (0)
     // What Mcu::run_until's fast path checks after an instruction, then the
-    // next one: the first cycle timer due or the step count (the fuel), the
-    // crash oracles (only after the slots that can trip them).
+    // next one: the first cycle timer due or the step count (the fuel), and
+    // in the handlers' checked copy the crash oracles.
 #define AVRBENCH_NEXT()                                                                           \
     do {                                                                                          \
         ++steps;                                                                                  \
         fuel -= cycle;                                                                            \
         if (__builtin_expect(fuel <= 0, 0)) goto out_of_fuel;                                     \
-        if (__builtin_expect(slot->check != 0, 0)) goto check_oracles;                            \
+        if constexpr (AVRBENCH_CHECKED) goto check_oracles;                                       \
         if constexpr (kCover) edges->hit(static_cast<std::uint32_t>(new_pc));                     \
         AVRBENCH_DISPATCH();                                                                      \
     } while (0)
@@ -397,10 +405,24 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         [[maybe_unused]] const std::uint8_t b = slot->b;
 
     AVRBENCH_DISPATCH();
+#define AVRBENCH_CHECKED false
     {
 #include "core/PredecodedOps.inc"
     }
-op_kUndecoded:  // a calloc'd slot, whose word 0 matched a NOP in flash
+#undef AVRBENCH_CHECKED
+#undef AVRBENCH_OP
+#define AVRBENCH_OP(kind)                                    \
+    }                                                        \
+    checked_##kind : {                                       \
+        [[maybe_unused]] const std::uint8_t a = slot->a;     \
+        [[maybe_unused]] const std::uint8_t b = slot->b;
+#define AVRBENCH_CHECKED true
+    {
+#include "core/PredecodedOps.inc"
+    }
+#undef AVRBENCH_CHECKED
+op_kUndecoded:
+checked_kUndecoded:  // a calloc'd slot, whose word 0 matched a NOP in flash
 decode_slot : {
     // From the dispatch's opcode check, or from a calloc'd slot's handler
     // (new_pc already past it): the slot's own PC either way.
@@ -408,9 +430,10 @@ decode_slot : {
     slots[pc >> 1] = cold.core->decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
     new_pc = pc + 2;
     cycle = 1;
-    goto* kHandlers[slot->kind];
+    goto* kHandlers[slot->handler];
 }
 op_kSimavr:
+checked_kSimavr:
 hand_over:
     batch.ended = Ended::HandOver;
     avr->pc = slot_pc();

@@ -115,6 +115,7 @@ public:
 #undef AVRBENCH_KIND_ENUMERATOR
         kKinds
     };
+    static_assert(2 * kKinds <= 256, "Slot::handler indexes both copies of the handlers in one byte");
 
     struct Slot {
         std::uint16_t word;     // the opcode this slot was decoded from
@@ -126,7 +127,8 @@ public:
         std::uint8_t check;     // nonzero: after it, run_batch must test the crash oracles
         std::uint32_t target;   // RJMP/RCALL/branch: the new PC in bytes; LDS/STS: the data address
         std::uint16_t word2;    // LDS/STS: the second word `target` was decoded from
-        std::uint16_t unused;
+        std::uint8_t handler;   // run_batch's handler: `kind`, plus kKinds when `check` (its checked copy)
+        std::uint8_t unused;
     };
     // 16 bytes: a slot's address is the flash byte address times 8.
     static_assert(sizeof(Slot) == 16);
