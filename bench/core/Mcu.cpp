@@ -254,6 +254,7 @@ Mcu::~Mcu() {
     twi_.reset();
     scheduler_.reset();
     fixes_.reset();  // the fixes unhook themselves from the core: before it is freed
+    predecoded_.reset();  // likewise (its flash watch is one of the core's I/O modules)
     if (avr_ != nullptr) {
         avr_cycle_timer_cancel(avr_, &horizon_timer, this);
         route_simavr_log(avr_, nullptr);
@@ -302,6 +303,9 @@ void Mcu::set_predecoded_core(bool on) {
     } else if (!predecoded_) {
         predecoded_ = make_predecoded_core();
     }
+}
+void Mcu::flash_written(std::uint32_t begin_bytes, std::uint32_t end_bytes) {
+    if (predecoded_) predecoded_->flash_written(begin_bytes, end_bytes);
 }
 std::uint64_t Mcu::idle_jumps() const { return skipper_ ? skipper_->jumps() : 0; }
 std::uint64_t Mcu::idle_cycles_skipped() const { return skipper_ ? skipper_->cycles_skipped() : 0; }

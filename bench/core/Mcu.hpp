@@ -228,6 +228,9 @@ public:
     void set_skip_idle_loops(bool on);
     // McuOptions::predecoded_core after construction (not during a run).
     void set_predecoded_core(bool on);
+    // Flash bytes [begin, end) were written from outside the firmware (a
+    // debugger): the predecoded core decodes them again. SPM needs no call.
+    void flash_written(std::uint32_t begin_bytes, std::uint32_t end_bytes);
     // Idle-loop jumps taken and the cycles they covered (core/IdleLoopSkip.hpp).
     std::uint64_t idle_jumps() const;
     std::uint64_t idle_cycles_skipped() const;

@@ -1,7 +1,13 @@
 #include "core/PredecodedCore.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <new>
+
+extern "C" {
+#include <avr_flash.h>
+}
 
 #include "core/Mcu.hpp"
 #include "core/ProcessHeap.hpp"
@@ -23,20 +29,63 @@ avr_io_read_t find_port_read(const avr_t* avr) {
 }
 }  // namespace
 
-PredecodedCore::PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc) {
+PredecodedCore::PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc) : avr_(avr) {
     // One slot per flash word; calloc leaves untouched pages unmapped and
     // zero is kUndecoded, so only the code that runs costs memory.
     slot_count_ = static_cast<std::size_t>(avr->flashend) / 2 + 2;
-    // A cache of what flash says (each slot is checked against its flash
-    // word on every fetch), so a fuzz target that restores its board
-    // (core/ProcessHeap.hpp) keeps it on the process's heap: what one input
-    // decoded, the next need not decode again.
+    // A cache of what flash says (run_one checks each slot against its
+    // flash word; run_batch counts on every flash write invalidating the
+    // slots there, and on flash_written_ after a restore), so a fuzz target
+    // that restores its board (core/ProcessHeap.hpp) keeps it on the
+    // process's heap: what one input decoded, the next need not decode again.
     const OnProcessHeap cache_outlives_restores;
     slots_.reset(static_cast<Slot*>(std::calloc(slot_count_, sizeof(Slot))));
     checked_for_.reset(static_cast<CheckedFor*>(std::malloc(sizeof(CheckedFor))));
     if (!slots_ || !checked_for_) throw std::bad_alloc();
-    *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc};
+    *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc, flash_written_};
     port_read_ = find_port_read(avr);
+    flash_watch_.io.kind = "predecoded-core";
+    flash_watch_.io.ioctl = &PredecodedCore::on_ioctl;
+    flash_watch_.io.avr = avr;
+    flash_watch_.io.next = avr->io_port;
+    flash_watch_.core = this;
+    avr->io_port = &flash_watch_.io;
+}
+
+PredecodedCore::~PredecodedCore() {
+    for (avr_io_t** link = &avr_->io_port; *link != nullptr; link = &(*link)->next) {
+        if (*link == &flash_watch_.io) {
+            *link = flash_watch_.io.next;
+            break;
+        }
+    }
+}
+
+int PredecodedCore::on_ioctl(avr_io_t* io, std::uint32_t ctl, void*) {
+    if (ctl == AVR_IOCTL_FLASH_SPM) {
+        // The page avr_flash_ioctl may erase or write: Z (with RAMPZ) cut
+        // down to its page. Pages are 64 to 256 bytes on the AVRs simavr
+        // has (SPM_PAGESIZE); 512 covers any of them.
+        const avr_t* avr = io->avr;
+        avr_flashaddr_t z = avr->data[R_ZL] | (avr->data[R_ZH] << 8);
+        if (avr->rampz) z |= static_cast<avr_flashaddr_t>(avr->data[avr->rampz]) << 16;
+        constexpr avr_flashaddr_t kPageBytesAtMost = 512;
+        const avr_flashaddr_t page = z & ~(kPageBytesAtMost - 1);
+        reinterpret_cast<FlashWatch*>(io)->core->invalidate(page, page + kPageBytesAtMost);
+    }
+    return -1;  // not answered: the flash module does the SPM
+}
+
+void PredecodedCore::flash_written(avr_flashaddr_t begin, avr_flashaddr_t end) { invalidate(begin, end); }
+
+void PredecodedCore::invalidate(avr_flashaddr_t begin, avr_flashaddr_t end) {
+    static std::atomic<std::uint64_t> writes_in_process{0};
+    flash_written_ = ++writes_in_process;
+    checked_for_->flash_written = flash_written_;
+    // From the word before: an LDS or STS there holds the next word.
+    const std::size_t first = begin >= 2 ? (begin - 2) / 2 : 0;
+    const std::size_t last = std::min<std::size_t>((static_cast<std::size_t>(end) + 1) / 2, slot_count_);
+    if (first < last) std::memset(static_cast<void*>(slots_.get() + first), 0, (last - first) * sizeof(Slot));
 }
 
 PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc) const {
@@ -306,11 +355,14 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         batch.ended = Ended::Count;
         return batch;
     }
-    if (checked_for_->code_end_minus_one != limits.code_end_minus_one || checked_for_->bad_interrupt_pc != limits.bad_interrupt_pc) {
+    if (checked_for_->code_end_minus_one != limits.code_end_minus_one || checked_for_->bad_interrupt_pc != limits.bad_interrupt_pc ||
+        checked_for_->flash_written != flash_written_) {
         // Other oracle limits (a boot loader wrote another application):
-        // every slot is decoded again, with its `check` for these.
+        // every slot is decoded again, with its `check` for these. Or a
+        // fuzz target restored its board: the slots may hold what an input
+        // wrote to flash.
         std::memset(static_cast<void*>(slots_.get()), 0, slot_count_ * sizeof(Slot));
-        *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc};
+        *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc, flash_written_};
     }
     // Each handler twice: as is, and (from kKinds on) a copy that tests the
     // crash oracles after it - the slot's `handler` picks one, so the
@@ -374,7 +426,6 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
 #define AVRBENCH_DISPATCH()                                                                       \
     do {                                                                                          \
         slot = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + new_pc * 8); \
-        if (__builtin_expect(slot->word != flash16(m.flash, new_pc), 0)) goto decode_slot;        \
         new_pc += 2;                                                                              \
         cycle = 1;                                                                                \
         goto* kHandlers[slot->handler];                                                           \
@@ -395,6 +446,8 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
 #define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(fuel + reserve))
 #define AVRBENCH_PC slot_pc()
 #define AVRBENCH_HAND_OVER() goto hand_over
+    // Every flash write invalidates the slot before the word it writes.
+#define AVRBENCH_WORD2_HOLDS() true
     // Each handler is a block with the slot's operands; it begins by
     // closing the one before (which never falls through: every handler
     // ends in a jump), so they are not live across the dispatch.
@@ -421,11 +474,10 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
 #include "core/PredecodedOps.inc"
     }
 #undef AVRBENCH_CHECKED
-op_kUndecoded:
-checked_kUndecoded:  // a calloc'd slot, whose word 0 matched a NOP in flash
-decode_slot : {
-    // From the dispatch's opcode check, or from a calloc'd slot's handler
-    // (new_pc already past it): the slot's own PC either way.
+op_kUndecoded:  // a slot not decoded yet (calloc'd, or invalidated by a flash write)
+checked_kUndecoded:
+{
+    // new_pc already past it: the slot's own PC.
     const avr_flashaddr_t pc = slot_pc();
     slots[pc >> 1] = cold.core->decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
     new_pc = pc + 2;
@@ -487,6 +539,7 @@ out:
 #undef AVRBENCH_CYCLE_BEFORE
 #undef AVRBENCH_PC
 #undef AVRBENCH_HAND_OVER
+#undef AVRBENCH_WORD2_HOLDS
 #undef AVRBENCH_NEXT_CALLED
 #undef AVRBENCH_NEXT
 #undef AVRBENCH_DISPATCH

@@ -72,7 +72,15 @@ public:
     // code_end_minus_one and bad_interrupt_pc: the crash oracles' limits
     // Mcu::run_until will pass in BatchLimits (decoding records which
     // instructions can reach them; other limits later cost one re-decode).
-    explicit PredecodedCore(const avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u);
+    explicit PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u);
+    ~PredecodedCore();  // unhooks from avr's I/O modules: before the avr_t is freed
+    PredecodedCore(const PredecodedCore&) = delete;
+    PredecodedCore& operator=(const PredecodedCore&) = delete;
+
+    // Flash bytes [begin, end) were written from outside the firmware (a
+    // debugger's memory write): run_batch decodes them again. (An SPM's
+    // writes it notices itself.)
+    void flash_written(avr_flashaddr_t begin, avr_flashaddr_t end);
 
     // avr_run_one for one instruction (see above).
     __attribute__((always_inline)) avr_flashaddr_t run_one(avr_t* avr);
@@ -172,11 +180,33 @@ private:
     // The limits the slots' `check` was computed for. Beside the slots on
     // the process heap (core/ProcessHeap.hpp), so that a fuzz target's
     // restore cannot pair them with slots decoded for other limits.
+    // Also the flash write the slots have seen last (flash_written_): a
+    // restore takes the board's flash and flash_written_ back, not the
+    // slots, and a different value makes run_batch decode every slot again.
     struct CheckedFor {
         std::uint32_t code_end_minus_one;
         std::uint32_t bad_interrupt_pc;
+        std::uint64_t flash_written;
     };
     std::unique_ptr<CheckedFor, FreeDeleter> checked_for_;
+    // run_batch does not compare a slot with its flash word (run_one does):
+    // whatever writes flash makes the slots there undecoded. An SPM writes
+    // through simavr's flash module (avr_flash_ioctl, AVR_IOCTL_FLASH_SPM);
+    // this I/O module, first in avr->io_port, sees each SPM ioctl before it
+    // (avr_ioctl asks the modules in turn until one answers; this one never
+    // does).
+    struct FlashWatch {
+        avr_io_t io;
+        PredecodedCore* core;
+    };
+    static int on_ioctl(avr_io_t* io, std::uint32_t ctl, void* param);
+    void invalidate(avr_flashaddr_t begin, avr_flashaddr_t end);
+    avr_t* avr_;
+    FlashWatch flash_watch_{};
+    // A value no other write in this process had (a process-wide count):
+    // after a restore the board's value matches checked_for_'s only if the
+    // slots saw exactly this flash.
+    std::uint64_t flash_written_ = 0;
     std::uint64_t handed_ = 0;
     avr_io_read_t port_read_ = nullptr;  // Machine::port_read
 };
@@ -555,6 +585,8 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
 #define AVRBENCH_NEXT() goto plain
 #define AVRBENCH_NEXT_CALLED() goto called_simavr
 #define AVRBENCH_HAND_OVER() goto hand_over
+    // slot_at compared the first word only.
+#define AVRBENCH_WORD2_HOLDS() (slot->word2 == flash16(m.flash, new_pc))
     switch (slot->kind) {
 #include "core/PredecodedOps.inc"
         case kUndecoded:
@@ -569,6 +601,7 @@ __attribute__((always_inline)) inline PredecodedCore::Done PredecodedCore::execu
 #undef AVRBENCH_NEXT
 #undef AVRBENCH_NEXT_CALLED
 #undef AVRBENCH_HAND_OVER
+#undef AVRBENCH_WORD2_HOLDS
 plain:
     new_pc_out = new_pc;
     cycles_out = cycle;

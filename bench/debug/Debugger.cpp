@@ -470,6 +470,7 @@ bool Debugger::write_memory(Target& t, std::uint32_t address, const std::string&
         if (a < kDataBase) {
             if (a > avr->flashend) return false;
             avr->flash[a] = b;
+            t.mcu->flash_written(a, a + 1);
         } else if (a < kDataBase + kSpaceSize) {
             const std::uint32_t d = a - kDataBase;
             if (d > avr->ramend) return false;

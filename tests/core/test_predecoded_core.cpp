@@ -208,6 +208,97 @@ TEST(PredecodedCore, LdsAndStsFollowTheirAddressWordWhenFlashChangesIt) {
     EXPECT_EQ(avr->data[17], 0xa5);
 }
 
+// run_batch does not compare a slot with flash on every fetch: what writes
+// flash invalidates the slots there. An SPM (simavr's flash module, through
+// avr_ioctl) and a debugger's write (Mcu::flash_written) both must. Here a
+// batch runs LDI r16, 0x12 at an application page and stops at WDR (an
+// instruction avr_run_one executes); the boot section's OUT SPMCSR, r20;
+// SPM then rewrite the page (fill the temporary page word by word with
+// SPMEN, erase with PGERS|SPMEN, write with PGWRT|SPMEN: ATmega328P
+// datasheet, "Self-Programming the Flash"; SPMCSR is I/O 0x37, bits SPMEN
+// 0, PGERS 1, PGWRT 2) to LDI r16, 0x34; WDR, and the batch must run that.
+// Opcodes (AVR instruction set manual): LDI Rd, K = 1110 KKKK dddd KKKK;
+// OUT A, Rr = 1011 1AAr rrrr AAAA; SPM = 0x95E8; WDR = 0x95A8.
+TEST(PredecodedCore, BatchRunsWhatAnSpmWroteOverDecodedCode) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    PredecodedCore core(avr, avr->flashend - 1);
+    const avr_flashaddr_t page = 0x1000;  // 128-byte pages on the ATmega328P
+    // The last 512 bytes lie in the boot section whatever BOOTSZ says
+    // (256 words at least): only SPM from there writes (fixes/SelfProgramming).
+    const avr_flashaddr_t boot = (avr->flashend + 1) - 256;
+    constexpr std::uint16_t kWdr = 0x95A8;
+    const auto ldi_r16 = [](std::uint8_t k) { return static_cast<std::uint16_t>(0xE000 | ((k & 0xF0) << 4) | (k & 0x0F)); };
+    put_word(avr, page, ldi_r16(0x12));
+    put_word(avr, page + 2, kWdr);
+    put_word(avr, boot, 0xBF47);  // OUT 0x37 (SPMCSR), r20: 0xB800 | (0x30 << 5) | (20 << 4) | 0x7
+    put_word(avr, boot + 2, 0x95E8);
+    const auto run_page = [&] {
+        avr->pc = page;
+        const PredecodedCore::BatchLimits limits{avr->cycle + 1'000'000, 100, static_cast<std::uint32_t>(avr->flashend - 1), ~0u, 0};
+        return core.run_batch<false>(avr, limits, nullptr);
+    };
+    PredecodedCore::Batch b = run_page();
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::HandOver);
+    EXPECT_EQ(avr->pc, page + 2);
+    EXPECT_EQ(avr->data[16], 0x12);
+
+    const auto spm = [&](std::uint8_t spmcsr, avr_flashaddr_t z, std::uint16_t r1_r0) {
+        avr->data[20] = spmcsr;
+        avr->data[R_ZL] = static_cast<std::uint8_t>(z);
+        avr->data[R_ZH] = static_cast<std::uint8_t>(z >> 8);
+        avr->data[0] = static_cast<std::uint8_t>(r1_r0);
+        avr->data[1] = static_cast<std::uint8_t>(r1_r0 >> 8);
+        avr->pc = boot;
+        avr->pc = core.run_one(avr);  // OUT
+        avr->pc = core.run_one(avr);  // SPM (avr_run_one's)
+        ASSERT_EQ(avr->pc, boot + 4);
+    };
+    spm(0x01, page, ldi_r16(0x34));
+    spm(0x01, page + 2, kWdr);
+    spm(0x03, page, 0);
+    spm(0x05, page, 0);
+    ASSERT_EQ(avr->flash[page] | (avr->flash[page + 1] << 8), ldi_r16(0x34)) << "the SPMs wrote the page";
+
+    b = run_page();
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::HandOver);
+    EXPECT_EQ(avr->data[16], 0x34) << "the batch ran the slot decoded before the SPM";
+
+    // A write from outside (a debugger's), announced.
+    put_word(avr, page, ldi_r16(0x56));
+    core.flash_written(page, page + 2);
+    b = run_page();
+    EXPECT_EQ(avr->data[16], 0x56);
+}
+
+// An STS keeps its address word in the slot: a write of that word alone
+// (the slot's second) makes the slot decode again too.
+TEST(PredecodedCore, BatchFollowsAWriteOfAnStsAddressWord) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    PredecodedCore core(avr, avr->flashend - 1);
+    const avr_flashaddr_t at = 0x1000;
+    put_word(avr, at, 0x9300);  // STS k, r16: 1001 001d dddd 0000, k in the next word
+    put_word(avr, at + 2, 0x0300);
+    put_word(avr, at + 4, 0x95A8);  // WDR
+    const auto run = [&] {
+        avr->pc = at;
+        const PredecodedCore::BatchLimits limits{avr->cycle + 1'000'000, 100, static_cast<std::uint32_t>(avr->flashend - 1), ~0u, 0};
+        return core.run_batch<false>(avr, limits, nullptr);
+    };
+    avr->data[16] = 0x5a;
+    run();
+    EXPECT_EQ(avr->data[0x0300], 0x5a);
+    put_word(avr, at + 2, 0x0301);
+    core.flash_written(at + 2, at + 4);
+    avr->data[16] = 0xa5;
+    run();
+    EXPECT_EQ(avr->data[0x0301], 0xa5);
+    EXPECT_EQ(avr->data[0x0300], 0x5a);
+}
+
 // run_batch tests the crash oracles only after the slots whose `check`
 // says they can trip them, computed for the limits the core was given; a
 // batch with other limits (a boot loader that wrote another application)

@@ -24,6 +24,9 @@
 
 #include "FirmwareTarget.hpp"
 #include "SnapshotHeap.hpp"
+#include "core/ElfImage.hpp"
+#include "core/Mcu.hpp"
+#include "core/PredecodedCore.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {
@@ -253,6 +256,66 @@ TEST(SnapshotHeap, AFunctionLocalStaticFirstReachedByAnInputOutlivesTheRestore) 
     });
     ASSERT_EQ(r.status, 0) << r.text;
     EXPECT_EQ(r.text, "ordinary region\nstatic process\nafter restore 4096 xxx\n");
+}
+
+// The predecoded core's slots live on the process heap (a restore keeps
+// what earlier inputs decoded), the flash in the region. An input whose SPM
+// rewrote decoded code leaves slots for that code; after the restore the
+// flash holds the old code again, and the batch must run the old code.
+// Opcodes and SPM sequence as in tests/core/test_predecoded_core.cpp
+// (BatchRunsWhatAnSpmWroteOverDecodedCode): LDI r16, K = 0xE000 | (K & 0xF0)
+// << 4 | (K & 0x0F); WDR = 0x95A8; OUT SPMCSR (I/O 0x37), r20 = 0xBF47;
+// SPM = 0x95E8; SPMCSR SPMEN = 1, PGERS = 2, PGWRT = 4.
+TEST(SnapshotHeap, ARestoreUndoesWhatAnInputsSpmDidToTheDecodedCode) {
+    const ChildResult r = in_child([] {
+        Mcu* mcu = nullptr;
+        PredecodedCore* core = nullptr;
+        {
+            const fuzz::snapshot_heap::Collecting collecting;
+            mcu = new Mcu(ElfImage::load(test::firmware("busy_poll")), McuOptions{});
+            core = new PredecodedCore(mcu->avr(), mcu->avr()->flashend - 1);
+        }
+        avr_t* avr = mcu->avr();
+        const auto put = [&](avr_flashaddr_t at, std::uint16_t word) {
+            avr->flash[at] = static_cast<std::uint8_t>(word);
+            avr->flash[at + 1] = static_cast<std::uint8_t>(word >> 8);
+        };
+        const avr_flashaddr_t page = 0x1000;
+        const avr_flashaddr_t boot = (avr->flashend + 1) - 256;  // in every BOOTSZ's boot section
+        put(page, 0xE102);                                       // LDI r16, 0x12
+        put(page + 2, 0x95A8);
+        put(boot, 0xBF47);
+        put(boot + 2, 0x95E8);
+        const auto run_page = [&] {
+            avr->pc = page;
+            const PredecodedCore::BatchLimits limits{avr->cycle + 1'000'000, 100, static_cast<std::uint32_t>(avr->flashend - 1), ~0u, 0};
+            core->run_batch<false>(avr, limits, nullptr);
+            return static_cast<unsigned>(avr->data[16]);
+        };
+        const auto spm = [&](std::uint8_t spmcsr, avr_flashaddr_t z, std::uint16_t r1_r0) {
+            avr->data[20] = spmcsr;
+            avr->data[R_ZL] = static_cast<std::uint8_t>(z);
+            avr->data[R_ZH] = static_cast<std::uint8_t>(z >> 8);
+            avr->data[0] = static_cast<std::uint8_t>(r1_r0);
+            avr->data[1] = static_cast<std::uint8_t>(r1_r0 >> 8);
+            avr->pc = boot;
+            avr->pc = core->run_one(avr);
+            avr->pc = core->run_one(avr);
+        };
+        std::ostringstream out;
+        out << "booted " << std::hex << run_page();
+        fuzz::snapshot_heap::take();
+        spm(0x01, page, 0xE304);  // LDI r16, 0x34
+        spm(0x01, page + 2, 0x95A8);
+        spm(0x03, page, 0);
+        spm(0x05, page, 0);
+        out << " input " << run_page();
+        fuzz::snapshot_heap::restore();
+        out << " restored " << run_page() << "\n";
+        return out.str();
+    });
+    ASSERT_EQ(r.status, 0) << r.text;
+    EXPECT_EQ(r.text, "booted 12 input 34 restored 12\n");
 }
 
 TEST(SnapshotHeap, AFaultOutsideTheRegionStillKillsTheProcess) {
