@@ -22,10 +22,15 @@
 // every firmware the build makes (tests/core/test_predecoded_core.cpp) and
 // by every run-loop, scenario and golden test, which run on this core.
 //
-// Flash that changes (SPM, a boot loader writing the application, a
-// debugger) needs no invalidation call: a slot remembers the opcode word it
-// was decoded from and is decoded again when the flash no longer holds it.
-// The second word of LDS/STS/JMP/CALL is read from flash when they run.
+// Flash that changes: run_one (the general step) compares a slot's opcode
+// words with flash and decodes again when they differ. run_batch does not
+// compare on each fetch; a flash write invalidates the slots it covers: an
+// SPM is seen by the core's own I/O module, first in avr->io_port, before
+// simavr's flash module does the write (FlashWatch below); other writers
+// from outside the firmware (the debugger) call flash_written; a fuzz
+// target's restore changes the board's flash_written_ token, and the next
+// batch decodes everything again. JMP/CALL read their second word from
+// flash when they run.
 #pragma once
 
 #include <cstdint>
