@@ -61,11 +61,6 @@ struct ResetHook {
 
 namespace {
 
-// When the SLEEP instruction itself reaches the target, simavr fires this
-// timer and then computes the sleep from the next one; re-arming one cycle
-// ahead keeps that jump short. run_until() cancels it on the way out.
-avr_cycle_count_t horizon_timer(avr_t* avr, avr_cycle_count_t, void*) { return avr->cycle + 1; }
-
 // Due at once: a stop requested from inside an instruction (an I/O hook)
 // ends run_until's fast path, which looks only at the first timer.
 avr_cycle_count_t stop_timer(avr_t*, avr_cycle_count_t, void*) { return 0; }
@@ -256,7 +251,6 @@ Mcu::~Mcu() {
     fixes_.reset();  // the fixes unhook themselves from the core: before it is freed
     predecoded_.reset();  // likewise (its flash watch is one of the core's I/O modules)
     if (avr_ != nullptr) {
-        avr_cycle_timer_cancel(avr_, &horizon_timer, this);
         route_simavr_log(avr_, nullptr);
         avr_terminate(avr_);
         std::free(avr_);
@@ -389,13 +383,13 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
     if (halted_) return StopReason::Halted;
     in_run_ = true;
     avr_t* const avr = avr_;
-    // A cycle timer at the target: a core that sleeps (now, or when the SLEEP
-    // instruction executes inside avr_run) jumps to its next cycle timer, and
-    // without this one that could lie far past the target.
-    if (avr->cycle < target_cycle) avr_cycle_timer_register(avr, target_cycle - avr->cycle, &horizon_timer, this);
-    run_target_ = target_cycle;
     const bool reference = options_.reference_run_loop;
     SimavrStepper stepper(avr, predecoded_.get());
+    // A core that sleeps jumps to its next cycle timer, which could lie far
+    // past the target: the stepper stops the jump there. (It was a cycle
+    // timer at the target, registered and cancelled on every call: a tenth
+    // of a five-MCU board's turn, docs/PERFORMANCE.md.)
+    stepper.set_horizon(target_cycle);
     // One unsigned comparison covers PC = 0 (a reset) and PC past the program.
     const std::uint32_t code_end_minus_one = code_end_bytes_ - 1;
     // The crash oracles after an instruction; findings that halt also
@@ -436,16 +430,12 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         // instantiation, which looks at every opcode there.
         if (kProfile || (!kStopAtSleep && stop_at_sleep_) || debug_ != nullptr || reference || avr->cycle >= target_cycle || !stepper.fast_path_open()) continue;
 
-        // Fast path: while the core runs, no interrupt is on its way and no
-        // cycle timer is due, a step of SimavrStepper is one instruction (the
-        // predecoded core's run_batch, or avr_run_one) and the
-        // new PC. Anything else is finished by SimavrStepper::finish, as
-        // step() would, and the loop goes back to the general step. The
-        // horizon timer (at the target, put back after a reset) is in the
-        // list, so the first timer is never later than the target and
-        // "first timer due" also stops the loop at the target.
-        const avr_cycle_timer_slot_p head = avr->cycle_timers.timer;
-        if (head == nullptr || head->when > target_cycle) continue;
+        // Fast path: while the core runs, no interrupt is on its way and
+        // neither a cycle timer nor the target is due, a step of
+        // SimavrStepper is one instruction (the predecoded core's run_batch,
+        // or avr_run_one) and the new PC. Anything else is finished by
+        // SimavrStepper::finish, as step() would, and the loop goes back to
+        // the general step.
         std::uint32_t countdown = skip_countdown_;
         const std::uint32_t countdown_before = countdown;
         // avr->data is fixed once the core is made (fixes/MemoryGuard grows it then).
@@ -462,8 +452,13 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
                 // The predecoded core's run of instructions it executes
                 // itself: the checks below, made inside its loop. It stops
                 // in front of one for avr_run_one, which the step below takes.
-                const PredecodedCore::BatchLimits limits{avr->cycle_timers.timer->when, countdown - 1, code_end_minus_one,
-                                                         bad_interrupt_pc, stack_floor};
+                const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
+                const PredecodedCore::BatchLimits limits{first != nullptr ? std::min(first->when, target_cycle) : target_cycle,
+                                                         countdown - 1,
+                                                         code_end_minus_one,
+                                                         bad_interrupt_pc,
+                                                         stack_floor,
+                                                         target_cycle};
                 const PredecodedCore::Batch batch = core->run_batch<kCover>(avr, limits, edges);
                 countdown -= batch.steps;
                 if (batch.ended == PredecodedCore::Ended::TimerDue) {
@@ -488,10 +483,9 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
             --countdown;
             // avr_run_one (or the predecoded core) leaves avr->pc alone: it still holds the PC before the instruction.
             const std::uint32_t pc = stepper.run_one();
-            // Never null here: the horizon timer stays in the list until run_until
-            // cancels it (only a reset drops it, and resets happen in timers).
             const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
-            if (__builtin_expect(first->when <= avr->cycle, 0) || __builtin_expect(avr->state != cpu_Running, 0) ||
+            if (__builtin_expect(avr->cycle >= target_cycle, 0) || __builtin_expect(first != nullptr && first->when <= avr->cycle, 0) ||
+                __builtin_expect(avr->state != cpu_Running, 0) ||
                 __builtin_expect(avr->interrupt_state != 0, 0)) {
                 const std::uint32_t fast_pc_before = avr->pc;
                 check(stepper.finish(pc), fast_pc_before);
@@ -517,8 +511,6 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         steps_ += steps;  // one per turn of the loop above, each one countdown
         if (__builtin_expect(stop_requested_, 0)) break;
     }
-    avr_cycle_timer_cancel(avr, &horizon_timer, this);
-    run_target_ = 0;
     in_run_ = false;
     if (halted_ && debug_ != nullptr) debug_->halted(*this);
     if (halted_) return StopReason::Halted;
@@ -537,8 +529,6 @@ void Mcu::after_reset() {
     ++resets_;
     // avr_reset() drops every cycle timer: put the scheduler's back.
     scheduler_->rearm();
-    // And the run's horizon: run_until's fast path counts on it.
-    if (avr_->cycle < run_target_) avr_cycle_timer_register(avr_, run_target_ - avr_->cycle, &horizon_timer, this);
     if (twi_) twi_->reset();
     if (profiler_) profiler_->reset();
     for (auto& fn : reset_listeners_) fn();

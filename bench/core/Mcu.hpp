@@ -314,7 +314,6 @@ private:
     std::unique_ptr<PredecodedCore> predecoded_;  // nullptr: avr_run_one (McuOptions::predecoded_core)
     std::unique_ptr<PredecodedCore> make_predecoded_core() const;
     std::uint32_t skip_countdown_ = 1;
-    Cycle run_target_ = 0;  // run_until's target while it runs (its horizon timer)
     bool in_run_ = false;
     // simavr's cycle counter and core state (avr_t::cycle, avr_t::state),
     // for the inline getters; cpu_Sleeping is 3 in sim_avr.h (static_assert in Mcu.cpp).

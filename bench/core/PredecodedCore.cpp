@@ -389,8 +389,9 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         std::uint32_t code_end_minus_one;
         std::uint32_t bad_interrupt_pc;
         std::uint16_t stack_floor;
+        avr_cycle_count_t horizon;
     };
-    volatile Cold cold{this, limits.max_steps, limits.code_end_minus_one, limits.bad_interrupt_pc, limits.stack_floor};
+    volatile Cold cold{this, limits.max_steps, limits.code_end_minus_one, limits.bad_interrupt_pc, limits.stack_floor, limits.horizon};
     // The PC and the cycle count live in registers until the batch ends;
     // AVRBENCH_BEFORE_CALLBACKS stores them before simavr's I/O callbacks.
     // One PC: `new_pc` is, at the dispatch, the instruction to fetch, and
@@ -502,8 +503,10 @@ after_callbacks : {
     // What the fast path checks after avr_run_one: a timer the callbacks
     // made due, a core no longer running, an interrupt on its way.
     const avr_cycle_timer_slot_p first = avr->cycle_timers.timer;
-    if (first == nullptr || first->when <= cycle_now || avr->state != cpu_Running || avr->interrupt_state != 0) goto timer_due;
-    cycle_limit = first->when;
+    const avr_cycle_count_t horizon = cold.horizon;
+    const avr_cycle_count_t next_limit = first != nullptr && first->when < horizon ? first->when : horizon;
+    if (next_limit <= cycle_now || avr->state != cpu_Running || avr->interrupt_state != 0) goto timer_due;
+    cycle_limit = next_limit;
     refuel(static_cast<std::int64_t>(cycle_limit - cycle_now));
     if (slot->check == 0) goto advance;
     goto check_oracles;

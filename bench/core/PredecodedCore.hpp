@@ -92,11 +92,15 @@ public:
 
     // What Mcu::run_until's fast path checks after every instruction.
     struct BatchLimits {
-        avr_cycle_count_t cycle;           // the first cycle timer's `when`
+        avr_cycle_count_t cycle;           // the first cycle timer's `when`, or the horizon if sooner
         std::uint32_t max_steps;           // instructions at most
         std::uint32_t code_end_minus_one;  // a new PC with PC - 1 at or past it is checked
         std::uint32_t bad_interrupt_pc;
         std::uint16_t stack_floor;
+        // Mcu::run_until's target: after an I/O callback moved the timers,
+        // the batch's cycle limit is worked out again from the first timer
+        // and this.
+        avr_cycle_count_t horizon = ~avr_cycle_count_t{0};
     };
     enum class Ended {
         HandOver,  // in front of an instruction avr_run_one must execute (or a PC past the flash)

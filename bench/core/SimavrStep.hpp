@@ -23,6 +23,8 @@
 // anything else to finish() (docs/PERFORMANCE.md).
 #pragma once
 
+#include <algorithm>
+
 extern "C" {
 #include <sim_avr.h>
 #include <sim_core.h>
@@ -101,6 +103,14 @@ public:
                 return cpu_Done;
             }
             if (!due) sleep = first->when - avr->cycle;
+            if (horizon_ != kNoHorizon) {
+                // The sleep a cycle timer at the horizon would give (simavr
+                // sleeps to the first timer): up to it, or, once reached,
+                // one cycle - that timer would have fired in this step and
+                // re-armed itself one cycle on, to keep the jump short.
+                const avr_cycle_count_t to_horizon = horizon_ > avr->cycle ? horizon_ - avr->cycle : 1;
+                sleep = avr->cycle_timers.timer == nullptr ? to_horizon : std::min(sleep, to_horizon);
+            }
             avr->sleep(avr, sleep);
             avr->cycle += 1 + sleep;
         }
@@ -122,11 +132,18 @@ public:
         return avr->state;
     }
 
+    // Mcu::run_until's target: a sleep jumps no further than a cycle timer
+    // there would let it (simavr's sleep goes to the first timer), without
+    // a timer registered and cancelled on every run.
+    void set_horizon(avr_cycle_count_t horizon) { horizon_ = horizon; }
+
 private:
+    static constexpr avr_cycle_count_t kNoHorizon = ~avr_cycle_count_t{0};
     void recheck() { raw_ = avr_->run == &avr_callback_run_raw && avr_->run_cycle_limit == 1; }
 
     avr_t* avr_;
     PredecodedCore* core_;
+    avr_cycle_count_t horizon_ = kNoHorizon;
     bool raw_ = false;
 };
 
