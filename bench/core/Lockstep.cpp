@@ -191,6 +191,10 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         // One look at each MCU per turn: present, next cycle timer, state.
         std::size_t runner = n;
         Time runner_at = kNeverTime;
+        // The two earliest actions (below) of all MCUs, the first's index:
+        // the earliest of every MCU but the runner, whichever it is.
+        Time first_action = kNeverTime, second_action = kNeverTime;
+        std::size_t first_actor = n;
         for (std::size_t k = 0; k < n; ++k) {
             const Mcu& m = *mcus[k];
             const avr_t* const avr = m.avr();
@@ -199,6 +203,14 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
             t.present = time_of<Time>(k, avr->cycle);
             t.awake = !t.halted && !(lookahead_ && dormant_now(avr));
             t.next = t.awake || t.halted ? kNeverTime : time_of<Time>(k, next_event_now(avr));
+            const Time action = t.halted ? kNeverTime : t.awake ? t.present : t.next;
+            if (action < first_action) {
+                second_action = first_action;
+                first_action = action;
+                first_actor = k;
+            } else if (action < second_action) {
+                second_action = action;
+            }
             // The MCU whose next step comes first: an awake one's present, a
             // dormant one's next event (or the run's end).
             if (t.halted || avr->cycle >= end_cycles[k]) continue;
@@ -218,7 +230,22 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
             Turn<Time>& t = turn[k];
             t.earliest_action = k == runner || t.halted ? kNeverTime : t.awake ? t.present : t.next;
         }
-        if (lookahead_) {
+        Mcu& behind = *mcus[runner];
+        const auto runner_bound = [&] {
+            Time b = kNeverTime;
+            for (const Influence& i : influenced_by_[runner]) b = std::min(b, turn[i.from].earliest_action);
+            for (const std::size_t x : influences_[runner]) {
+                if (turn[x].awake) b = std::min(b, turn[x].present);
+            }
+            return b;
+        };
+        Time bound = runner_bound();
+        // The wake-ups below only lower an MCU's earliest action to another's
+        // (never below the earliest of them all, the runner aside): a bound
+        // already there is the answer, and that is most turns of two awake
+        // MCUs taking turns.
+        const Time earliest_but_runner = first_actor == runner ? second_action : first_action;
+        if (lookahead_ && bound > earliest_but_runner) {
             for (bool changed = true; changed;) {
                 changed = false;
                 for (std::size_t k = 0; k < n; ++k) {
@@ -232,12 +259,7 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
                     }
                 }
             }
-        }
-        Mcu& behind = *mcus[runner];
-        Time bound = kNeverTime;
-        for (const Influence& i : influenced_by_[runner]) bound = std::min(bound, turn[i.from].earliest_action);
-        for (const std::size_t x : influences_[runner]) {
-            if (turn[x].awake) bound = std::min(bound, turn[x].present);
+            bound = runner_bound();
         }
         if (!coupled_.empty()) {
             for (std::size_t k = 0; k < n; ++k) {
