@@ -407,7 +407,6 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         }
         return false;
     };
-    IdleLoopSkipper* const skipper = skipper_.get();
     while (avr->cycle < target_cycle) {
         if (__builtin_expect(debug_ != nullptr, 0)) {
             debug_->before_step(*this);
@@ -415,7 +414,9 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         }
         // run_until_sleep: stop in front of SLEEP (it executes it itself).
         if (__builtin_expect(stop_at_sleep_, 0) && avr->state == cpu_Running && opcode_at(avr, avr->pc) == kSleepOpcode) break;
-        if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper != nullptr ? skipper->tick(target_cycle) : ~0u;
+        // skipper_ read here, not once per run: a debugger hooked in from a
+        // timer inside the run (a replay's checkpoint) drops it.
+        if (__builtin_expect(--skip_countdown_ == 0, 0)) skip_countdown_ = skipper_ != nullptr ? skipper_->tick(target_cycle) : ~0u;
         const std::uint32_t pc_before = avr->pc;
         [[maybe_unused]] const Cycle cycle_before = avr->cycle;
         [[maybe_unused]] const bool was_sleeping = avr->state == cpu_Sleeping;
@@ -465,7 +466,16 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
                     const std::uint32_t fast_pc_before = avr->pc;
                     check(stepper.finish(batch.new_pc), fast_pc_before);
                     if constexpr (kCover) edges->hit(avr->pc);
-                    break;
+                    // The timers fired and left the core running with
+                    // nothing pending: the next batch, not the general step
+                    // (which would run the same instruction the same way).
+                    // A timer may have hooked a debugger in (a replay's
+                    // checkpoint): then the general step.
+                    if (stop_requested_ || debug_ != nullptr || stop_at_sleep_ != kStopAtSleep || avr->cycle >= target_cycle ||
+                        !stepper.fast_path_open()) {
+                        break;
+                    }
+                    continue;
                 }
                 if (batch.ended == PredecodedCore::Ended::CheckPc) {
                     const std::uint32_t fast_pc_before = avr->pc;
