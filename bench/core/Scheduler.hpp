@@ -7,8 +7,8 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
-#include <queue>
 #include <vector>
 
 #include "core/Time.hpp"
@@ -39,22 +39,26 @@ public:
     void rearm();
 
 private:
+    // The queue orders small records; the callbacks stay where they were
+    // put (a deque: a callback may schedule more while it runs), so the heap
+    // moves no std::function about.
     struct Event {
         Cycle cycle;
         std::uint64_t sequence;  // keeps same-cycle events in registration order
-        Callback fn;
+        std::uint32_t slot;      // its callback in slots_
     };
     struct Later {
         bool operator()(const Event& a, const Event& b) const {
             return a.cycle != b.cycle ? a.cycle > b.cycle : a.sequence > b.sequence;
         }
     };
-
     static std::uint64_t on_timer(avr_t* avr, std::uint64_t when, void* param);
     void arm();
 
     avr_t* avr_;
-    std::priority_queue<Event, std::vector<Event>, Later> queue_;
+    std::vector<Event> queue_;  // a heap under Later: the earliest first
+    std::deque<Callback> slots_;
+    std::vector<std::uint32_t> free_slots_;
     std::uint64_t next_sequence_ = 0;
     bool dispatching_ = false;
     Cycle armed_for_ = 0;
