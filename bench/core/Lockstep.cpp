@@ -1,6 +1,7 @@
 #include "core/Lockstep.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -156,6 +157,8 @@ std::uint64_t Lockstep::now_ps() const {
 void Lockstep::reach(Mcu& mcu) {
     Mcu* const runner = running_;
     if (runner == nullptr || &mcu == runner) return;
+    // Whatever changes next may change its state: its turn entry is looked at again.
+    mark_stale(mcu);
     // Whatever changes now may wake `mcu` or change its outputs: every
     // bound is worked out again after the runner's instruction.
     runner->request_yield();
@@ -174,6 +177,40 @@ StopReason Lockstep::run_until_ps(std::uint64_t end_ps) {
 }
 
 template <typename Time>
+void Lockstep::look_at(std::size_t k, Turn<Time>& t) const {
+    const Mcu& m = *mcus_[k];
+    const avr_t* const avr = m.avr();
+    t.halted = m.halted();
+    t.present = time_of<Time>(k, avr->cycle);
+    t.awake = !t.halted && !(lookahead_ && dormant_now(avr));
+    t.next = t.awake || t.halted ? kNever<Time> : time_of<Time>(k, next_event_now(avr));
+    // The earliest time it could act: its present when awake; asleep, its next cycle timer.
+    t.action = t.halted ? kNever<Time> : t.awake ? t.present : t.next;
+    t.may_run = !t.halted && avr->cycle < end_cycles_[k];
+    t.at = t.awake ? t.present : std::min(t.next, time_of<Time>(k, end_cycles_[k]));
+}
+
+template <typename Time>
+void Lockstep::check_turns(const std::vector<Turn<Time>>& turns) const {
+    for (std::size_t k = 0; k < mcus_.size(); ++k) {
+        Turn<Time> fresh{};
+        look_at(k, fresh);
+        const Turn<Time>& kept = turns[k];
+        if (fresh.present != kept.present || fresh.next != kept.next || fresh.action != kept.action || fresh.at != kept.at ||
+            fresh.awake != kept.awake || fresh.halted != kept.halted || fresh.may_run != kept.may_run) {
+            throw std::logic_error("lockstep: the turn entry kept for MCU '" + mcus_[k]->name() +
+                                   "' is out of date (it changed without running or reach())");
+        }
+    }
+}
+
+void Lockstep::mark_stale(const Mcu& mcu) {
+    for (std::size_t k = 0; k < mcus_.size() && k < 64; ++k) {
+        if (mcus_[k] == &mcu) stale_ |= std::uint64_t{1} << k;
+    }
+}
+
+template <typename Time>
 StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& turns) {
     constexpr Time kNeverTime = kNever<Time>;
     const std::size_t n = mcus_.size();
@@ -187,37 +224,43 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
     Mcu* const* const mcus = mcus_.data();
     Cycle* const end_cycles = end_cycles_.data();
     for (std::size_t k = 0; k < n; ++k) end_cycles[k] = cycle_at_ps(*mcus[k], end_ps);
+    stale_ = ~std::uint64_t{0};
     for (;;) {
-        // One look at each MCU per turn: present, next cycle timer, state.
+        // What each MCU's turn entry says changes only when that MCU runs
+        // (the runner, or one reach() brought forward) or something outside
+        // it changes what it sees (reach() again): only those are looked at
+        // again. More than 64 MCUs: every one, every turn.
+        if (n > 64) {
+            for (std::size_t k = 0; k < n; ++k) look_at(k, turn[k]);
+        } else {
+            for (std::uint64_t left = n == 64 ? stale_ : stale_ & ((std::uint64_t{1} << n) - 1); left != 0; left &= left - 1) {
+                const auto k = static_cast<std::size_t>(std::countr_zero(left));
+                look_at(k, turn[k]);
+            }
+        }
+        stale_ = 0;
+        if (__builtin_expect(check_turns_, 0)) check_turns(turns);
+        // The MCU whose next step comes first (an awake one's present, a
+        // dormant one's next event or the run's end), and the two earliest
+        // actions of all MCUs with the first's index: the earliest of every
+        // MCU but the runner, whichever it is.
         std::size_t runner = n;
         Time runner_at = kNeverTime;
-        // The two earliest actions (below) of all MCUs, the first's index:
-        // the earliest of every MCU but the runner, whichever it is.
         Time first_action = kNeverTime, second_action = kNeverTime;
         std::size_t first_actor = n;
         for (std::size_t k = 0; k < n; ++k) {
-            const Mcu& m = *mcus[k];
-            const avr_t* const avr = m.avr();
-            Turn<Time>& t = turn[k];
-            t.halted = m.halted();
-            t.present = time_of<Time>(k, avr->cycle);
-            t.awake = !t.halted && !(lookahead_ && dormant_now(avr));
-            t.next = t.awake || t.halted ? kNeverTime : time_of<Time>(k, next_event_now(avr));
-            const Time action = t.halted ? kNeverTime : t.awake ? t.present : t.next;
-            if (action < first_action) {
+            const Turn<Time>& t = turn[k];
+            if (t.action < first_action) {
                 second_action = first_action;
-                first_action = action;
+                first_action = t.action;
                 first_actor = k;
-            } else if (action < second_action) {
-                second_action = action;
+            } else if (t.action < second_action) {
+                second_action = t.action;
             }
-            // The MCU whose next step comes first: an awake one's present, a
-            // dormant one's next event (or the run's end).
-            if (t.halted || avr->cycle >= end_cycles[k]) continue;
-            const Time at = t.awake ? t.present : std::min(t.next, time_of<Time>(k, end_cycles[k]));
-            if (runner == n || at < runner_at) {
+            if (!t.may_run) continue;
+            if (runner == n || t.at < runner_at) {
                 runner = k;
-                runner_at = at;
+                runner_at = t.at;
             }
         }
         if (runner == n) break;
@@ -226,10 +269,7 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         // than the runner that could wake it sooner. (When the runner wakes
         // one, reach() makes it yield at once and the bounds are worked out
         // again, so its own wake-ups never need to hold it back.)
-        for (std::size_t k = 0; k < n; ++k) {
-            Turn<Time>& t = turn[k];
-            t.earliest_action = k == runner || t.halted ? kNeverTime : t.awake ? t.present : t.next;
-        }
+        for (std::size_t k = 0; k < n; ++k) turn[k].earliest_action = k == runner ? kNeverTime : turn[k].action;
         Mcu& behind = *mcus[runner];
         const auto runner_bound = [&] {
             Time b = kNeverTime;
@@ -271,6 +311,7 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         running_ = &behind;
         const StopReason r = behind.run_until(target);
         running_ = nullptr;
+        if (runner < 64) stale_ |= std::uint64_t{1} << runner;
         if ((r == StopReason::Requested || requested_stop_) && !stopped) {
             // The run ends at the requesting instruction's time: every MCU
             // still behind it (awake ones that did not need to wait, dormant
@@ -279,6 +320,7 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
             stopped = true;
             const Time stop_at = time_of<Time>(runner, behind.cycle());
             for (std::size_t k = 0; k < n; ++k) end_cycles[k] = std::min(end_cycles[k], cycle_of<Time>(k, stop_at));
+            stale_ = ~std::uint64_t{0};
         }
         requested_stop_ = false;
     }

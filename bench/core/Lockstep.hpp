@@ -59,6 +59,9 @@ public:
     // Off: every MCU's horizon is its present time (strict lockstep), for
     // tests that compare the two.
     void set_lookahead(bool on) { lookahead_ = on; }
+    // Tests: every turn, each MCU's kept turn entry is compared with one
+    // worked out anew (std::logic_error when one changed unseen).
+    void set_check_turns(bool on) { check_turns_ = on; }
 
     // Runs every MCU to `end_ps` picoseconds of simulated time (each stops at
     // the first instruction boundary at or after it). Halted MCUs drop out.
@@ -89,14 +92,19 @@ private:
     // mixed clocks the products need 128 bits.
     __extension__ using WideTime = unsigned __int128;
     template <typename Time>
-    struct Turn {  // one MCU, worked out for each turn of run_until_ps
-        Time present, next, earliest_action;
-        bool awake, halted;
+    struct Turn {  // one MCU, looked at again after it ran (or reach() saw a change)
+        Time present, next, action, at, earliest_action;
+        bool awake, halted, may_run;
     };
     template <typename Time>
     static constexpr Time kNever = ~Time{0};
     template <typename Time>
     StopReason run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& turns);
+    template <typename Time>
+    void look_at(std::size_t k, Turn<Time>& t) const;
+    template <typename Time>
+    void check_turns(const std::vector<Turn<Time>>& turns) const;
+    void mark_stale(const Mcu& mcu);
     struct Influence {
         std::size_t from = 0;
         bool any_change_may_wake = false;
@@ -124,6 +132,8 @@ private:
     std::vector<Turn<WideTime>> turns_mixed_clocks_;
     std::set<std::pair<const Mcu*, const Mcu*>> coupled_;
     bool lookahead_ = true;
+    bool check_turns_ = false;
+    std::uint64_t stale_ = ~std::uint64_t{0};  // bit k: MCU k's turn entry must be looked at again
     Mcu* running_ = nullptr;
     bool requested_stop_ = false;  // a catch-up run was stopped by a callback
     std::uint64_t catch_ups_ = 0;
