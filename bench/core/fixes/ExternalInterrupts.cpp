@@ -93,6 +93,11 @@ public:
             for (auto e : enables) also_enable = also_enable || e == a;
             if (!also_enable) hooks_.push_back(std::make_unique<IoWriteHook>(avr, a, &on_control_write, this));
         }
+        for (auto& line : lines_) {
+            for (const avr_regbit_t& isc : extint_->eint[line.index].isc) {
+                if (isc.reg != 0) control_bits_.push_back({static_cast<avr_io_addr_t>(isc.reg), static_cast<std::uint8_t>(isc.mask << isc.bit)});
+            }
+        }
         for (auto a : flags) hooks_.push_back(std::make_unique<IoWriteHook>(avr, a, &on_flag_write, this));
         for (auto& line : lines_) update_level(line);
     }
@@ -182,9 +187,19 @@ private:
         for (auto& line : self->lines_) self->update_level(line);
     }
 
+    // MCUCR on the ATmega32 holds the sleep bits too: written on every
+    // sleep. Only a change of the sense control bits can change a request;
+    // every other change of a level line's request (pin, enable, vector
+    // taken or cleared, reset) is followed at once by its own handler.
     static void on_control_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
         auto* self = static_cast<ExternalInterrupts*>(hook.context());
+        const std::uint8_t before = avr->data[addr];
         hook.write_original(avr, addr, value);
+        std::uint8_t sense_bits = 0;
+        for (const ControlBits& c : self->control_bits_) {
+            if (c.reg == addr) sense_bits |= c.mask;
+        }
+        if (((before ^ avr->data[addr]) & sense_bits) == 0) return;
         for (auto& line : self->lines_) self->update_level(line);
     }
 
@@ -216,6 +231,11 @@ private:
     avr_extint_t* extint_;
     PartFacts facts_;
     std::vector<Line> lines_;
+    struct ControlBits {
+        avr_io_addr_t reg;
+        std::uint8_t mask;  // ISCn bits in place
+    };
+    std::vector<ControlBits> control_bits_;
     std::vector<std::unique_ptr<IoWriteHook>> hooks_;
     void (*original_reset_)(avr_io_t*) = nullptr;
 };
