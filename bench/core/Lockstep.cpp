@@ -115,6 +115,12 @@ void Lockstep::add_influence(const Mcu& from, const Mcu& to, const Pin* through)
     }
 }
 
+bool Lockstep::wakes(Influence& influence, const Mcu& influenced) const {
+    if (influence.any_change_may_wake) return true;
+    if (influence.wakes == -1) influence.wakes = may_wake(influence, influenced) ? 1 : 0;
+    return influence.wakes == 1;
+}
+
 bool Lockstep::may_wake(const Influence& influence, const Mcu& influenced) const {
     if (influence.any_change_may_wake) return true;
     for (const Pin* p : influence.pins) {
@@ -201,6 +207,12 @@ void Lockstep::check_turns(const std::vector<Turn<Time>>& turns) const {
             throw std::logic_error("lockstep: the turn entry kept for MCU '" + mcus_[k]->name() +
                                    "' is out of date (it changed without running or reach())");
         }
+        for (const Influence& i : influenced_by_[k]) {
+            if (i.wakes != -1 && (i.wakes == 1) != may_wake(i, *mcus_[k])) {
+                throw std::logic_error("lockstep: what may wake MCU '" + mcus_[k]->name() +
+                                       "' changed without it running or reach()");
+            }
+        }
     }
 }
 
@@ -231,11 +243,15 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         // it changes what it sees (reach() again): only those are looked at
         // again. More than 64 MCUs: every one, every turn.
         if (n > 64) {
-            for (std::size_t k = 0; k < n; ++k) look_at(k, turn[k]);
+            for (std::size_t k = 0; k < n; ++k) {
+                look_at(k, turn[k]);
+                for (Influence& i : influenced_by_[k]) i.wakes = -1;
+            }
         } else {
             for (std::uint64_t left = n == 64 ? stale_ : stale_ & ((std::uint64_t{1} << n) - 1); left != 0; left &= left - 1) {
                 const auto k = static_cast<std::size_t>(std::countr_zero(left));
                 look_at(k, turn[k]);
+                for (Influence& i : influenced_by_[k]) i.wakes = -1;
             }
         }
         stale_ = 0;
@@ -269,37 +285,39 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         // than the runner that could wake it sooner. (When the runner wakes
         // one, reach() makes it yield at once and the bounds are worked out
         // again, so its own wake-ups never need to hold it back.)
-        for (std::size_t k = 0; k < n; ++k) turn[k].earliest_action = k == runner ? kNeverTime : turn[k].action;
         Mcu& behind = *mcus[runner];
-        const auto runner_bound = [&] {
+        // Before any wake-up is counted, the earliest action of an MCU
+        // other than the runner is its own.
+        const auto runner_bound = [&](Time Turn<Time>::*earliest) {
             Time b = kNeverTime;
-            for (const Influence& i : influenced_by_[runner]) b = std::min(b, turn[i.from].earliest_action);
+            for (const Influence& i : influenced_by_[runner]) b = std::min(b, turn[i.from].*earliest);
             for (const std::size_t x : influences_[runner]) {
                 if (turn[x].awake) b = std::min(b, turn[x].present);
             }
             return b;
         };
-        Time bound = runner_bound();
+        Time bound = runner_bound(&Turn<Time>::action);
         // The wake-ups below only lower an MCU's earliest action to another's
         // (never below the earliest of them all, the runner aside): a bound
         // already there is the answer, and that is most turns of two awake
         // MCUs taking turns.
         const Time earliest_but_runner = first_actor == runner ? second_action : first_action;
         if (lookahead_ && bound > earliest_but_runner) {
+            for (std::size_t k = 0; k < n; ++k) turn[k].earliest_action = k == runner ? kNeverTime : turn[k].action;
             for (bool changed = true; changed;) {
                 changed = false;
                 for (std::size_t k = 0; k < n; ++k) {
                     Turn<Time>& t = turn[k];
                     if (k == runner || t.awake || t.halted) continue;
-                    for (const Influence& i : influenced_by_[k]) {
-                        if (turn[i.from].earliest_action < t.earliest_action && (i.any_change_may_wake || may_wake(i, *mcus[k]))) {
+                    for (Influence& i : influenced_by_[k]) {
+                        if (turn[i.from].earliest_action < t.earliest_action && wakes(i, *mcus[k])) {
                             t.earliest_action = turn[i.from].earliest_action;
                             changed = true;
                         }
                     }
                 }
             }
-            bound = runner_bound();
+            bound = runner_bound(&Turn<Time>::earliest_action);
         }
         if (!coupled_.empty()) {
             for (std::size_t k = 0; k < n; ++k) {

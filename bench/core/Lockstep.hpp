@@ -109,10 +109,14 @@ private:
         std::size_t from = 0;
         bool any_change_may_wake = false;
         std::vector<const Pin*> pins;  // pins of the influenced MCU that wake it only when enabled
+        // may_wake() as last worked out (-1: not since the influenced MCU
+        // last ran or reach() saw a change to it; it depends on its registers only).
+        std::int8_t wakes = -1;
     };
     std::size_t index_of(const Mcu& mcu) const;
     bool coupled(const Mcu& a, const Mcu& b) const;
     bool may_wake(const Influence& influence, const Mcu& influenced) const;
+    bool wakes(Influence& influence, const Mcu& influenced) const;  // may_wake, remembered
     template <typename Time>
     Time time_of(std::size_t k, Cycle cycle) const {
         if constexpr (sizeof(Time) == sizeof(Cycle)) return cycle;  // one clock: units are cycles, never is never

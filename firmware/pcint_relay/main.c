@@ -10,6 +10,12 @@
  *     Timer0's overflow does, every 256 * 64 = 16384 cycles (1.024 ms at
  *     16 MHz: TCCR0B CS01|CS00 = clk/64, §15.9.2), and PC0 takes PB1's level
  *     then - up to 1.024 ms late.
+ *   pcint_relay_gated (RELAY_ON_PIN_CHANGE=2): PCINT1 copies as in _wake,
+ *     but Timer0's overflow (every 1.024 ms, as in _poll) opens and closes
+ *     the gate, PCICR.PCIE0, in turn: whether a change of PB1 can wake it
+ *     changes while it runs (the lockstep's remembered wake-ups).
+ *     Changes while the gate is closed are copied when it opens (PCIF0
+ *     stays set, §13.2.5).
  * `copies` counts the copies made.
  */
 #include <avr/interrupt.h>
@@ -42,6 +48,12 @@ ISR(PCINT0_vect)
 {
     copy();
 }
+#if RELAY_ON_PIN_CHANGE == 2
+ISR(TIMER0_OVF_vect)
+{
+    PCICR ^= _BV(PCIE0);
+}
+#endif
 #else
 ISR(TIMER0_OVF_vect)
 {
@@ -55,6 +67,10 @@ int main(void)
 #if RELAY_ON_PIN_CHANGE
     PCMSK0 = _BV(PCINT1);
     PCICR = _BV(PCIE0);
+#if RELAY_ON_PIN_CHANGE == 2
+    TIMSK0 = _BV(TOIE0);
+    TCCR0B = _BV(CS01) | _BV(CS00);
+#endif
 #else
     TIMSK0 = _BV(TOIE0);
     TCCR0B = _BV(CS01) | _BV(CS00);
