@@ -114,21 +114,25 @@ private:
     // a winding current reached zero).
     double step(double h);
     void check_settled();
-    // sin and cos of the electrical angle `e`, remembered for the last state
-    // asked: a step's mode choice and first RK4 stage, its events and the
-    // settled check after it all ask at the same state (the same values as
-    // computing them anew: one function, one argument).
+    // sin and cos of the electrical angle `e`, remembered for the last two
+    // states asked: a step's mode choice and first RK4 stage, its events and
+    // the settled check after it all ask at the same state, and the events
+    // of a blocked winding ask at the step's start and end in turn, once per
+    // blocked winding (the same values as computing them anew: one
+    // function, one argument).
     void sin_cos(double e, double& s, double& c) const {
         // Compared bit for bit: -0.0 == +0.0, but their sines differ in sign.
-        if (std::bit_cast<std::uint64_t>(e) != std::bit_cast<std::uint64_t>(trig_angle_)) {
-            sin_cos_uncached(e, s, c);
-            trig_angle_ = e;
-            trig_sin_ = s;
-            trig_cos_ = c;
-            return;
+        const auto bits = std::bit_cast<std::uint64_t>(e);
+        for (const Trig& t : trig_) {
+            if (bits == std::bit_cast<std::uint64_t>(t.angle)) {
+                s = t.sin;
+                c = t.cos;
+                return;
+            }
         }
-        s = trig_sin_;
-        c = trig_cos_;
+        sin_cos_uncached(e, s, c);
+        trig_[trig_next_] = Trig{e, s, c};
+        trig_next_ ^= 1;
     }
     static void sin_cos_uncached(double e, double& s, double& c) {
         s = std::sin(e);
@@ -154,7 +158,11 @@ private:
     std::uint64_t zero_crossings_ = 0;
     // The caches start at NaN, their values too: sin, cos and tanh of NaN.
     static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    mutable double trig_angle_ = kNaN, trig_sin_ = kNaN, trig_cos_ = kNaN;  // sin_cos
+    struct Trig {
+        double angle, sin, cos;
+    };
+    mutable std::array<Trig, 2> trig_{Trig{kNaN, kNaN, kNaN}, Trig{kNaN, kNaN, kNaN}};  // sin_cos
+    mutable unsigned trig_next_ = 0;                                                    // the one to replace
     mutable double friction_omega_ = kNaN, friction_tanh_ = kNaN;           // friction_shape
 };
 
