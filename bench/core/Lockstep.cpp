@@ -216,9 +216,13 @@ void Lockstep::check_turns(const std::vector<Turn<Time>>& turns) const {
     }
 }
 
+void Lockstep::mark_stale(std::size_t k) {
+    if (k < 64) stale_ |= std::uint64_t{1} << k;
+}
+
 void Lockstep::mark_stale(const Mcu& mcu) {
-    for (std::size_t k = 0; k < mcus_.size() && k < 64; ++k) {
-        if (mcus_[k] == &mcu) stale_ |= std::uint64_t{1} << k;
+    for (std::size_t k = 0; k < mcus_.size(); ++k) {
+        if (mcus_[k] == &mcu) mark_stale(k);
     }
 }
 
@@ -242,16 +246,15 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         // (the runner, or one reach() brought forward) or something outside
         // it changes what it sees (reach() again): only those are looked at
         // again. More than 64 MCUs: every one, every turn.
+        const auto refresh = [&](std::size_t k) {
+            look_at(k, turn[k]);
+            for (Influence& i : influenced_by_[k]) i.wakes = -1;
+        };
         if (n > 64) {
-            for (std::size_t k = 0; k < n; ++k) {
-                look_at(k, turn[k]);
-                for (Influence& i : influenced_by_[k]) i.wakes = -1;
-            }
+            for (std::size_t k = 0; k < n; ++k) refresh(k);
         } else {
             for (std::uint64_t left = n == 64 ? stale_ : stale_ & ((std::uint64_t{1} << n) - 1); left != 0; left &= left - 1) {
-                const auto k = static_cast<std::size_t>(std::countr_zero(left));
-                look_at(k, turn[k]);
-                for (Influence& i : influenced_by_[k]) i.wakes = -1;
+                refresh(static_cast<std::size_t>(std::countr_zero(left)));
             }
         }
         stale_ = 0;
@@ -329,7 +332,7 @@ StopReason Lockstep::run_turns(std::uint64_t end_ps, std::vector<Turn<Time>>& tu
         running_ = &behind;
         const StopReason r = behind.run_until(target);
         running_ = nullptr;
-        if (runner < 64) stale_ |= std::uint64_t{1} << runner;
+        mark_stale(runner);
         if ((r == StopReason::Requested || requested_stop_) && !stopped) {
             // The run ends at the requesting instruction's time: every MCU
             // still behind it (awake ones that did not need to wait, dormant

@@ -104,6 +104,7 @@ private:
     void look_at(std::size_t k, Turn<Time>& t) const;
     template <typename Time>
     void check_turns(const std::vector<Turn<Time>>& turns) const;
+    void mark_stale(std::size_t k);  // MCU k's turn entry is looked at again (every one when more than 64)
     void mark_stale(const Mcu& mcu);
     struct Influence {
         std::size_t from = 0;
