@@ -444,8 +444,12 @@ void parse_serial(const YAML::Node& root, const std::string& path, BoardSpec& sp
                     // has more than 64 KiB of RAM to hold one.
                     s.rx_buffer_bytes = static_cast<unsigned>(parse_integer(value, loc + ": rx_buffer", 1, 65536));
                 } else if (key == "family") {
-                    if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
-                        throw BadInput(loc + ": family '" + value + "' is not grbl, marlin, teacup or generic");
+                    // The serial_host part's choices (stimulus/HostFamily.hpp).
+                    static const std::set<std::string> kFamilies = {"generic", "grbl",     "marlin", "teacup",
+                                                                    "repetier", "sprinter", "prusa"};
+                    if (kFamilies.count(value) == 0) {
+                        throw BadInput(loc + ": family '" + value +
+                                       "' is not generic, grbl, marlin, teacup, repetier, sprinter or prusa");
                     }
                     s.family = value;
                 } else if (key == "line_timeout") {

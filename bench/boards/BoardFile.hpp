@@ -67,7 +67,7 @@ struct SerialDecl {
     int usart = 0;
     std::string flow = "send_and_wait";  // or character_counting
     unsigned rx_buffer_bytes = 128;
-    std::string family = "generic";  // grbl, marlin, teacup, generic (stimulus/UartHost.hpp)
+    std::string family = "generic";  // stimulus/HostFamily.hpp
     double line_timeout_s = 0;       // no answer for this long (keep-alives restart it); 0: the family's
     std::string location;
 };

@@ -15,10 +15,11 @@ class Uart;
 // How a host talks to the firmware behind this connector (the spelling of
 // board files: stimulus/UartHost.hpp parses it).
 struct HostProtocol {
-    std::string family = "generic";      // grbl, marlin, teacup, generic
+    std::string family = "generic";      // stimulus/HostFamily.hpp: grbl, marlin, teacup, ...
     std::string flow = "send_and_wait";  // or character_counting
     unsigned rx_buffer_bytes = 128;      // the firmware's receive buffer (character counting)
     double line_timeout_s = 0;           // 0: the family's
+    std::string error_pattern;           // a regular expression for error lines besides the family's ("": none)
 };
 
 class HostConnector {

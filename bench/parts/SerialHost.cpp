@@ -5,6 +5,7 @@
 #include "core/Errors.hpp"
 #include "core/McuPins.hpp"
 #include "core/Pin.hpp"
+#include "core/TextPattern.hpp"
 #include "core/Uart.hpp"
 #include "parts/PartRegistry.hpp"
 
@@ -21,8 +22,11 @@ std::vector<ParamSpec> SerialHost::param_specs() {
     using D = Dimension;
     return {
         {.name = "family", .type = PT::Choice, .default_value = "generic",
-         .choices = {"generic", "grbl", "marlin", "teacup"},
+         .choices = {"generic", "grbl", "marlin", "teacup", "repetier", "sprinter", "prusa"},
          .help = "what the firmware speaks: its welcome, keep-alives and answers (docs/THIRD_PARTY.md)"},
+        {.name = "error_pattern", .type = PT::Text,
+         .source = "the firmware's documentation of its error messages (its family's own are known: docs/HOSTS.md)",
+         .help = "a regular expression (RE2) for lines the firmware prints on an error, besides its family's"},
         {.name = "flow", .type = PT::Choice, .default_value = "send_and_wait",
          .choices = {"send_and_wait", "character_counting"},
          .help = "one line then its answer, or grbl's character counting"},
@@ -92,6 +96,10 @@ SerialHost::SerialHost(std::string name, Mcu& clock, const ParamValues& params)
     protocol_.flow = params.text("flow");
     protocol_.rx_buffer_bytes = static_cast<unsigned>(params.integer("rx_buffer"));
     protocol_.line_timeout_s = params.quantity("line_timeout");
+    if (params.has("error_pattern")) {
+        protocol_.error_pattern = params.text("error_pattern");
+        (void)TextPattern(protocol_.error_pattern, "part '" + this->name() + "': error_pattern");
+    }
     rx_pin_ = add_pin("rx", TerminalRole::Input);
     tx_pin_ = add_pin("tx", TerminalRole::Output);
 }

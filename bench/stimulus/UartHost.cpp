@@ -1,5 +1,6 @@
 #include "stimulus/UartHost.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -23,30 +24,39 @@ const FindingKind UartHost::kHostProtocol = FindingKind::declare("host-protocol"
 
 namespace {
 
-bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
-
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
+// A line as it goes out: byte for byte as written (a line's length is
+// what a firmware's buffer limits are tested with), but for its comments -
+// "; ..." to the end and "( ... )", an unclosed '(' to the end. The blanks
+// around an inline comment stay; those before a comment that ends the line
+// go with it, as hosts such as Printrun send them. A line of nothing but
+// blanks and comments is no line ("").
 std::string strip_comments(std::string_view raw) {
     std::string out;
     out.reserve(raw.size());
-    bool in_paren = false;
+    bool in_paren = false, comment_at_end = false;
     for (char c : raw) {
         if (in_paren) {
             if (c == ')') in_paren = false;
             continue;
         }
-        if (c == ';') break;
+        if (c == ';') {
+            comment_at_end = true;
+            break;
+        }
         if (c == '(') {
-            in_paren = true;
+            in_paren = comment_at_end = true;
             continue;
         }
+        if (!is_space(c)) comment_at_end = false;
         out.push_back(c);
     }
-    std::size_t begin = 0, end = out.size();
-    while (begin < end && is_space(out[begin])) ++begin;
-    while (end > begin && is_space(out[end - 1])) --end;
-    return out.substr(begin, end - begin);
+    if (comment_at_end) {
+        while (!out.empty() && is_space(out.back())) out.pop_back();
+    }
+    if (std::all_of(out.begin(), out.end(), is_space)) return "";
+    return out;
 }
 
 // Printable form of a transcript text for tail(): control bytes as \xNN.
@@ -149,80 +159,6 @@ std::string_view checked_gcode_text(std::string_view text, const std::string& or
     return text;
 }
 
-const char* to_string(FirmwareFamily family) {
-    switch (family) {
-        case FirmwareFamily::Generic: return "generic";
-        case FirmwareFamily::Grbl: return "grbl";
-        case FirmwareFamily::Marlin: return "marlin";
-        case FirmwareFamily::Teacup: return "teacup";
-    }
-    return "?";
-}
-
-double default_line_timeout_s(FirmwareFamily family) {
-    switch (family) {
-        case FirmwareFamily::Marlin: return 5.0;
-        case FirmwareFamily::Teacup: return 2.5;
-        case FirmwareFamily::Grbl:
-        case FirmwareFamily::Generic: return 2.0;
-    }
-    return 2.0;
-}
-
-FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what) {
-    for (FirmwareFamily f : {FirmwareFamily::Generic, FirmwareFamily::Grbl, FirmwareFamily::Marlin, FirmwareFamily::Teacup}) {
-        if (text == to_string(f)) return f;
-    }
-    throw BadInput(std::string(what) + ": firmware family '" + std::string(text) + "' is not generic, grbl, marlin or teacup");
-}
-
-namespace {
-
-// The family's welcome line (what a reset prints first).
-bool is_welcome(FirmwareFamily family, const std::string& text) {
-    switch (family) {
-        case FirmwareFamily::Grbl: return text.rfind("Grbl ", 0) == 0;
-        case FirmwareFamily::Marlin:
-        case FirmwareFamily::Teacup: return text == "start";
-        case FirmwareFamily::Generic: return false;
-    }
-    return false;
-}
-
-// A firmware that stopped for good: "!!" (Teacup, Repetier, Marlin 2's host
-// protocol), "fatal:" in any case, Marlin's kill() "Error:Printer halted.
-// kill() called!" (it answers nothing after it).
-bool is_fatal(const std::string& text) {
-    auto starts_ci = [&text](const char* p) {
-        const std::size_t n = std::strlen(p);
-        if (text.size() < n) return false;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (std::tolower(static_cast<unsigned char>(text[i])) != p[i]) return false;
-        }
-        return true;
-    };
-    return starts_ci("!!") || starts_ci("fatal:") || starts_ci("error:printer halted");
-}
-
-// Output that answers no line: reports, messages, keep-alives.
-bool is_unsolicited(FirmwareFamily family, const std::string& text) {
-    auto starts = [&text](const char* p) { return text.rfind(p, 0) == 0; };
-    switch (family) {
-        case FirmwareFamily::Grbl:
-            // '>' startup-line results (">G54:ok", ">:error:7"), [MSG:..], [GC:..], <status>.
-            return starts(">") || starts("[") || starts("<") || starts("Grbl ");
-        case FirmwareFamily::Marlin:
-            return starts("echo:") || starts("busy:") || starts("//") || starts("T:") || starts(" T:") ||
-                   starts("B:") || starts("X:") || starts("start");
-        case FirmwareFamily::Teacup:
-            return starts("T:") || starts(" T:") || starts("start");
-        case FirmwareFamily::Generic: return false;
-    }
-    return false;
-}
-
-}  // namespace
-
 UartHost::UartHost(Mcu& mcu, int uart_index, UartHostOptions options)
     : UartHost(mcu, mcu.uart(uart_index), std::move(options)) {}
 
@@ -239,8 +175,7 @@ UartHost::UartHost(Mcu& mcu, SerialLink& link, UartHostOptions options)
         options_.startup = Startup::WaitForBanner;
         if (options_.banner_timeout_s < 10.0) options_.banner_timeout_s = 10.0;  // SD probes take seconds
     }
-    // Marlin's "Error:" is followed by "Resend:" and its own "ok".
-    if (options_.family == FirmwareFamily::Marlin) options_.error_acknowledges = false;
+    for (const std::string& p : options_.error_patterns) error_patterns_.emplace_back(p, "error pattern");
 
     std::weak_ptr<bool> alive = alive_;
     uart_.on_transmit([this, alive](Cycle cycle, std::uint8_t byte) {
@@ -268,7 +203,7 @@ UartHost::UartHost(Mcu& mcu, SerialLink& link, UartHostOptions options)
                 HostEvent e;
                 e.kind = HostEventKind::BannerTimeout;
                 e.cycle = mcu_.cycle();
-                const char* welcome = options_.family == FirmwareFamily::Grbl ? "Grbl X.Y" : "start";
+                const char* welcome = welcome_text(options_.family);
                 e.message = options_.family != FirmwareFamily::Generic
                                 ? std::string("no welcome '") + welcome + "' from the " + to_string(options_.family) +
                                       " firmware within " + seconds_text(options_.banner_timeout_s)
@@ -294,6 +229,7 @@ void UartHost::load_file(const std::string& path) {
     const std::string bytes = read_input_file(path, "G-code file", kMaxGcodeFileBytes);
     auto parsed = parse_gcode(checked_gcode_text(bytes, path), path);
     lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
+    line_errored_.resize(lines_.size(), false);
     pump();
 }
 
@@ -307,6 +243,7 @@ void UartHost::add_lines(std::string_view text) {
     }
     added_raw_lines_ += raw;
     lines_.insert(lines_.end(), std::make_move_iterator(parsed.begin()), std::make_move_iterator(parsed.end()));
+    line_errored_.resize(lines_.size(), false);
     pump();
 }
 
@@ -388,53 +325,79 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     if (!failed_ && !outstanding_.empty()) arm_line_timeout();
 
     const FirmwareFamily family = options_.family;
+    AnswerKind kind = classify_answer(family, text);
+    if (kind == AnswerKind::Text) {
+        for (const TextPattern& p : error_patterns_) {
+            if (p.found_in(text)) {
+                kind = AnswerKind::ErrorNote;
+                break;
+            }
+        }
+    }
     bool answered = false;  // a line acknowledged: the next may go out
     if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) {
         if (family != FirmwareFamily::Generic) {
             // Everything before the welcome is discarded by the firmware's own
             // init anyway (grbl resets its read buffer); after it, wait for quiet.
-            if (is_welcome(family, text)) banner_ = text;
+            if (kind == AnswerKind::Welcome) banner_ = text;
             if (banner_) arm_quiet_timer();
         } else if (options_.banner_contains.empty() || text.find(options_.banner_contains) != std::string::npos) {
             banner_ = text;
             become_ready();
         }
-    } else if (ready_ && is_welcome(family, text)) {
-        HostEvent e = event_at_oldest_line(HostEventKind::Restarted, cycle, text);
-        e.message = "the firmware restarted mid-job (welcome '" + text + "' again" +
-                    (e.line ? ", while line " + std::to_string(e.line->number) + " '" + e.line->text + "' was unanswered)" : ")");
-        fail(std::move(e));
-    } else if (is_unsolicited(family, text)) {
-        // Reports and keep-alives: transcript only.
-    } else if (family == FirmwareFamily::Marlin && starts_with(text, "Resend:")) {
-        resend(cycle, text);
-    } else if (starts_with(text, "ok") && resend_on_next_ok_) {
-        resend_on_next_ok_ = false;
-        const GcodeLine& line = lines_[outstanding_.front().index];
-        transcript_.push_back(TranscriptEntry{cycle, Direction::Sent, line.text, line.number});
-        uart_.send(line.text + "\n");
-    } else if (starts_with(text, "ok")) {
-        ++oks_;
-        answered = acknowledge();
-    } else if (is_fatal(text)) {
-        ++fatals_;
-        HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
-        e.message = "firmware fatal error '" + text + "'" + after_line(e);
-        stop_or_record(options_.stop_on_fatal, std::move(e));
-    } else if (starts_with(text, "error") || starts_with(text, "Error")) {
-        ++errors_;
-        HostEvent e = event_at_oldest_line(HostEventKind::Error, cycle, text);
-        e.message = e.line ? "line " + std::to_string(e.line->number) + " " + quoted_line(e.line->text) + " got '" + text + "'"
-                           : "'" + text + "' with no line outstanding";
-        stop_or_record(options_.stop_on_error, std::move(e));
-        if (options_.error_acknowledges) answered = acknowledge();
-    } else if (starts_with(text, "ALARM")) {
-        ++alarms_;
-        HostEvent e = event_at_oldest_line(HostEventKind::Alarm, cycle, text);
-        e.message = "firmware alarm '" + text + "'" + after_line(e);
-        stop_or_record(options_.stop_on_alarm, std::move(e));
+    } else {
+        switch (kind) {
+            case AnswerKind::Text: break;  // reports, keep-alives, messages: transcript only
+            case AnswerKind::Welcome:
+                if (ready_) {
+                    HostEvent e = event_at_oldest_line(HostEventKind::Restarted, cycle, text);
+                    e.message = "the firmware restarted mid-job (welcome '" + text + "' again" +
+                                (e.line ? ", while line " + std::to_string(e.line->number) + " '" + e.line->text + "' was unanswered)"
+                                        : ")");
+                    fail(std::move(e));
+                }
+                break;
+            case AnswerKind::Resend: resend(cycle, text); break;
+            case AnswerKind::Ok:
+                if (resend_on_next_ok_) {
+                    resend_on_next_ok_ = false;
+                    if (!outstanding_.empty()) {
+                        const std::size_t index = outstanding_.front().index;
+                        // The error that asked for it was about the line as it
+                        // arrived, not as the firmware will take it now.
+                        line_errored_[index] = false;
+                        const GcodeLine& line = lines_[index];
+                        transcript_.push_back(TranscriptEntry{cycle, Direction::Sent, line.text, line.number});
+                        uart_.send(line.text + "\n");
+                    }
+                } else {
+                    ++oks_;
+                    answered = acknowledge();
+                }
+                break;
+            case AnswerKind::Fatal: {
+                ++fatals_;
+                HostEvent e = event_at_oldest_line(HostEventKind::Fatal, cycle, text);
+                e.message = "firmware fatal error '" + text + "'" + after_line(e);
+                stop_or_record(options_.stop_on_fatal, std::move(e));
+                break;
+            }
+            case AnswerKind::Error:
+            case AnswerKind::ErrorNote:
+            case AnswerKind::ResendError:
+                record_error(cycle, text);
+                if (kind == AnswerKind::Error) answered = acknowledge();
+                if (kind == AnswerKind::ResendError) resend(cycle, text);
+                break;
+            case AnswerKind::Alarm: {
+                ++alarms_;
+                HostEvent e = event_at_oldest_line(HostEventKind::Alarm, cycle, text);
+                e.message = "firmware alarm '" + text + "'" + after_line(e);
+                stop_or_record(options_.stop_on_alarm, std::move(e));
+                break;
+            }
+        }
     }
-    // Anything else (echo:, [MSG:...], banners, reports) is transcript only.
 
     // Listeners hear the answer before the next line goes out: a motion
     // judge takes back a refused line's moves before it reads the next.
@@ -443,6 +406,47 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         pump();
         check_finished();
     }
+}
+
+// An error answer is about the line it names (Repetier reports an unknown
+// command when it runs, after the ok it queued it with), else about the
+// oldest unanswered line, else about the line answered last.
+std::optional<std::size_t> UartHost::line_of_error(const std::string& text) const {
+    const std::string named = command_named(text);
+    const auto names = [&](std::size_t index) { return command_word(lines_[index].text) == named; };
+    if (!named.empty()) {
+        for (const Outstanding& o : outstanding_) {
+            if (names(o.index) && !line_errored_[o.index]) return o.index;
+        }
+        // Lines answered already, newest first, a receive buffer's worth back.
+        const std::size_t answered_end = outstanding_.empty() ? next_ : outstanding_.front().index;
+        constexpr std::size_t kLinesLookedBack = 64;  // assumed: deeper than any firmware's command queue
+        for (std::size_t i = answered_end; i > 0 && answered_end - i < kLinesLookedBack; --i) {
+            if (names(i - 1) && !line_errored_[i - 1]) return i - 1;
+        }
+    }
+    if (!outstanding_.empty()) return outstanding_.front().index;
+    if (next_ > 0) return next_ - 1;
+    return std::nullopt;
+}
+
+void UartHost::record_error(Cycle cycle, const std::string& text) {
+    ++errors_;
+    HostEvent e;
+    e.kind = HostEventKind::Error;
+    e.cycle = cycle;
+    e.response = text;
+    if (const auto index = line_of_error(text)) {
+        e.line = lines_[*index];
+        line_errored_[*index] = true;
+    }
+    e.message = e.line ? "line " + std::to_string(e.line->number) + " " + quoted_line(e.line->text) + " got '" + text + "'"
+                       : "'" + text + "' with no line sent";
+    stop_or_record(options_.stop_on_error, std::move(e));
+}
+
+std::size_t UartHost::lines_errored() const {
+    return static_cast<std::size_t>(std::count(line_errored_.begin(), line_errored_.end(), true));
 }
 
 HostEvent UartHost::event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const {

@@ -29,6 +29,8 @@
 
 #include "core/Time.hpp"
 #include "core/SerialLink.hpp"
+#include "core/TextPattern.hpp"
+#include "stimulus/HostFamily.hpp"
 
 namespace avrbench {
 
@@ -55,28 +57,8 @@ enum class Startup {
     FixedDelay,     // wait startup_delay_s of simulated time
 };
 
-// What the firmware on the other end speaks. Each family has its welcome,
-// its unsolicited output and its answers (docs/THIRD_PARTY.md):
-//   grbl    welcome "Grbl X.Y"; '>' startup-line results, '[MSG:', '[GC:',
-//           '<...>' status reports are unsolicited; ok / error:N answer a line
-//   marlin  welcome "start"; "echo:", "busy:", "//" and temperature reports
-//           ("T:...", " T:...") are unsolicited keep-alives; "Error:" is
-//           followed by "Resend: N" and an "ok"
-//   teacup  welcome "start" (and a boot "ok", unsolicited); "T:" reports
-//   generic nothing assumed: sends at once, every line is an answer or text
-enum class FirmwareFamily { Generic, Grbl, Marlin, Teacup };
-const char* to_string(FirmwareFamily family);
-// "generic", "grbl", "marlin", "teacup"; BadInput naming `what` otherwise.
-FirmwareFamily parse_firmware_family(std::string_view text, std::string_view what);
-
-// A family's line timeout: 2.5 times the longest keep-alive period its
-// firmware documents, so a keep-alive arriving on time never races it.
-//   marlin  5 s: busy: every DEFAULT_KEEPALIVE_INTERVAL = 2 s
-//           (HOST_KEEPALIVE_FEATURE, Marlin's Configuration_adv.h)
-//   teacup  2.5 s: "Waiting for target temp" every second while M116 waits
-//   grbl    2 s: the host's own '?' every 250 ms brings a report (assumed)
-//   generic 2 s (assumed: no keep-alives known)
-double default_line_timeout_s(FirmwareFamily family);
+// What the firmware on the other end speaks (its welcome, unsolicited
+// output and answers): stimulus/HostFamily.hpp, docs/HOSTS.md.
 
 struct UartHostOptions {
     FlowControl flow = FlowControl::SendAndWait;
@@ -108,9 +90,11 @@ struct UartHostOptions {
     std::string banner_contains;     // WaitForBanner: empty = the first line, whatever it says
     double banner_timeout_s = 2.0;   // WaitForBanner: give up (failed) after this long
     double startup_delay_s = 0.0;    // FixedDelay
-    // Does "error..." answer a line? grbl: yes (error:N replaces ok). Marlin
-    // follows its "Error:" with "Resend:" and its own "ok": set false there.
-    bool error_acknowledges = true;
+    // Lines the firmware prints that are errors besides its family's own
+    // (stimulus/HostFamily.hpp): RE2 patterns searched in every line that
+    // answers nothing else. Such a line is an error about the oldest
+    // unanswered line (or the last answered one); it answers no line itself.
+    std::vector<std::string> error_patterns;
     bool stop_on_error = false;  // stop streaming (failed) at the first error
     bool stop_on_alarm = true;   // grbl ALARM:N stops streaming (failed)
     // A fatal message stops streaming (failed): "!!" (Teacup, Repetier,
@@ -134,10 +118,12 @@ struct GcodeLine {
 // bytes as \xNN.
 std::string quoted_line(const std::string& text);
 
-// Strips "; ..." to the end of the line and "( ... )" comments (an unclosed
-// '(' runs to the end of the line), leading and trailing whitespace, and
-// drops the lines left empty. Accepts "\n", "\r\n" and lone "\r" line ends.
-// `first_number` is the number of the first line of `text`.
+// The job's lines, each sent byte for byte as written (leading and
+// trailing blanks included) but for its comments: "; ..." to the end of
+// the line and "( ... )" (an unclosed '(' runs to the end), each with the
+// blanks before it. Lines left blank are dropped. Accepts "\n", "\r\n"
+// and lone "\r" line ends. `first_number` is the number of the first line
+// of `text`.
 std::vector<GcodeLine> parse_gcode(std::string_view text, const std::string& origin, std::size_t first_number = 1);
 
 // A job file's bytes checked as text before streaming: a UTF-16 file, a NUL
@@ -238,7 +224,12 @@ public:
 
     // --- answers -----------------------------------------------------------
     std::size_t oks() const { return oks_; }
+    // Error answers (each family's, docs/HOSTS.md), counted as they come.
     std::size_t errors() const { return errors_; }
+    // Job lines an error answer was about (a line the firmware asked for
+    // again and then took is not among them).
+    std::size_t lines_errored() const;
+    bool line_errored(std::size_t index) const { return index < line_errored_.size() && line_errored_[index]; }
     std::size_t resends() const { return resends_; }
     std::size_t status_polls() const { return status_polls_; }  // grbl '?' sent as keep-alive queries
     // Answers that came with no line outstanding (a boot "ok", say).
@@ -274,6 +265,8 @@ public:
 private:
     // An event about the oldest unanswered line (if any), with the firmware's answer.
     HostEvent event_at_oldest_line(HostEventKind kind, Cycle cycle, const std::string& response) const;
+    std::optional<std::size_t> line_of_error(const std::string& text) const;
+    void record_error(Cycle cycle, const std::string& text);
     static std::string after_line(const HostEvent& event);  // " after line N 'text'" or ""
     void stop_or_record(bool stop, HostEvent event);
 
@@ -317,6 +310,8 @@ private:
     std::shared_ptr<bool> alive_;  // callbacks held by the Uart and the Scheduler check it
 
     std::vector<GcodeLine> lines_;
+    std::vector<bool> line_errored_;  // per line of lines_
+    std::vector<TextPattern> error_patterns_;
     std::size_t next_ = 0;           // next line to send
     std::size_t timed_bytes_pending_ = 0;  // send_bytes_at() calls not yet due
     std::size_t acknowledged_ = 0;

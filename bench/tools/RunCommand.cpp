@@ -65,6 +65,7 @@ struct RunArgs {
     std::string report;
     std::string profile;  // --profile: the timing profile as JSON
     std::string family;        // --family: overrides the board's
+    std::vector<std::string> error_patterns;  // --error-pattern: besides the family's error lines
     std::string line_timeout;  // --line-timeout: overrides the board's
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
     bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
@@ -201,6 +202,7 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
         g.raw_bytes = args.gcode_bytes;
         g.flow = args.flow;
         g.family = args.family;
+        g.error_patterns = args.error_patterns;
         g.line_timeout = args.line_timeout;
         g.wait_banner = args.wait_banner;
         for (const auto& item : args.realtime) g.realtime.push_back(parse_realtime_bytes(item, "--realtime"));
@@ -344,7 +346,11 @@ Command add_run_command(CLI::App& app) {
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");
     run_cmd->add_flag("--wait-banner", run.wait_banner, "send the job only after the firmware's first output line");
     run_cmd->add_option("--family", run.family,
-                        "grbl | marlin | teacup | generic: the firmware's protocol on the --host port (default: the board's)");
+                        "grbl | marlin | prusa | teacup | repetier | sprinter | generic: the firmware's protocol on the "
+                        "--host port, its welcome and error answers (default: the board's; docs/HOSTS.md)");
+    run_cmd->add_option("--error-pattern", run.error_patterns,
+                        "REGEX (RE2): a line the firmware prints that is an error, besides its family's own "
+                        "(repeatable; needs --gcode)");
     run_cmd->add_option("--line-timeout", run.line_timeout,
                         "a line unanswered this long with no output at all is a timeout (default: the board's, else the family's: marlin 5s, teacup 2.5s, grbl and generic 2s; never under 2.5 times the keep-alive period seen)");
     run_cmd->add_option("--realtime", run.realtime,

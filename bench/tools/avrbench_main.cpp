@@ -38,7 +38,7 @@ Command add_fuzz_command(CLI::App& app) {
                          "(libFuzzer -runs, AFL++ -E)");
     fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");
     fuzz_cmd->add_option("--out", fuzz.out, "corpus, reproducers, runs and the libFuzzer log (default fuzz-out)");
-    fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, teacup, generic (default: the board's)");
+    fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, prusa, teacup, repetier, sprinter, generic (default: the board's)");
     fuzz_cmd->add_flag("--hang", fuzz.hang, "a line still unanswered when --bound ends is a finding, keep-alives or not");
     fuzz_cmd->add_flag("--raw", fuzz.raw, "send the input's bytes to the port as they are (binary protocols such as seed 002's records)");
     fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw: simulated time the firmware boots before the first input (default 0.2s)");

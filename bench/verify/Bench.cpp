@@ -87,6 +87,7 @@ UartHostOptions default_host_options(const SerialPort& port) {
     o.rx_buffer_bytes = p.rx_buffer_bytes;
     o.family = parse_firmware_family(p.family, port.location);
     o.line_timeout_s = p.line_timeout_s;
+    if (!p.error_pattern.empty()) o.error_patterns.push_back(p.error_pattern);
     return o;
 }
 
@@ -225,13 +226,9 @@ void Bench::follow_sent_lines(UartHost& host) {
         if (host.lines_acknowledged() == *acknowledged) return;
         *acknowledged = host.lines_acknowledged();
         const GcodeLine& line = host.lines()[*acknowledged - 1];
-        // Refused: answered with an error, or (Marlin) an "Error:" line
-        // before the "ok" that frees the slot.
-        bool refused = entry.text.rfind("ok", 0) != 0;
-        for (auto e = host.events().rbegin(); !refused && e != host.events().rend(); ++e) {
-            if (e->line && e->line->number < line.number) break;
-            refused = e->kind == HostEventKind::Error && e->line && e->line->number == line.number;
-        }
+        // Refused: answered with an error, or with an error before its ok
+        // (Marlin's "Error:" or "echo:Unknown command", Teacup's "E:").
+        const bool refused = entry.text.rfind("ok", 0) != 0 || host.line_errored(*acknowledged - 1);
         for (auto& feed : *feeds) feed.answered(line, refused);
     });
 }
@@ -256,7 +253,7 @@ void Bench::check_accepted_moves(UartHost& host) {
         if (acknowledged == seen->acknowledged) return;
         seen->acknowledged = acknowledged;
         const GcodeLine& line = host.lines()[acknowledged - 1];
-        if (entry.text.rfind("ok", 0) != 0) {
+        if (entry.text.rfind("ok", 0) != 0 || host.line_errored(acknowledged - 1)) {
             // An error: the firmware did not take the line (its axes stay as
             // they were). A refused target no robot reaches either is a
             // right answer, not a finding (findings() leaves it out).

@@ -1,5 +1,7 @@
 #include "verify/BoardRun.hpp"
 
+#include "core/TextPattern.hpp"
+
 #include <cctype>
 #include <chrono>
 #include <cstdio>
@@ -174,6 +176,10 @@ void BoardRun::start_gcode_job() {
     UartHostOptions o = default_host_options(decl);
     if (!job.flow.empty()) o.flow = parse_flow_control(job.flow, "--flow");
     if (!job.family.empty()) o.family = parse_firmware_family(job.family, "--family");
+    for (const std::string& p : job.error_patterns) {
+        (void)TextPattern(p, "--error-pattern");
+        o.error_patterns.push_back(p);
+    }
     if (!job.line_timeout.empty()) {
         o.line_timeout_s = seconds_from_ps(parse_duration_ps(job.line_timeout, "--line-timeout"));
         if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");

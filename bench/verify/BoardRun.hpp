@@ -52,6 +52,7 @@ struct BoardRunOptions {
         std::string path;
         bool raw_bytes = false;  // the file's bytes as lines, binary bytes included (fuzz reproducers)
         std::string flow, family, line_timeout;  // overrides of the port's declaration ("" = the board's)
+        std::vector<std::string> error_patterns;  // besides the family's and the board's
         bool wait_banner = false;
         std::vector<std::pair<Picoseconds, std::string>> realtime;  // bytes sent outside the line stream
     };

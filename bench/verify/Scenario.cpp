@@ -1,5 +1,7 @@
 #include "verify/Scenario.hpp"
 
+#include "core/TextPattern.hpp"
+
 #include "trace/WaveformFiles.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -11,6 +13,7 @@
 
 #include "boards/BoardFile.hpp"
 #include "boards/YamlKeys.hpp"
+#include "stimulus/HostFamily.hpp"
 #include "core/Errors.hpp"
 #include "core/VectorNames.hpp"
 #include "core/Finding.hpp"
@@ -402,23 +405,24 @@ void scenario_firmware(ScenarioSpec& spec, const BoardSpec& board, const YAML::N
     }
 }
 
-// `host: {family, line_timeout}`.
+// `host: {family, line_timeout, error_pattern}`.
 void scenario_host(ScenarioSpec& spec, const YAML::Node& host, const BoardNames& names, const std::string& path) {
-    if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout}");
+    if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout, error_pattern}");
     names.check_serial("host", where(path, host));
     for (const auto& kv : host) {
         const std::string key = scalar(kv.first, path, "host key");
         const std::string value = scalar(kv.second, path, key);
         if (key == "family") {
-            if (value != "generic" && value != "grbl" && value != "marlin" && value != "teacup") {
-                throw BadInput(where(path, kv.second) + ": family '" + value + "' is not grbl, marlin, teacup or generic");
-            }
+            (void)parse_firmware_family(value, where(path, kv.second));
             spec.host_family = value;
+        } else if (key == "error_pattern") {
+            (void)TextPattern(value, where(path, kv.second) + ": error_pattern");
+            spec.host_error_pattern = value;
         } else if (key == "line_timeout") {
             spec.host_line_timeout_ps = parse_duration_ps(value, where(path, kv.second) + ": line_timeout");
             if (*spec.host_line_timeout_ps == 0) throw BadInput(where(path, kv.second) + ": line_timeout must be longer than 0");
         } else {
-            throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout)");
+            throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout, error_pattern)");
         }
     }
 }

@@ -86,6 +86,7 @@ struct ScenarioSpec {
     // `host: {family, line_timeout}`: the first serial port's host, instead of
     // what the board file declares (e.g. our own firmware on a grbl board).
     std::optional<std::string> host_family;
+    std::optional<std::string> host_error_pattern;  // besides the family's error lines
     std::optional<Picoseconds> host_line_timeout_ps;
     // Paths of send_file steps, resolved.
     std::vector<std::string> stimulus_files() const;

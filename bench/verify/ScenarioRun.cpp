@@ -547,9 +547,10 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     if (options.update_golden && !spec.golden_path.empty()) check_golden_writable(spec);
     Bench bench(spec.board_path, spec.firmware);
     bind(spec, bench);
-    if (spec.host_family || spec.host_line_timeout_ps) {
+    if (spec.host_family || spec.host_line_timeout_ps || spec.host_error_pattern) {
         UartHostOptions o = default_host_options(bench.serial_port());
         if (spec.host_family) o.family = parse_firmware_family(*spec.host_family, spec.path);
+        if (spec.host_error_pattern) o.error_patterns.push_back(*spec.host_error_pattern);
         if (spec.host_line_timeout_ps) o.line_timeout_s = seconds_from_ps(*spec.host_line_timeout_ps);
         bench.host("", o);
     }

@@ -2,7 +2,8 @@
  * host_peer - the serial protocol of a printer/CNC firmware family, as its
  * documentation and sources describe it, without the machine behind it:
  * what the bench's UART host must cope with. USART0 at 115200 baud (U2X0,
- * UBRR0 = 16), polled. One build per family (-DFAMILY_GRBL/_MARLIN/_TEACUP).
+ * UBRR0 = 16), polled. One build per family (-DFAMILY_GRBL/_MARLIN/_PRUSA/
+ * _TEACUP/_SPRINTER/_REPETIER).
  *
  * grbl 1.1 (doc/markdown/interface.md; on a blank EEPROM): before its
  *   welcome it reports the EEPROM error and its settings ("error:7",
@@ -25,8 +26,26 @@
  *   Configuration_adv.h): the next line waits unanswered in the meantime.
  *   "KILL" prints "Error:Printer halted. kill() called!" and "FATAL" prints
  *   "fatal:Homing failed!" - then either halts for good, answering nothing.
+ *   A line it does not know ("M9999", "G5 ...": it knows G0-G4, G28,
+ *   G90-G92, M104-M114) gets `echo:Unknown command: "<line>"` before its ok
+ *   (Marlin_main.cpp, MSG_UNKNOWN_COMMAND, then ClearToSend()).
+ * Prusa-Firmware (MK3S, Marlin_main.cpp): Marlin's, but an unknown G or M
+ *   code is "Unknown G code: <line>" (MSG_UNKNOWN_CODE "Unknown %c code:
+ *   %s") before the ok.
  * Teacup: "start" and a boot "ok"; each line "ok"; "M116" waits 5 s in
- *   silence, then "ok".
+ *   silence, then "ok"; an unknown G or M code gets "E: Bad G-code <n>" /
+ *   "E: Bad M-code <n>" before the ok (gcode_process.c); "*99" (a bad
+ *   checksum) gets "rs N1 Expected checksum 17" and the ok the first time
+ *   (gcode_parse.c: the line is not run).
+ * Sprinter: "start"; each line "ok"; an unknown G or M code gets
+ *   "Unknown G-COM:<line>" / "Unknown M-COM:<line>" before the ok
+ *   (Sprinter.pde with SEND_WRONG_CMD_INFO); "*99" gets "Serial Error: Line
+ *   Number is not Last Line Number+1, Last Line:0", "Resend:1" and "ok" the
+ *   first time (FlushSerialRequestResend).
+ * Repetier 1.0: "start"; each line "ok" as soon as it is queued; an unknown
+ *   command is reported when it runs, after that ok, as "Unknown command:
+ *   M9999 " (Commands.cpp, GCode::printCommand); "wait" when idle a second
+ *   (WAITING_IDENTIFIER).
  */
 #include <avr/io.h>
 #include <avr/pgmspace.h>
@@ -105,6 +124,29 @@ static void read_line(void)
     }
 }
 
+/* The commands the printer families know here: G0-G4, G28, G90-G92,
+ * M104-M114; any other G or M number is unknown. */
+__attribute__((unused)) static uint8_t known_command(void)
+{
+    const char *p = line;
+    if (*p == 'N') {
+        while (*p != '\0' && *p != ' ') ++p;
+        while (*p == ' ') ++p;
+    }
+    if (*p != 'G' && *p != 'M') return 1; /* not a G or M line: nothing to refuse */
+    const int n = atoi(p + 1);
+    if (*p == 'G') return n <= 4 || n == 28 || (n >= 90 && n <= 92);
+    return n >= 104 && n <= 114;
+}
+
+/* "Unknown command: "<line>"" and friends: the prefix, then the line. */
+__attribute__((unused)) static void say_unknown(const char *prefix, const char *suffix)
+{
+    print_P(prefix);
+    for (const char *p = line; *p != '\0'; ++p) put(*p);
+    print_P(suffix);
+}
+
 __attribute__((unused)) static void discard_input(void)
 {
     while (bit_is_set(UCSR0A, RXC0)) (void)UDR0;
@@ -139,7 +181,7 @@ int main(void)
         if (strncmp_P(line, PSTR("BUSY"), 4) == 0) busy(atol(line + 4));
         SAY("ok");
     }
-#elif defined(FAMILY_MARLIN)
+#elif defined(FAMILY_MARLIN) || defined(FAMILY_PRUSA)
     SAY("start");
     SAY("echo:Marlin 1.1.9");
     SAY("echo: Last Updated: 2018-08-01 | Author: (none, default config)");
@@ -175,18 +217,58 @@ int main(void)
             checksum_failed = 1;
             SAY("Error:checksum mismatch, Last Line: 0");
             SAY("Resend: 1");
+        } else if (!known_command()) {
+#if defined(FAMILY_PRUSA)
+            print_P(PSTR("Unknown "));
+            put(line[0]);
+            say_unknown(PSTR(" code: "), PSTR("\r\n"));
+#else
+            say_unknown(PSTR("echo:Unknown command: \""), PSTR("\"\r\n"));
+#endif
         }
         SAY("ok");
     }
 #elif defined(FAMILY_TEACUP)
     SAY("start");
     SAY("ok");
+    uint8_t checksum_failed = 0;
     for (;;) {
         read_line();
         if (strncmp_P(line, PSTR("M116"), 4) == 0) _delay_ms(5000);
+        if (strstr_P(line, PSTR("*99")) != 0 && !checksum_failed) {
+            checksum_failed = 1;
+            SAY("rs N1 Expected checksum 17");
+        } else if (!known_command()) {
+            print_P(line[0] == 'G' ? PSTR("E: Bad G-code ") : PSTR("E: Bad M-code "));
+            const char *n = line + 1;
+            while (*n >= '0' && *n <= '9') put(*n++);
+            print_P(PSTR("\r\n"));
+        }
         SAY("ok");
     }
+#elif defined(FAMILY_SPRINTER)
+    SAY("start");
+    uint8_t checksum_failed = 0;
+    for (;;) {
+        read_line();
+        if (strstr_P(line, PSTR("*99")) != 0 && !checksum_failed) {
+            checksum_failed = 1;
+            SAY("Serial Error: Line Number is not Last Line Number+1, Last Line:0");
+            SAY("Resend:1");
+        } else if (!known_command()) {
+            say_unknown(line[0] == 'G' ? PSTR("Unknown G-COM:") : PSTR("Unknown M-COM:"), PSTR("\r\n"));
+        }
+        SAY("ok");
+    }
+#elif defined(FAMILY_REPETIER)
+    SAY("start");
+    for (;;) {
+        read_line();
+        SAY("ok"); /* queued */
+        _delay_ms(2); /* ... and run */
+        if (!known_command()) say_unknown(PSTR("Unknown command:"), PSTR(" \r\n"));
+    }
 #else
-#error "build with FAMILY_GRBL, FAMILY_MARLIN or FAMILY_TEACUP"
+#error "build with FAMILY_GRBL, _MARLIN, _PRUSA, _TEACUP, _SPRINTER or _REPETIER"
 #endif
 }

@@ -6,7 +6,7 @@ W5
 L45 (45 us low: 20 kHz with W5)
 
 X10
-X-10   
+X-10
 Y20
 Z-5 (down)
 ?
