@@ -17,6 +17,14 @@ namespace avrbench {
 // (a line it could not read, a relative move from an unknown place) is empty.
 using AxisPositions = std::array<std::optional<double>, 3>;
 
+// How a firmware draws an arc: straight segments whose chords stray from
+// the circle by at most `tolerance_mm` (grbl's $12 arc_tolerance), or
+// segments `segment_mm` long (Marlin's MM_PER_ARC_SEGMENT); 0: exact.
+struct ArcRule {
+    double tolerance_mm = 0;
+    double segment_mm = 0;
+};
+
 struct CommandedMove {
     enum class Kind {
         Rapid,            // G0: travel, the tool lifted
@@ -29,6 +37,7 @@ struct CommandedMove {
     AxisPositions from_mm{};
     AxisPositions to_mm{};
     std::array<double, 2> centre_mm{};  // arcs: X, Y of the centre
+    ArcRule arc_rule;                   // arcs: how the firmware draws them
     std::array<bool, 3> homed{};        // Home: the axes it homes
     std::string line;                   // "line 7 'G2 X60 Y50 I0 J-10'", for findings
 };

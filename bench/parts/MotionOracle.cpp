@@ -109,7 +109,7 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
                                e.on_move([this](const Eigen::Vector3d&) { on_carriage(); });
                            });
     require_port<ToolContact>("tool", false, "the pen (a pen_lift's tool)", [this](ToolContact& t) { tool_ = &t; });
-    add_readout("moves_judged", [this] { return static_cast<double>(moves_judged_); });
+    add_readout("moves_judged", [this] { return static_cast<double>(moves_judged_now()); });
     add_readout("judging", [this] { return lost_ ? 0.0 : 1.0; });
 }
 
@@ -143,7 +143,32 @@ void MotionOracle::start() {
         if (carriages_[k] != nullptr) finest_step = std::min(finest_step, carriages_[k]->step_mm());
     }
     rest_jitter_mm_ = finest_step / 2;
+    // A step motor's carriage stands only on its step grid: every axis is up
+    // to one step off the ideal line, so the tool up to the diagonal of one
+    // step of each (grbl's 1/250 mm steps made 0.100-0.104 mm "deviations"
+    // of a 0.1 mm tolerance). An effector (servos) has no grid.
+    double quantum2 = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (carriages_[k] != nullptr) quantum2 += carriages_[k]->step_mm() * carriages_[k]->step_mm();
+    }
+    step_quantum_mm_ = std::sqrt(quantum2);
 }
+
+namespace {
+
+// How far a firmware's straight segments stray from a circle of radius r:
+// the sagitta of one chord, r (1 - cos(theta / 2)) for a segment of angle
+// theta = segment / r (at most half the circle), or its stated tolerance.
+double chord_error_mm(const ArcRule& rule, double radius_mm) {
+    double error = rule.tolerance_mm;
+    if (rule.segment_mm > 0 && radius_mm > 0) {
+        const double half_angle = std::min(std::numbers::pi / 2, rule.segment_mm / (2 * radius_mm));
+        error = std::max(error, radius_mm * (1 - std::cos(half_angle)));
+    }
+    return error;
+}
+
+}  // namespace
 
 bool MotionOracle::Tracked::drawing() const {
     return !barrier && (kind == CommandedMove::Kind::Feed || kind == CommandedMove::Kind::ArcClockwise ||
@@ -230,6 +255,7 @@ void MotionOracle::commanded(const CommandedMove& move) {
         }
     }
     if (!arc || t.kind == CommandedMove::Kind::Feed) t.length = (t.to - t.from).norm();
+    t.tolerance = path_tolerance_mm_ + step_quantum_mm_ + (arc ? chord_error_mm(move.arc_rule, t.radius) : 0.0);
     const bool z_and_xy = t.from.z() != t.to.z() && (t.from.head<2>() - t.to.head<2>()).norm() > 0;
     if (z_before_xy_ && z_and_xy && !arc && !home) {
         Tracked z_alone = t;
@@ -311,7 +337,7 @@ void MotionOracle::observe(Tracked& m, const Eigen::Vector3d& p, Cycle now) {
         m.worst_cycle = now;
         // Told at once (a fuzzer's input ends at its first finding), then
         // again each time it grows by a micrometre.
-        if (m.worst > path_tolerance_mm_ && m.worst > m.deviation_told + 1e-3) {
+        if (m.worst > m.tolerance && m.worst > m.deviation_told + 1e-3) {
             m.deviation_told = m.worst;
             tell(m.deviation_finding, kPathDeviation, deviation_text(m));
         }
@@ -396,7 +422,7 @@ std::string MotionOracle::seconds_text(Cycle cycle) const {
 std::string MotionOracle::deviation_text(const Tracked& m) const {
     const bool arc = m.kind == CommandedMove::Kind::ArcClockwise || m.kind == CommandedMove::Kind::ArcCounterClockwise;
     return m.line + ": the tool strays " + mm_text(m.worst) + " mm from the commanded " + (arc ? "arc" : "line") +
-           " (tolerance " + mm_text(path_tolerance_mm_) + " mm), at " + firmware_text(m, m.worst_at) + " at " +
+           " (tolerance " + mm_text(m.tolerance) + " mm), at " + firmware_text(m, m.worst_at) + " at " +
            seconds_text(m.worst_cycle);
 }
 
@@ -524,6 +550,29 @@ std::vector<Finding> MotionOracle::pending_findings() const {
     return out;
 }
 
+std::string MotionOracle::still_going() const {
+    if (lost_ || moves_.empty() || moves_.front().barrier) return "";
+    const Tracked& cur = moves_.front();
+    const Eigen::Vector3d p = tool_position();
+    const bool begun = cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached;
+    if (clock().cycle() < last_move_cycle_ + rest_cycles_) {
+        // Moving (or within rest_time of it): on its way through the moves.
+        if (cur.end_reached && moves_.size() == 1) return "";
+        return cur.line + " under way (the tool at " + firmware_text(cur, p) + ", its end " + firmware_text(cur, cur.to) + ")";
+    }
+    // At rest: a move begun and left short was judged there (rest_verdict);
+    // one not begun may yet begin (a firmware waiting for its heater first).
+    const std::size_t first = begun ? 1 : 0;
+    if (first >= moves_.size() || moves_[first].barrier) return "";
+    const Tracked& next = moves_[first];
+    std::string text = next.line + " accepted and not begun (the tool at rest at " + firmware_text(next, p) + ", the move to " +
+                       firmware_text(next, next.to) + ")";
+    const std::size_t more = static_cast<std::size_t>(
+        std::count_if(moves_.begin() + static_cast<std::ptrdiff_t>(first) + 1, moves_.end(), [](const Tracked& m) { return !m.barrier; }));
+    if (more > 0) text += ", " + std::to_string(more) + " more after it";
+    return text;
+}
+
 std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cycle now) const {
     if (lost_ || moves_.empty() || moves_.front().barrier) return std::nullopt;
     const Tracked& cur = moves_.front();
@@ -543,10 +592,32 @@ std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cy
     return make_finding(kMoveEndMissed, now, detail);
 }
 
+std::size_t MotionOracle::moves_judged_now() const {
+    std::size_t judged = moves_judged_;
+    if (lost_ || moves_.empty() || moves_.front().barrier) return judged;
+    const Tracked& cur = moves_.front();
+    const Eigen::Vector3d p = tool_position();
+    const Cycle now = clock().cycle();
+    const bool at_rest = now >= last_move_cycle_ + rest_cycles_;
+    // The cursor's move is judged once it reached its end, or the machine
+    // came to rest anywhere but at its start (a rest verdict was given).
+    const bool cursor_judged =
+        cur.end_reached || cur.rest_reported || (at_rest && rest_judged_ && !ends_within(cur, p, cur.from));
+    if (cursor_judged) ++judged;
+    // The moves a finished job left unmade are judged together (unmade_verdict).
+    const Cycle settle = std::min(rest_cycles_, clock().cycles_from_seconds(0.025));
+    if (job_answered_ && job_answered_() && now >= last_move_cycle_ + settle) {
+        for (std::size_t i = cursor_judged ? 1 : 0; i < moves_.size() && !moves_[i].barrier && !moves_[i].after_dwell; ++i) {
+            ++judged;
+        }
+    }
+    return judged;
+}
+
 std::string MotionOracle::summary() {
-    std::size_t found = findings().size();
+    const std::size_t found = findings().size() + pending_findings().size();
     char line[200];
-    std::snprintf(line, sizeof line, "oracle     %s: %zu moves judged, %zu findings", name().c_str(), moves_judged_, found);
+    std::snprintf(line, sizeof line, "oracle     %s: %zu moves judged, %zu findings", name().c_str(), moves_judged_now(), found);
     std::string text = line;
     if (lost_) text += "; stopped judging: " + lost_why_;
     return text;

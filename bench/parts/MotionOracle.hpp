@@ -63,6 +63,9 @@ public:
     void start() override;
     std::string summary() override;
     std::vector<Finding> pending_findings() const override;
+    // An accepted move the machine is making or has not begun: the run is
+    // not done. A move begun and left short at rest is judged, not waited for.
+    std::string still_going() const override;
 
     void commanded(const CommandedMove& move) override;
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;
@@ -73,7 +76,7 @@ public:
     void dwell() override { dwell_pending_ = true; }
 
     // For tests and front ends: moves judged so far, and whether judging stopped.
-    std::size_t moves_judged() const { return moves_judged_; }
+    std::size_t moves_judged() const { return moves_judged_now(); }
     bool judging() const { return !lost_; }
 
 private:
@@ -91,6 +94,9 @@ private:
         Eigen::Vector2d centre = Eigen::Vector2d::Zero();
         double radius = 0, start_rad = 0, sweep_rad = 0;
         double length = 0;     // mm along the path
+        // How far the tool may stray: the board's path_tolerance, the
+        // machine's step quantum and, for an arc, the firmware's chords.
+        double tolerance = 0;
         // What the tool did on it.
         double progress = 0;   // mm along the path, as far as it came
         bool end_reached = false;
@@ -133,6 +139,8 @@ private:
     // At the end of a run whose job was all answered, with the machine at
     // rest: the first move it never made (and how many more), if any.
     std::optional<Finding> unmade_verdict(const Eigen::Vector3d& p, Cycle now) const;
+    // Moves left behind by the cursor, and those judged where they stand.
+    std::size_t moves_judged_now() const;
     bool ends_within(const Tracked& m, const Eigen::Vector3d& p, const Eigen::Vector3d& target) const;
     Finding make_finding(FindingKind kind, Cycle cycle, std::string detail) const;
     std::string firmware_text(const Tracked& m, const Eigen::Vector3d& carriage_mm) const;
@@ -144,6 +152,7 @@ private:
     bool dwell_pending_ = false;  // a G4 since the last move commanded
     ToolContact* tool_ = nullptr;
     double path_tolerance_mm_;
+    double step_quantum_mm_ = 0;  // the diagonal of one step on every axis: a DDA's worst distance from a line
     std::optional<double> end_tolerance_mm_;
     bool rapids_straight_;
     bool feeds_straight_;

@@ -69,6 +69,19 @@ double default_line_timeout_s(FirmwareFamily family) {
     return 2.0;
 }
 
+FamilyArcs family_arcs(FirmwareFamily family) {
+    switch (family) {
+        case FirmwareFamily::Grbl: return {0.002, 0};  // grbl defaults.h: DEFAULT_ARC_TOLERANCE 0.002 (mm)
+        case FirmwareFamily::Marlin:                    // Marlin 1.0 Configuration_adv.h: MM_PER_ARC_SEGMENT 1
+        case FirmwareFamily::Prusa:                     // (Marlin 1.1 and Prusa-Firmware keep it)
+        case FirmwareFamily::Sprinter:                  // Sprinter Configuration.h: MM_PER_ARC_SEGMENT 1
+        case FirmwareFamily::Repetier: return {0, 1.0};  // Repetier.h: MM_PER_ARC_SEGMENT 1
+        case FirmwareFamily::Teacup:                     // no G2/G3 ("E: Bad G-code 2")
+        case FirmwareFamily::Generic: return {};
+    }
+    return {};
+}
+
 const char* welcome_text(FirmwareFamily family) { return family == FirmwareFamily::Grbl ? "Grbl X.Y" : "start"; }
 
 const char* to_string(AnswerKind kind) {

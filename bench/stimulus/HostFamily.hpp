@@ -55,6 +55,15 @@ std::string command_named(std::string_view error_line);
 // A line's own first G/M/T/D word ("G1" of "N12 G1 X10*91"), "" for none.
 std::string command_word(std::string_view gcode_line);
 
+// How the family's firmware draws G2/G3 arcs by default: chords within
+// `tolerance_mm` of the circle (grbl's $12), or segments `segment_mm` long
+// (MM_PER_ARC_SEGMENT); both 0 where it draws none or is unknown.
+struct FamilyArcs {
+    double tolerance_mm = 0;
+    double segment_mm = 0;
+};
+FamilyArcs family_arcs(FirmwareFamily family);
+
 // The family's welcome as messages show it ("Grbl X.Y", "start").
 const char* welcome_text(FirmwareFamily family);
 

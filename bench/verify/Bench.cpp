@@ -158,7 +158,10 @@ namespace {
 // lines read again; where the judge cannot (the machine began one of those
 // moves) or a G92 is among them, the judge stops.
 struct SentLineFeed {
-    explicit SentLineFeed(CommandedMoves& j) : judge(&j), path(j) {}
+    SentLineFeed(CommandedMoves& j, FirmwareFamily family) : judge(&j), path(j) {
+        const FamilyArcs arcs = family_arcs(family);
+        path.set_arc_rule({arcs.tolerance_mm, arcs.segment_mm});
+    }
     CommandedMoves* judge;
     CommandedPath path;
     struct Unanswered {
@@ -212,7 +215,7 @@ void Bench::judge_job_by(const std::function<bool()>& all_answered) const {
 
 void Bench::follow_sent_lines(UartHost& host) {
     auto feeds = std::make_shared<std::vector<SentLineFeed>>();
-    for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge);
+    for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge, host.options().family);
     if (feeds->empty()) return;
     judge_job_by([&host] { return host.done(); });
     auto last_sent = std::make_shared<std::size_t>(0);

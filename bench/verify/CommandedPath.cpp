@@ -128,6 +128,7 @@ void CommandedPath::move(int code, const std::array<std::optional<double>, 3>& w
              : code == 2 ? CommandedMove::Kind::ArcClockwise
                          : CommandedMove::Kind::ArcCounterClockwise;
     m.line = quoted;
+    m.arc_rule = arc_rule_;
     m.from_mm = position_mm_;
     for (std::size_t k = 0; k < 3; ++k) {
         if (!words_mm[k]) {

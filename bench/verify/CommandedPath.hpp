@@ -30,6 +30,8 @@ public:
     void accept(std::string_view line, const std::string& quoted);
     // Nothing after this line is judged (a refusal the judge cannot undo).
     void lose(const std::string& quoted);
+    // How the firmware draws arcs (its family's: FirmwareArcs in verify/Bench).
+    void set_arc_rule(ArcRule rule) { arc_rule_ = rule; }
 
     // How many moves and renames the judge was told so far, and whether the
     // reading state (position, modes) is the same as another's: to undo a
@@ -51,6 +53,7 @@ private:
     double mm_per_unit_ = 1.0;
     bool xy_plane_ = true;
     bool lost_ = false;
+    ArcRule arc_rule_;
 };
 
 }  // namespace avrbench

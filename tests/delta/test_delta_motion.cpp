@@ -41,9 +41,10 @@ TEST(DeltaMotion, TheImprovedBuildEndsEveryMoveOnItsTarget) {
     ASSERT_TRUE(bench.host().done()) << bench.host().tail(10);
     // Line 1 is where the firmware starts (its modal target), no move; each
     // "ok" came once the servos were there, so lines 2 and 3 were left for
-    // the next at their ends, and the last stands at its target.
+    // the next at their ends, and the last stands at its target: three moves
+    // judged.
     auto& oracle = bench.board().part_as<MotionOracle>("motion");
-    EXPECT_EQ(oracle.moves_judged(), 2u);
+    EXPECT_EQ(oracle.moves_judged(), 3u);
     EXPECT_TRUE(oracle.judging());
     EXPECT_TRUE(bench.findings().empty()) << bench.findings().front().describe();
     const Eigen::Vector3d at = bench.board().part_as<DeltaRobot>("robot").effector_mm();
