@@ -34,6 +34,8 @@ public:
     virtual void send(const std::string& bytes) = 0;
     // Bytes handed to the firmware's side of the line so far.
     virtual std::uint64_t bytes_delivered() const = 0;
+    // Called as each byte reaches the firmware's side (its cycle, the byte).
+    virtual void on_deliver(ByteListener fn) = 0;
     // Bytes queued and not yet on their way.
     virtual std::size_t pending_rx() const = 0;
     // One frame's length on the line now, in the link's clock cycles.

@@ -97,6 +97,7 @@ void Uart::pump() {
 void Uart::deliver(std::uint16_t value) {
     ++delivered_;
     avr_raise_irq(irqs_ + UART_IRQ_INPUT, value);
+    for (auto& fn : deliver_listeners_) fn(avr_->cycle, static_cast<std::uint8_t>(value));
 }
 
 void Uart::draw_host_frame(std::uint16_t value) {

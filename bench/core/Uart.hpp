@@ -75,6 +75,7 @@ public:
     std::uint64_t line_parity_errors() const { return line_parity_errors_; }
     std::size_t pending_rx() const override { return to_send_.size(); }
     std::uint64_t bytes_delivered() const override { return delivered_; }
+    void on_deliver(ByteListener fn) override { deliver_listeners_.push_back(std::move(fn)); }
 
     // Datasheet frame time for the current UBRR/U2X/UCSZ settings.
     Cycle cycles_per_frame() const override;
@@ -100,6 +101,7 @@ private:
     std::vector<UartByte> transmitted_;
     std::vector<TxListener> tx_listeners_;
     std::deque<std::uint8_t> to_send_;
+    std::vector<ByteListener> deliver_listeners_;
     std::uint64_t delivered_ = 0;
     bool receiver_full_ = false;
     bool retry_scheduled_ = false;

@@ -15,8 +15,10 @@ public:
     virtual ~AcceptedMoves() = default;
     // Whether this part wants the targets (its configuration may say no).
     virtual bool checks_move_commands() const = 0;
-    // `line` quotes the accepted line, for the finding's detail.
-    virtual void check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) = 0;
+    // `line` quotes the accepted line, for the finding's detail. False when
+    // the machine cannot reach the target (a finding of this part's): the
+    // move is judged, and a run need not wait for the machine to make it.
+    virtual bool check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) = 0;
     // A G0/G1 target the firmware refused (answered an error to): true when
     // the machine cannot reach it either, so the refusal is right and not a
     // finding of the host's (a delta's "error: unreachable").

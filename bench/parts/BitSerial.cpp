@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "core/Scheduler.hpp"
 
@@ -16,19 +15,52 @@ Cycle BitSerial::bit_time(Cycle frame_start, double bits) const {
 }
 
 void BitSerial::send(const std::string& bytes, Cycle at_cycle) {
-    Cycle start = std::max({at_cycle, tx_free_at_, clock_.cycle()});
-    for (unsigned char byte : bytes) {
-        // start bit 0, 8 data bits LSB first, stop bit 1
-        std::vector<bool> bits{false};
-        for (int i = 0; i < 8; ++i) bits.push_back(((byte >> i) & 1) != 0);
-        bits.push_back(true);
-        for (std::size_t i = 0; i < bits.size(); ++i) {
-            const bool level = bits[i];
-            clock_.scheduler().at(bit_time(start, static_cast<double>(i)), [this, level](Cycle) { hooks_.drive_tx(level); });
-        }
-        start = bit_time(start, 10.0);
+    if (bytes.empty()) return;
+    // Frames sit end to end: the first at `at_cycle` or when the line is free.
+    const Cycle start = std::max({at_cycle, tx_free_at_, clock_.cycle()});
+    Cycle end = start;
+    for (std::size_t i = 0; i < bytes.size(); ++i) end = bit_time(end, 10.0);
+    tx_free_at_ = end;
+    queued_ += bytes.size();
+    tx_chunks_.push_back({bytes, start});
+    if (!tx_active_) {
+        tx_active_ = true;
+        tx_index_ = 0;
+        tx_bit_ = 0;
+        tx_frame_start_ = start;
+        schedule_transmit(start);
     }
-    tx_free_at_ = start;
+}
+
+void BitSerial::schedule_transmit(Cycle at) {
+    clock_.scheduler().at(at, [this](Cycle) { transmit_bit(); });
+}
+
+// start bit 0, 8 data bits LSB first, stop bit 1
+void BitSerial::transmit_bit() {
+    const auto byte = static_cast<std::uint8_t>(tx_chunks_.front().bytes[tx_index_]);
+    const bool level = tx_bit_ == 0 ? false : tx_bit_ == 9 ? true : ((byte >> (tx_bit_ - 1)) & 1) != 0;
+    hooks_.drive_tx(level);
+    if (tx_bit_ < 9) {
+        ++tx_bit_;
+        schedule_transmit(bit_time(tx_frame_start_, static_cast<double>(tx_bit_)));
+        return;
+    }
+    ++sent_;
+    if (hooks_.on_sent) hooks_.on_sent(clock_.cycle(), byte);
+    // The next frame: right after this one, or a later chunk's own start.
+    tx_frame_start_ = bit_time(tx_frame_start_, 10.0);
+    tx_bit_ = 0;
+    if (++tx_index_ == tx_chunks_.front().bytes.size()) {
+        tx_chunks_.pop_front();
+        tx_index_ = 0;
+        if (tx_chunks_.empty()) {
+            tx_active_ = false;
+            return;
+        }
+        tx_frame_start_ = std::max(tx_frame_start_, tx_chunks_.front().first_start);
+    }
+    schedule_transmit(tx_frame_start_);
 }
 
 void BitSerial::rx_edge(bool level) {

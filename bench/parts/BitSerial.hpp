@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <string>
 
@@ -28,12 +29,20 @@ public:
         // An edge inside a frame, `bits` after its start bit's edge (on the
         // grid when a whole number); optional.
         std::function<void(double bits)> on_edge;
+        // A frame sent whole: its stop bit begins now (the receiver has its
+        // data bits); optional.
+        std::function<void(Cycle stop_bit, std::uint8_t byte)> on_sent;
     };
 
     BitSerial(Mcu& clock, double baud, Hooks hooks);
 
-    // Queues `bytes`, the first start bit at `at_cycle` or when the line is free.
+    // Queues `bytes`, the first start bit at `at_cycle` or when the line is
+    // free, the others frame after frame. Streamed: one bit's event is
+    // scheduled at a time, so a long queue costs its bytes and no more.
     void send(const std::string& bytes, Cycle at_cycle);
+    // Bytes queued and not yet sent whole.
+    std::uint64_t bytes_queued() const { return queued_; }
+    std::uint64_t bytes_sent() const { return sent_; }
     // The RX pin changed level (call from the part's on_input).
     void rx_edge(bool level);
 
@@ -45,6 +54,20 @@ public:
 private:
     Cycle bit_time(Cycle frame_start, double bits) const;
     void sample(unsigned bit_index);
+    void transmit_bit();  // the bit at tx_bit_ of the frame at tx_frame_start_
+    void schedule_transmit(Cycle at);
+
+    // Queued text in chunks as send() got it, each with its first frame's start.
+    struct Chunk {
+        std::string bytes;
+        Cycle first_start = 0;
+    };
+    std::deque<Chunk> tx_chunks_;
+    std::size_t tx_index_ = 0;   // the byte of the front chunk on the line
+    unsigned tx_bit_ = 0;        // 0 start bit, 1..8 data, 9 stop
+    Cycle tx_frame_start_ = 0;
+    bool tx_active_ = false;
+    std::uint64_t queued_ = 0, sent_ = 0;
 
     Mcu& clock_;
     double bit_cycles_;

@@ -65,6 +65,10 @@ public:
     virtual AxisPositions power_up_mm() const { return {0.0, 0.0, 0.0}; }
     // The firmware waits here (G4) before the moves that follow.
     virtual void dwell() {}
+    // Another part judged the move of line `line` (quoted as in
+    // CommandedMove::line): the machine cannot make it (a delta's
+    // target-out-of-reach). Nobody waits for it to begin.
+    virtual void judged_elsewhere(const std::string& line) { (void)line; }
     // How the judge can tell that the firmware has answered every line the
     // job sent (its host is done): moves still waiting then were, for the
     // firmware, made or queued, so a machine at rest at the end has not made

@@ -138,10 +138,11 @@ std::optional<DeltaRobot::ReachProblem> DeltaRobot::reach_problem(const Eigen::V
     return std::nullopt;
 }
 
-void DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) {
-    if (const auto why = reach_problem(target_mm)) {
-        report(DeltaRobot::kTargetOutOfReach, why->what + "; " + line + " was answered ok" + why->details);
-    }
+bool DeltaRobot::check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) {
+    const auto why = reach_problem(target_mm);
+    if (!why) return true;
+    report(DeltaRobot::kTargetOutOfReach, why->what + "; " + line + " was answered ok" + why->details);
+    return false;
 }
 
 std::string DeltaRobot::summary() {

@@ -51,7 +51,7 @@ public:
     // reachable space, or within kTravelMarginDeg of the travel's ends (half
     // a degree for a firmware that rounds angles to whole table entries, as
     // seed 004's does, and 0.1 deg for float32).
-    void check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) override;
+    bool check_accepted_move(const Eigen::Vector3d& target_mm, const std::string& line) override;
     bool refusal_is_right(const Eigen::Vector3d& target_mm) const override { return reach_problem(target_mm).has_value(); }
     // Why no pose of this robot reaches the target, clearly (beyond the
     // margins below), or nothing when one does: a finding says

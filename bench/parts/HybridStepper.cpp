@@ -422,6 +422,9 @@ void HybridStepper::set_command(double electrical) {
         last_command_change_ = now;
     }
     command_e_ = next;
+    // A coil-driven motor's step is a new excitation (a step/dir driver
+    // notes its own STEP pulses): the bench's idle detection hears it.
+    if (!angle_from_source_) note_activity();
 }
 
 void HybridStepper::check_slip() {

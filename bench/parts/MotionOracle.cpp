@@ -550,27 +550,38 @@ std::vector<Finding> MotionOracle::pending_findings() const {
     return out;
 }
 
-std::string MotionOracle::still_going() const {
-    if (lost_ || moves_.empty() || moves_.front().barrier) return "";
+void MotionOracle::judged_elsewhere(const std::string& line) {
+    for (Tracked& m : moves_) {
+        if (m.line == line) m.unreachable = true;
+    }
+}
+
+bool MotionOracle::still_going(std::string* why) const {
+    if (lost_ || moves_.empty() || moves_.front().barrier) return false;
     const Tracked& cur = moves_.front();
-    const Eigen::Vector3d p = tool_position();
     const bool begun = cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached;
     if (clock().cycle() < last_move_cycle_ + rest_cycles_) {
         // Moving (or within rest_time of it): on its way through the moves.
-        if (cur.end_reached && moves_.size() == 1) return "";
-        return cur.line + " under way (the tool at " + firmware_text(cur, p) + ", its end " + firmware_text(cur, cur.to) + ")";
+        if (cur.end_reached && moves_.size() == 1) return false;
+        if (why != nullptr) {
+            *why = cur.line + " under way (the tool at " + firmware_text(cur, tool_position()) + ", its end " +
+                   firmware_text(cur, cur.to) + ")";
+        }
+        return true;
     }
     // At rest: a move begun and left short was judged there (rest_verdict);
     // one not begun may yet begin (a firmware waiting for its heater first).
     const std::size_t first = begun ? 1 : 0;
-    if (first >= moves_.size() || moves_[first].barrier) return "";
-    const Tracked& next = moves_[first];
-    std::string text = next.line + " accepted and not begun (the tool at rest at " + firmware_text(next, p) + ", the move to " +
-                       firmware_text(next, next.to) + ")";
-    const std::size_t more = static_cast<std::size_t>(
-        std::count_if(moves_.begin() + static_cast<std::ptrdiff_t>(first) + 1, moves_.end(), [](const Tracked& m) { return !m.barrier; }));
-    if (more > 0) text += ", " + std::to_string(more) + " more after it";
-    return text;
+    if (first >= moves_.size() || moves_[first].barrier || moves_[first].unreachable) return false;
+    if (why != nullptr) {
+        const Tracked& next = moves_[first];
+        *why = next.line + " accepted and not begun (the tool at rest at " + firmware_text(next, tool_position()) +
+               ", the move to " + firmware_text(next, next.to) + ")";
+        const auto more = std::count_if(moves_.begin() + static_cast<std::ptrdiff_t>(first) + 1, moves_.end(),
+                                        [](const Tracked& m) { return !m.barrier; });
+        if (more > 0) *why += ", " + std::to_string(more) + " more after it";
+    }
+    return true;
 }
 
 std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cycle now) const {

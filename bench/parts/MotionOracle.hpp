@@ -65,7 +65,7 @@ public:
     std::vector<Finding> pending_findings() const override;
     // An accepted move the machine is making or has not begun: the run is
     // not done. A move begun and left short at rest is judged, not waited for.
-    std::string still_going() const override;
+    bool still_going(std::string* why) const override;
 
     void commanded(const CommandedMove& move) override;
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;
@@ -74,6 +74,7 @@ public:
     AxisPositions power_up_mm() const override { return start_mm_; }
     void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
     void dwell() override { dwell_pending_ = true; }
+    void judged_elsewhere(const std::string& line) override;
 
     // For tests and front ends: moves judged so far, and whether judging stopped.
     std::size_t moves_judged() const { return moves_judged_now(); }
@@ -110,6 +111,7 @@ private:
         Cycle tool_off_cycle = 0;
         bool rest_reported = false;
         bool after_dwell = false;  // a G4 came before it: it may still be waiting when a run ends
+        bool unreachable = false;  // another part found the machine cannot make it
         // Findings recorded when the fault began, revised as it grows.
         std::optional<std::size_t> deviation_finding, tool_finding;
         double deviation_told = 0, tool_told = 0;

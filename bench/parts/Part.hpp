@@ -125,11 +125,14 @@ public:
     // now (a move the machine has not left yet): not recorded, asked again
     // at each look (Board::findings()).
     virtual std::vector<Finding> pending_findings() const { return {}; }
-    // What the part is still doing that a run must wait for before the
-    // firmware counts as done (a move it accepted and has not made), one
-    // phrase for people; "" when nothing. Asked between slices of a run
-    // that waits for idle (Bench::still_going).
-    virtual std::string still_going() const { return {}; }
+    // Whether the part is still doing something a run must wait for before
+    // the firmware counts as done (a move it accepted and has not made);
+    // when it is and `why` is given, one phrase for people there. Asked
+    // between slices of a run that waits for idle (Bench::still_going).
+    virtual bool still_going(std::string* why) const {
+        (void)why;
+        return false;
+    }
 
     // Faults, by name, for tests and scenario files ("open", "stuck_on", ...;
     // "none" repairs). inject_fault applies one when this part's clock reaches

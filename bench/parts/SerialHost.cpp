@@ -57,23 +57,21 @@ public:
                  .on_byte = [this](Cycle start, std::uint8_t byte) { received(start, byte); },
                  .on_framing_error = [&host](Cycle) {
                      host.report(kHostLineFraming, "a frame on " + host.link_text() + " with its stop bit low");
+                 },
+                 .on_edge = {},
+                 .on_sent = [this](Cycle at, std::uint8_t byte) {
+                     for (auto& fn : deliver_listeners_) fn(at, byte);
                  }}),
           clock_(host.clock()) {}
 
     const std::vector<UartByte>& transmitted() const override { return transmitted_; }
     void on_transmit(ByteListener fn) override { listeners_.push_back(std::move(fn)); }
     void connect_host() override {}  // the part holds TX at mark from the start
-    void send(const std::string& bytes) override {
-        line_.send(bytes, clock_.cycle());
-        sent_ += bytes.size();
-    }
-    std::uint64_t bytes_delivered() const override { return sent_; }
-    std::size_t pending_rx() const override {
-        const Cycle now = clock_.cycle();
-        if (line_.tx_free_at() <= now) return 0;
-        const Cycle frame = line_.frame_cycles();
-        return static_cast<std::size_t>((line_.tx_free_at() - now + frame - 1) / frame);
-    }
+    void send(const std::string& bytes) override { line_.send(bytes, clock_.cycle()); }
+    // A byte is delivered when its stop bit begins: the receiver has its data.
+    std::uint64_t bytes_delivered() const override { return line_.bytes_sent(); }
+    void on_deliver(ByteListener fn) override { deliver_listeners_.push_back(std::move(fn)); }
+    std::size_t pending_rx() const override { return static_cast<std::size_t>(line_.bytes_queued() - line_.bytes_sent()); }
     Cycle cycles_per_frame() const override { return line_.frame_cycles(); }
     void rx_edge(bool level) { line_.rx_edge(level); }
 
@@ -87,7 +85,7 @@ private:
     Mcu& clock_;
     std::vector<UartByte> transmitted_;
     std::vector<ByteListener> listeners_;
-    std::uint64_t sent_ = 0;
+    std::vector<ByteListener> deliver_listeners_;
 };
 
 SerialHost::SerialHost(std::string name, Mcu& clock, const ParamValues& params)

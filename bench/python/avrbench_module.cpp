@@ -193,7 +193,9 @@ private:
     std::map<std::string, std::unique_ptr<PySerial>> serials_;
 };
 
-void PySerial::write(const py::bytes& data) { bench_.bench().serial(port_).send(std::string(data)); }
+// Lines written here are lines the firmware must answer before
+// run_until_idle calls the run done (Bench::write).
+void PySerial::write(const py::bytes& data) { bench_.bench().write(port_, std::string(data)); }
 
 std::string PySerial::received() const { return bench_.bench().serial(port_).transmitted_text(); }
 
@@ -342,6 +344,7 @@ void bind_bench(py::module_& m) {
         .def("run_for", &PyBench::run_for)
         .def("run_until", &PyBench::run_until, py::arg("predicate"), py::arg("timeout"), py::arg("step"))
         .def("run_until_idle", &PyBench::run_until_idle, py::arg("max"), py::arg("settle"))
+        .def_property_readonly("left_going", [](PyBench& b) { return b.bench().left_going(); })
         .def("run_until_sleep", &PyBench::run_until_sleep, py::arg("mcu"), py::arg("timeout"))
         .def_property_readonly("now", &PyBench::now)
         .def("mcu", [](PyBench& b, const std::string& name) { return &b.bench().mcu(name); },

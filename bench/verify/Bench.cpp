@@ -17,6 +17,7 @@
 #include "parts/AcceptedMoves.hpp"
 #include "stimulus/CommandedTarget.hpp"
 #include "verify/CommandedPath.hpp"
+#include "verify/HeatTargets.hpp"
 
 namespace avrbench {
 
@@ -40,14 +41,23 @@ std::map<char, double> gcode_words(const std::string& line) {
 const char* to_string(IdleResult result) {
     switch (result) {
         case IdleResult::Idle: return "idle";
-        case IdleResult::TimeLimit: return "time limit";
+        case IdleResult::TimeLimit: return "time-limit";
         case IdleResult::Halted: return "halted";
-        case IdleResult::HostFailed: return "host failed";
+        case IdleResult::HostFailed: return "host-failed";
         case IdleResult::Interrupted: return "interrupted";
-        case IdleResult::RecorderFull: return "recorder full";
+        case IdleResult::RecorderFull: return "recorder-full";
     }
     return "?";
 }
+
+namespace {
+
+// Step intervals longer than this are a machine at rest between moves, not
+// a slow move (assumed: 4 steps/s, slower than the slowest homing approach
+// the motion oracle's rest_time allows for, 5 steps/s).
+constexpr Picoseconds kLongestStepIntervalCounted = kPsPerMs * 250;
+
+}  // namespace
 
 Bench::Bench(const std::string& board_file, const std::string& elf) {
     BoardSpec spec = load_board_file(board_file);
@@ -76,8 +86,66 @@ void Bench::watch_motion() {
         }
     }
     for (Part* part : board_->parts()) {
-        part->on_activity([this, part] { last_step_ps_ = ps_at_cycle(part->clock(), part->clock().cycle()); });
+        part->on_activity([this, part] {
+            const Picoseconds now = ps_at_cycle(part->clock(), part->clock().cycle());
+            last_step_ps_ = now;
+            auto [it, first] = last_step_by_part_ps_.try_emplace(part, now);
+            if (!first) {
+                const Picoseconds interval = now - std::min(now, it->second);
+                if (interval <= kLongestStepIntervalCounted) longest_step_interval_ps_ = std::max(longest_step_interval_ps_, interval);
+                it->second = now;
+            }
+        });
     }
+    heat_ = std::make_unique<HeatTargets>(*board_);
+    for (const SerialPort& port : serial_ports_) watch_port(port);
+}
+
+// Lines written by hand on `port`: each is taken when its '\n' reaches the
+// firmware, answered by the first line the firmware completes after that.
+void Bench::watch_port(const SerialPort& port) {
+    HandWritten& hand = hand_[port.name];
+    port.link().on_deliver([&hand](Cycle cycle, std::uint8_t) {
+        ++hand.delivered;
+        while (!hand.untaken.empty() && hand.untaken.front().first <= hand.delivered) {
+            hand.unanswered.emplace_back(cycle, std::move(hand.untaken.front().second));
+            hand.untaken.pop_front();
+        }
+    });
+    const FirmwareFamily family = parse_firmware_family(port.protocol().family, port.location);
+    port.link().on_transmit([&hand, family](Cycle cycle, std::uint8_t byte) {
+        if (byte != '\n' && byte != '\r') {
+            if (!hand.unanswered.empty() && hand.partial.size() < 256) hand.partial.push_back(static_cast<char>(byte));
+            return;
+        }
+        std::string line = std::move(hand.partial);
+        hand.partial.clear();
+        if (line.empty() || hand.unanswered.empty() || cycle <= hand.unanswered.front().first) return;
+        // A known family answers with ok or an error; a generic firmware's
+        // every line answers.
+        const AnswerKind kind = classify_answer(family, line);
+        const bool answers = family == FirmwareFamily::Generic || kind == AnswerKind::Ok || kind == AnswerKind::Error ||
+                             kind == AnswerKind::Alarm || kind == AnswerKind::Fatal;
+        if (answers) hand.unanswered.pop_front();
+    });
+}
+
+void Bench::write(const std::string& port, const std::string& bytes) {
+    const SerialPort& p = serial_port(port);
+    HandWritten& hand = hand_[p.name];
+    // The byte numbers these will have on the link: after what it delivered
+    // and what is queued before them.
+    const std::uint64_t base = hand.delivered + p.link().pending_rx();
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i < bytes.size(); ++i) {
+        if (bytes[i] != '\n') continue;
+        std::string text = bytes.substr(line_start, std::min<std::size_t>(i - line_start, 200));
+        if (!text.empty() && text.back() == '\r') text.pop_back();
+        hand.untaken.emplace_back(base + i + 1, std::move(text));
+        line_start = i + 1;
+    }
+    hand.written_end = std::max(hand.written_end, base + bytes.size());
+    p.link().send(bytes);
 }
 
 UartHostOptions default_host_options(const SerialPort& port) {
@@ -118,6 +186,18 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
         }
         slot = std::make_unique<UartHost>(*serial.mcu, serial.link(), o);
         check_accepted_moves(*slot);
+        // Heater targets from the lines the firmware took (not those it refused).
+        UartHost& h = *slot;
+        Mcu& clock = *serial.mcu;
+        auto acknowledged = std::make_shared<std::size_t>(0);
+        h.on_line_received([this, &h, &clock, acknowledged](const TranscriptEntry&) {
+            for (; *acknowledged < h.lines_acknowledged(); ++*acknowledged) {
+                if (h.line_errored(*acknowledged)) continue;
+                const GcodeLine& line = h.lines()[*acknowledged];
+                heat_->accepted(line.text, ps_at_cycle(clock, clock.cycle()),
+                                "line " + std::to_string(line.number) + " " + quoted_line(line.text));
+            }
+        });
     }
     return *slot;
 }
@@ -272,7 +352,11 @@ void Bench::check_accepted_moves(UartHost& host) {
         const auto target = seen->target.accept(line.text);
         if (!target) return;
         const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
-        for (AcceptedMoves* robot : robots) robot->check_accepted_move(Eigen::Vector3d{(*target)[0], (*target)[1], (*target)[2]}, quoted);
+        for (AcceptedMoves* robot : robots) {
+            if (!robot->check_accepted_move(Eigen::Vector3d{(*target)[0], (*target)[1], (*target)[2]}, quoted)) {
+                for (CommandedMoves* judge : motion_judges()) judge->judged_elsewhere(quoted);
+            }
+        }
     });
 }
 
@@ -331,28 +415,97 @@ IdleResult Bench::run_until_idle(double max_seconds, double settle_seconds) {
     return run_until_idle_ps(ps_from_seconds(max_seconds, "run_until_idle"), ps_from_seconds(settle_seconds, "settle time"));
 }
 
+bool Bench::still_going(Picoseconds settle_ps, std::vector<std::string>* why) const {
+    bool going = false;
+    const auto say = [&](std::string text) {
+        going = true;
+        if (why != nullptr) why->push_back(std::move(text));
+        return why == nullptr;  // true: stop looking, the answer is known
+    };
+    for (const auto& [name, host] : hosts_) {
+        if (host->finished()) continue;
+        std::string text = "host " + name + ": ";
+        if (!host->ready()) {
+            text += "waiting for the firmware's welcome";
+        } else if (host->outstanding_lines() > 0) {
+            const GcodeLine& line = host->lines()[host->lines_acknowledged()];
+            text += "line " + std::to_string(line.number) + " " + quoted_line(line.text) + " not answered";
+        } else if (host->lines_sent() < host->lines().size()) {
+            text += std::to_string(host->lines().size() - host->lines_sent()) + " lines still to send";
+        } else {
+            text += "bytes still to send at their times";
+        }
+        if (say(text + " (" + std::to_string(host->lines_acknowledged()) + " of " + std::to_string(host->lines().size()) +
+                " lines answered)")) {
+            return true;
+        }
+    }
+    for (const auto& [name, hand] : hand_) {
+        if (!hand.untaken.empty()) {
+            if (say("port " + name + ": " + std::to_string(hand.untaken.size()) + " line(s) written by hand not yet taken by the firmware (" +
+                    quoted_line(hand.untaken.front().second) + ")")) {
+                return true;
+            }
+        } else if (hand.delivered < hand.written_end) {
+            if (say("port " + name + ": bytes written by hand not yet taken by the firmware")) return true;
+        }
+        if (!hand.unanswered.empty() &&
+            say("port " + name + ": " + quoted_line(hand.unanswered.front().second) + ", written by hand, not answered")) {
+            return true;
+        }
+    }
+    std::string text;
+    for (Part* part : board_->parts()) {
+        if (part->still_going(why != nullptr ? &text : nullptr) && say(part->name() + ": " + text)) return true;
+    }
+    const Picoseconds now = now_ps();
+    if (heat_->unsettled(now, why)) {
+        going = true;
+        if (why == nullptr) return true;
+    }
+    // Quiet since the later of the last STEP edge and the last line either
+    // way on any port: a firmware that answers "ok" at once and starts
+    // moving a little later (grbl's planner) is not done yet. 2.5 times the
+    // longest step interval: AVR446's first (and last) step interval is
+    // 1 / 0.4056 = 2.47 times the next one's (application note AVR446, eq. 15).
+    Picoseconds last_activity = last_step_ps_.value_or(0);
+    for (const auto& [name, host] : hosts_) {
+        if (host->transcript().empty()) continue;
+        const Mcu& m = *port_of(name).mcu;
+        last_activity = std::max(last_activity, ps_at_cycle(m, host->transcript().back().cycle));
+    }
+    const Picoseconds quiet_needed = std::max(settle_ps, longest_step_interval_ps_ * 5 / 2);
+    const Picoseconds quiet = now - std::min(now, last_activity);
+    if (quiet < quiet_needed) {
+        char line[160];
+        std::snprintf(line, sizeof line, "motion: the last step or line %.3f s ago, done after %.3f s without one",
+                      seconds_from_ps(quiet), seconds_from_ps(quiet_needed));
+        say(line);
+    }
+    return going;
+}
+
 IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
+    return noting_what_is_going(run_until_done(max_ps, settle_ps), settle_ps);
+}
+
+IdleResult Bench::noting_what_is_going(IdleResult r, Picoseconds settle_ps) {
+    left_going_.clear();
+    if (r != IdleResult::Idle) still_going(settle_ps, &left_going_);
+    return r;
+}
+
+IdleResult Bench::run_until_done(Picoseconds max_ps, Picoseconds settle_ps) {
     const Picoseconds end = add_ps(now_ps(), max_ps);
     // Small slices so idleness is noticed promptly; each is one Lockstep run.
     const Picoseconds slice = std::clamp<Picoseconds>(settle_ps / 4, 10'000'000, kPsPerMs);
     for (;;) {
-        bool all_finished = true;
         for (auto& [name, host] : hosts_) {
             if (host->failed()) return IdleResult::HostFailed;
-            all_finished = all_finished && host->finished();
         }
         const Picoseconds now = now_ps();
-        // Quiet since the later of the last STEP edge and the last line
-        // either way on any port: a firmware that answers "ok" at once and
-        // starts moving a little later (grbl's planner) is not idle yet.
-        Picoseconds last_activity = last_step_ps_.value_or(0);
-        for (auto& [name, host] : hosts_) {
-            if (host->transcript().empty()) continue;
-            const Mcu& m = *port_of(name).mcu;
-            last_activity = std::max(last_activity, ps_at_cycle(m, host->transcript().back().cycle));
-        }
-        const bool motion_settled = now - std::min(now, last_activity) >= settle_ps;
-        if (all_finished && motion_settled) return IdleResult::Idle;
+        heat_->sample(now);
+        if (!still_going(settle_ps)) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
         if (user_stop_requested()) return IdleResult::Interrupted;
         if (timeline_.overflowed()) return IdleResult::RecorderFull;
@@ -364,21 +517,22 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
 IdleResult Bench::run_to_ps(Picoseconds end_ps, const RunSlices& how) {
     const Picoseconds slice_ps =
         how.slice_ps != 0 ? how.slice_ps : std::clamp<Picoseconds>(end_ps / 100, 1'000'000, 10 * kPsPerMs);
+    const auto ended = [this, &how](IdleResult r) { return how.until_idle ? noting_what_is_going(r, how.settle_ps) : r; };
     // Each pass ends with now_ps() >= its target > the previous now_ps() (core/Time.hpp).
     while (now_ps() < end_ps) {
-        if (user_stop_requested()) return IdleResult::Interrupted;
-        if (timeline_.overflowed()) return IdleResult::RecorderFull;
+        if (user_stop_requested()) return ended(IdleResult::Interrupted);
+        if (timeline_.overflowed()) return ended(IdleResult::RecorderFull);
         const Picoseconds target = std::min(end_ps, add_ps(now_ps(), slice_ps));
         if (how.until_idle) {
-            const IdleResult r = run_until_idle_ps(target - now_ps(), how.settle_ps);
-            if (r != IdleResult::TimeLimit) return r;
+            const IdleResult r = run_until_done(target - now_ps(), how.settle_ps);
+            if (r != IdleResult::TimeLimit) return ended(r);
         } else if (board_->run_until_ps(target) == StopReason::Halted) {
             return IdleResult::Halted;
         }
         if (how.after_slice) how.after_slice();
         if (how.stop_when && how.stop_when()) return IdleResult::Idle;
     }
-    return IdleResult::TimeLimit;
+    return ended(IdleResult::TimeLimit);
 }
 
 std::vector<Finding> Bench::findings() const {
@@ -487,35 +641,16 @@ void Bench::report_plots(RunReport& r) const {
             r.servos.push_back({d.part->name(), d.id});
         }
     }
-    // Temperature targets from the G-code the hosts sent: M104/M109 S.. set a
-    // tool heater (T<n> picks the n-th plant that is not a bed), M140/M190 S..
-    // the plant whose name contains "bed".
-    std::vector<Part*> tools;
-    Part* bed = nullptr;
-    for (Part* p : plants) {
-        if (p->name().find("bed") != std::string::npos) {
-            if (bed == nullptr) bed = p;
-        } else {
-            tools.push_back(p);
-        }
-    }
+    // Temperature targets from the G-code the hosts sent (verify/HeatTargets.hpp).
     std::map<const Part*, std::vector<std::pair<double, double>>> targets;
     for (const auto& [name, host] : hosts_) {
         const std::uint32_t hz = port_of(name).mcu->frequency_hz();
         for (const auto& e : host->transcript()) {
             if (e.direction != Direction::Sent) continue;
-            const auto words = gcode_words(e.text);
-            const auto m = words.find('M'), target = words.find('S');
-            if (m == words.end() || target == words.end()) continue;
-            const Part* plant = nullptr;
-            if (m->second == 140 || m->second == 190) {
-                plant = bed;
-            } else if (m->second == 104 || m->second == 109) {
-                const auto tool = words.find('T');
-                const std::size_t index = tool == words.end() || tool->second < 0 ? 0 : static_cast<std::size_t>(tool->second);
-                plant = index < tools.size() ? tools[index] : nullptr;
+            double degC = 0;
+            if (const Part* plant = heated_part_for(plants, e.text, &degC)) {
+                targets[plant].emplace_back(static_cast<double>(e.cycle) / hz, degC);
             }
-            if (plant != nullptr) targets[plant].emplace_back(static_cast<double>(e.cycle) / hz, target->second);
         }
     }
     for (Part* plant : plants) {

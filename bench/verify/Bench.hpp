@@ -9,6 +9,7 @@
 //   EXPECT_EQ(bench.axis("x").steps(), 1600u);
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -28,9 +29,10 @@
 namespace avrbench {
 
 class CommandedMoves;
+class HeatTargets;
 
 enum class IdleResult {
-    Idle,        // every host finished its job and no STEP edge for the settle time
+    Idle,        // the firmware is done: Bench::still_going says nothing
     TimeLimit,   // the simulated-time limit came first
     Halted,      // every MCU halted (crash findings say why)
     HostFailed,  // a host stopped: no answer (timeout), ALARM, !!, ...
@@ -38,6 +40,7 @@ enum class IdleResult {
     RecorderFull,  // the timeline's cap was hit: the run can no longer be recorded whole, so it ends
 };
 
+// "idle", "time-limit", "halted", "host-failed", "interrupted", "recorder-full".
 const char* to_string(IdleResult result);
 
 // The words of one G-code line, letter (upper case) -> number, first of each
@@ -91,8 +94,25 @@ public:
     Timeline& timeline() { return timeline_; }
     Recorder& recorder() { return recorder_; }
 
+    // Bytes from a person or a script (Python's port.write) to serial port
+    // `port`: each line in them is one the firmware must answer before the
+    // run is done (any line it prints after taking it answers it on a
+    // generic port; its family's ok or error on a known one).
+    void write(const std::string& port, const std::string& bytes);
+
     void run_for(double seconds) { board_->run_for_seconds(seconds); }
-    // Runs until idle (see IdleResult) or until `max_ps` of simulated time
+    // Whether the firmware is not yet done, and with `why` one phrase per
+    // thing still going there. Done means: every host finished its job
+    // (every line answered, or the host gave up); every line written by hand
+    // taken and answered; no part still going (a motion oracle's accepted
+    // move not made: Part::still_going); every heater with a target within
+    // its band or no longer changing (verify/HeatTargets.hpp); and no STEP
+    // edge, nor a line either way on a port, for `settle_ps` or 2.5 times
+    // the longest step interval of the run (up to 250 ms) if that is longer.
+    bool still_going(Picoseconds settle_ps, std::vector<std::string>* why = nullptr) const;
+    // What was still going when the last run_until_idle ended otherwise than idle.
+    const std::vector<std::string>& left_going() const { return left_going_; }
+    // Runs until done (see still_going) or until `max_ps` of simulated time
     // from now has passed. Every pass of its loop advances simulated time.
     IdleResult run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps = 50 * kPsPerMs);
     IdleResult run_until_idle(double max_seconds, double settle_seconds = 0.05);
@@ -162,6 +182,25 @@ private:
     // (check_accepted_moves): right answers, not findings.
     std::set<std::pair<const UartHost*, std::size_t>> right_refusals_;
     std::optional<Picoseconds> last_step_ps_;
+    // The longest time between two STEP edges of one part, up to
+    // kLongestStepIntervalCounted (longer is a machine at rest between moves).
+    Picoseconds longest_step_interval_ps_ = 0;
+    std::map<const Part*, Picoseconds> last_step_by_part_ps_;
+    std::unique_ptr<HeatTargets> heat_;
+    // Lines written by hand on one port, from the link's byte count to the answer.
+    struct HandWritten {
+        std::uint64_t delivered = 0;            // bytes the link delivered since the bench watched it
+        std::uint64_t written_end = 0;          // the byte number after the last byte written by hand
+        std::deque<std::pair<std::uint64_t, std::string>> untaken;  // each line's '\n' byte number and text
+        std::deque<std::pair<Cycle, std::string>> unanswered;        // taken at that cycle, not yet answered
+        std::string partial;                    // the firmware's line so far
+    };
+    std::map<std::string, HandWritten> hand_;
+    void watch_port(const SerialPort& port);
+    // run_until_idle_ps without noting what was left going (run_to_ps's slices).
+    IdleResult run_until_done(Picoseconds max_ps, Picoseconds settle_ps);
+    IdleResult noting_what_is_going(IdleResult r, Picoseconds settle_ps);
+    mutable std::vector<std::string> left_going_;
     bool traced_ = false;
 };
 

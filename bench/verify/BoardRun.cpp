@@ -347,9 +347,13 @@ RunVerdict BoardRun::verdict(bool strict) const {
         return {timed_out ? O::Timeout : O::Finding, host_->failure_message()};
     }
     if (host_ != nullptr && outcome_ == IdleResult::TimeLimit) {
-        return {O::Timeout, format_text("timeout: the job was not finished within %g s (%zu of %zu lines acknowledged)",
-                                   seconds_from_ps(options_.duration_ps), host_->lines_acknowledged(),
-                                   host_->lines().size())};
+        std::string message = format_text("timeout: the job was not finished within %g s (%zu of %zu lines acknowledged)",
+                                          seconds_from_ps(options_.duration_ps), host_->lines_acknowledged(),
+                                          host_->lines().size());
+        const auto& going = bench_->left_going();
+        if (!going.empty()) message += "; still going: " + going.front();
+        if (going.size() > 1) message += format_text(" (and %zu more, in the summary)", going.size() - 1);
+        return {O::Timeout, message};
     }
     if (strict) {
         for (const auto& f : findings_) {
@@ -403,6 +407,10 @@ std::vector<std::string> BoardRun::summary() const {
         out.push_back(format_text("  job        %s: %zu of %zu lines acknowledged (%zu ok, %zu error), %s",
                              options_.gcode->path.c_str(), host_->lines_acknowledged(), host_->lines().size(),
                              host_->oks(), host_->errors(), to_string(outcome_)));
+        // Why a job that did not end idle had not: what the firmware was still doing.
+        if (outcome_ != IdleResult::Idle) {
+            for (const std::string& why : bench_->left_going()) out.push_back("  going      " + why);
+        }
     }
     for (const auto& [mcu, count] : i2c_) {
         if (count->transfers == 0) continue;  // a master that never spoke is no master

@@ -162,7 +162,9 @@ TEST(SigrokReadsOurVcd, FiveMcuPrinterI2cBytesAndStepEdgesAgreeWithTheBench) {
         }
     });
     test::PinLog x_step(bench->mcu("interp"), "PA0");
-    bench->host().add_lines("M104 S60\nG1 X1 F600\nM400\nM105\n");  // M400: the move ends before the status
+    // M400: the move ends before the status; M104 S0: the heater off again,
+    // so the run is done without waiting for 60 degC.
+    bench->host().add_lines("M104 S60\nG1 X1 F600\nM400\nM105\nM104 S0\n");
     ASSERT_EQ(bench->run_until_idle(10.0), IdleResult::Idle) << bench->host().received_text();
     VcdOptions options;
     options.end_cycle = bench->mcu("interp").cycle();

@@ -129,9 +129,18 @@ class Bench:
         self._native.run_until(predicate, timeout, step)
 
     def run_until_idle(self, max="10s", settle="50ms"):
-        """Until every host finished and motion settled: "idle", or why not
-        ("time-limit", "halted", "host-failed", ...)."""
+        """Until the firmware is done: every G-code host's line and every line
+        written with serial().write() answered, every accepted move made,
+        every heater at its target, no step for `settle`. Returns "idle", or
+        why not: "time-limit", "halted", "host-failed", "interrupted",
+        "recorder-full" (`still_going` then says what was left)."""
         return self._native.run_until_idle(max, settle)
+
+    @property
+    def still_going(self):
+        """What the last run_until_idle that did not end "idle" left going,
+        one phrase each ("host host: line 3 'G1 X10' not answered", ...)."""
+        return self._native.left_going
 
     def run_until_sleep(self, mcu="", timeout="1s"):
         """Until the MCU executes SLEEP; False when it did not within timeout."""
