@@ -1,0 +1,105 @@
+/*
+ * dda_line - straight G1 lines by Bresenham on the Arduino UNO + CNC shield
+ * v3 (bench/boards/arduino-uno-cnc-shield-v3.yaml: X/Y STEP PD2/PD3, DIR
+ * PD5/PD6 with DIR low = +, drivers enabled by PB0 low), at the board's 250
+ * steps/mm: the step quantum every firmware's straight line has. A
+ * Bresenham (DDA) line keeps the minor axis within half a step of the ideal
+ * line, so the carriage is never more than one step of each axis from it.
+ *
+ * USART0 at 115200 baud (U2X0, UBRR0 = 16), polled. One command per line:
+ *   G1 X<mm> Y<mm>   absolute, from the power-up position (0, 0); "ok" once
+ *                    the move is made (one step event every 400 us)
+ * anything else is answered "ok" and ignored.
+ */
+#include <avr/io.h>
+#include <stdlib.h>
+#include <string.h>
+#include <util/delay.h>
+
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
+#define STEPS_PER_MM 250.0
+
+static char line[64];
+
+static void put(char c)
+{
+    loop_until_bit_is_set(UCSR0A, UDRE0);
+    UDR0 = (uint8_t)c;
+}
+
+static void read_line(void)
+{
+    uint8_t n = 0;
+    for (;;) {
+        loop_until_bit_is_set(UCSR0A, RXC0);
+        const char c = (char)UDR0;
+        if (c == '\n' || c == '\r') {
+            if (n == 0) continue;
+            line[n] = '\0';
+            return;
+        }
+        if (n < sizeof line - 1) line[n++] = c;
+    }
+}
+
+/* The steps of `letter`'s word, or `keep` when the line has none. */
+static long target_steps(char letter, long keep)
+{
+    const char *p = strchr(line, letter);
+    if (p == 0) return keep;
+    const double mm = strtod(p + 1, 0);
+    return (long)(mm * STEPS_PER_MM + (mm < 0 ? -0.5 : 0.5));
+}
+
+static void step(uint8_t bits)
+{
+    PORTD |= bits;
+    _delay_us(4); /* A4988: 1 us high at least */
+    PORTD &= (uint8_t)~bits;
+    _delay_us(396);
+}
+
+int main(void)
+{
+    DDRD = _BV(PD2) | _BV(PD3) | _BV(PD5) | _BV(PD6);
+    DDRB = _BV(PB0); /* PB0 low: drivers enabled */
+    UCSR0A = _BV(U2X0);
+    UBRR0 = 16;
+    UCSR0B = _BV(RXEN0) | _BV(TXEN0);
+    UCSR0C = _BV(UCSZ01) | _BV(UCSZ00);
+    long x = 0, y = 0;
+    for (;;) {
+        read_line();
+        if (line[0] == 'G' && line[1] == '1' && line[2] == ' ') {
+            const long tx = target_steps('X', x), ty = target_steps('Y', y);
+            long dx = tx - x, dy = ty - y;
+            /* DIR low = + (the board's forward_dir); set before the first step. */
+            if (dx < 0) PORTD |= _BV(PD5); else PORTD &= (uint8_t)~_BV(PD5);
+            if (dy < 0) PORTD |= _BV(PD6); else PORTD &= (uint8_t)~_BV(PD6);
+            _delay_us(4);
+            const uint8_t xbit = _BV(PD2), ybit = _BV(PD3);
+            const long ax = labs(dx), ay = labs(dy);
+            const uint8_t x_major = ax >= ay;
+            const long major = x_major ? ax : ay, minor = x_major ? ay : ax;
+            long err = major / 2;
+            for (long i = 0; i < major; ++i) {
+                uint8_t bits = x_major ? xbit : ybit;
+                err -= minor;
+                if (err < 0) {
+                    err += major;
+                    bits |= x_major ? ybit : xbit;
+                }
+                step(bits);
+            }
+            x = tx;
+            y = ty;
+        }
+        put('o');
+        put('k');
+        put('\r');
+        put('\n');
+    }
+}
