@@ -79,6 +79,7 @@ void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
         options.fuses = decl.fuses;
         options.lock_bits = decl.lock_bits;
         options.bootloader_hex = decl.bootloader;
+        options.watchdog_resets_expected = decl.watchdog_resets_expected;
         mcus_.push_back(std::make_unique<Mcu>(elf, options));
     }
 }

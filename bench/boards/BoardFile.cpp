@@ -351,7 +351,14 @@ void parse_mcus(const YAML::Node& root, const std::string& path, bool has_base, 
             else if (key == "bootloader") m.bootloader = scalar(field.second, path, "bootloader");
             else if (key == "fuses") m.fuses = parse_fuses(field.second, path, "MCU '" + m.name + "': fuses");
             else if (key == "lock") m.lock_bits = parse_byte(scalar(field.second, path, "lock"), loc + ": MCU '" + m.name + "': lock");
-            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware, bootloader, fuses, lock)");
+            else if (key == "watchdog_resets") {
+                const std::string value = scalar(field.second, path, "watchdog_resets");
+                if (value != "expected" && value != "findings") {
+                    throw BadInput(loc + ": MCU '" + m.name + "': watchdog_resets '" + value + "' is not expected or findings");
+                }
+                m.watchdog_resets_expected = value == "expected";
+            }
+            else throw BadInput(loc + ": MCU '" + m.name + "': unknown key '" + key + "' (expected type, clock, firmware, bootloader, fuses, lock, watchdog_resets)");
         }
         if (!m.bootloader.empty() && !m.fuses) {
             throw BadInput(m.location + ": MCU '" + m.name + "': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})");

@@ -45,6 +45,9 @@ struct McuDecl {
     std::string bootloader;
     std::optional<std::array<std::uint8_t, 3>> fuses;
     std::optional<std::uint8_t> lock_bits;  // the lock byte (Boot Lock Bits)
+    // `watchdog_resets: expected`: a firmware that resets itself by design;
+    // its watchdog resets are no findings (core/Mcu.hpp McuOptions).
+    bool watchdog_resets_expected = false;
     std::string location;
 };
 

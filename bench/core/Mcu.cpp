@@ -29,6 +29,7 @@ extern "C" {
 #include "core/IdleLoopSkip.hpp"
 #include "core/IntelHex.hpp"
 #include "core/TimingProfile.hpp"
+#include "core/WatchdogWatch.hpp"
 #include "core/Twi.hpp"
 #include "core/UserStop.hpp"
 #include "core/fixes/CompareOutputPins.hpp"
@@ -158,6 +159,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     }
 
     fixes_ = std::make_unique<SimavrFixes>(avr_);
+    watchdog_watch_ = std::make_unique<WatchdogWatch>(avr_);
     scheduler_ = std::make_unique<Scheduler>(avr_);
     adc_ = std::make_unique<Adc>(avr_, mcu_type_);
     twi_ = Twi::install(avr_, mcu_type_, *scheduler_, options_.name);
@@ -248,6 +250,7 @@ Mcu::~Mcu() {
     adc_.reset();
     twi_.reset();
     scheduler_.reset();
+    watchdog_watch_.reset();  // its hook came after the fixes': undone first
     fixes_.reset();  // the fixes unhook themselves from the core: before it is freed
     predecoded_.reset();  // likewise (its flash watch is one of the core's I/O modules)
     if (avr_ != nullptr) {
@@ -541,7 +544,19 @@ void Mcu::after_reset() {
     scheduler_->rearm();
     if (twi_) twi_->reset();
     if (profiler_) profiler_->reset();
+    watchdog_watch_->reset();
     for (auto& fn : reset_listeners_) fn();
+}
+
+std::vector<std::string> Mcu::requested_reset_lines() const {
+    std::vector<std::string> out;
+    for (const RequestedReset& r : requested_resets_) {
+        char text[96];
+        std::snprintf(text, sizeof text, "watchdog reset %s at %.6f s (", r.declared ? "expected by the board" : "asked for by the firmware",
+                      static_cast<double>(r.cycle) / frequency_hz());
+        out.push_back(text + std::string(r.declared ? "at " : "spinning at ") + describe_pc(r.pc_bytes) + ")");
+    }
+    return out;
 }
 
 int Mcu::on_pin_direction_change(std::function<void()> fn) {
@@ -600,12 +615,18 @@ bool Mcu::check_after_step(int state, std::uint32_t pc_before) {
             application_started();  // the boot loader jumps to the application
             return true;
         }
+        const bool asked_for = watchdog_reset_seen_ && watchdog_watch_->requested(pc_before);
         after_reset();
         if (watchdog_reset_seen_) {
             watchdog_reset_seen_ = false;
             // A boot loader leaving through a watchdog reset (optiboot does) is not a finding.
-            if (!in_boot_section(pc_before)) {
-                add_finding(kWatchdogReset, pc_before, "watchdog timed out; the MCU was reset", false);
+            if (asked_for || options_.watchdog_resets_expected) {
+                requested_resets_.push_back({avr_->cycle, pc_before, !asked_for});
+            } else if (!in_boot_section(pc_before)) {
+                add_finding(kWatchdogReset, pc_before,
+                            "watchdog timed out; the MCU was reset (not asked for: the firmware served it with WDR "
+                            "since it last set it up, or was not spinning in place)",
+                            false);
             }
         } else {
             std::snprintf(detail, sizeof detail, "execution jumped to the reset vector from %s", describe_pc(pc_before).c_str());

@@ -35,6 +35,7 @@ class DebugHook;
 class IdleLoopSkipper;
 class PredecodedCore;
 class TimingProfiler;
+class WatchdogWatch;
 class Mcu;
 class Twi;
 
@@ -65,6 +66,10 @@ struct McuOptions {
     // the boot section the fuses' BOOTSZ bits select; with BOOTRST
     // programmed the MCU starts there (core/BootSection.hpp). Needs `fuses`.
     std::string bootloader_hex;
+    // Every watchdog reset is expected (the board says so: a firmware that
+    // resets itself by design), none a finding. Otherwise a reset is a
+    // finding unless the firmware asked for it (core/WatchdogWatch.hpp).
+    bool watchdog_resets_expected = false;
 };
 
 enum class StopReason {
@@ -236,6 +241,18 @@ public:
     std::uint64_t idle_cycles_skipped() const;
     // How many times the core went through a reset after power-on.
     unsigned resets() const { return resets_; }
+    // Watchdog resets that were no finding: asked for by the firmware
+    // (core/WatchdogWatch.hpp) or expected by the board; each with the cycle
+    // and the PC the watchdog fired at.
+    struct RequestedReset {
+        Cycle cycle;
+        std::uint32_t pc_bytes;
+        bool declared;  // the board expects every reset (not recognised as asked for)
+    };
+    const std::vector<RequestedReset>& requested_resets() const { return requested_resets_; }
+    // One line per such reset, for a run's summary: "watchdog reset asked
+    // for by the firmware at 0.036000 s (spinning at 0x00d4 <main+0x2c>)".
+    std::vector<std::string> requested_reset_lines() const;
     // A pulse on the RESET pin (an Arduino's auto-reset capacitor when the
     // host opens the port, a reset button): the MCU restarts at its reset
     // vector with MCUSR.EXTRF set (328P §10.2). Between runs only.
@@ -345,6 +362,8 @@ private:
 
     std::uint64_t steps_ = 0;
     unsigned resets_ = 0;
+    std::vector<RequestedReset> requested_resets_;
+    std::unique_ptr<WatchdogWatch> watchdog_watch_;
     std::vector<std::function<void()>> reset_listeners_;
     bool stop_requested_ = false;
     bool halted_ = false;

@@ -425,6 +425,11 @@ std::vector<std::string> BoardRun::summary() const {
         if (m->profile() == nullptr) continue;
         for (const std::string& line : m->profile()->summary_lines()) out.push_back("  profile    " + m->name() + ": " + line);
     }
+    for (Mcu* m : board.mcus()) {
+        for (const std::string& text : m->requested_reset_lines()) {
+            out.push_back("  reset      " + (board.mcus().size() > 1 ? m->name() + ": " : std::string()) + text);
+        }
+    }
     out.push_back(format_text("  findings   %zu", findings_.size()));
     for (const auto& line : summarize_findings(findings_)) out.push_back("    " + line);
     if (host_ != nullptr) {

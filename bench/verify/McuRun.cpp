@@ -109,6 +109,7 @@ std::vector<std::string> McuRun::summary() const {
     if (const TimingProfiler* profile = mcu.profile()) {
         for (const std::string& text : profile->summary_lines()) out.push_back("  profile    " + text);
     }
+    for (const std::string& text : mcu.requested_reset_lines()) out.push_back("  reset      " + text);
     out.push_back(format_text("  findings   %zu", mcu.findings().size()));
     for (const auto& text : summarize_findings(mcu.findings())) out.push_back("    " + text);
     if (!options_.vcd.empty()) {

@@ -2,7 +2,10 @@
  * crash_watchdog - lets the watchdog reset the MCU once, then stays alive.
  *
  * First boot (not a watchdog reset): enable the watchdog in System Reset
- * Mode with the shortest time-out and spin without ever executing WDR. The
+ * Mode with the shortest time-out, serve it with WDR five times about 1 ms
+ * apart, then hang: spin without ever executing WDR again (a firmware that
+ * stops serving its watchdog, not one asking for a reset: that is
+ * firmware/verdicts/wdt_request). The
  * watchdog oscillator runs at 128 kHz; WDP3:0 = 0000 is 2K (2048) of its
  * cycles = 16 ms typical (avr-libc calls it WDTO_15MS), i.e. 256000 CPU
  * cycles at 16 MHz - which is also how simavr 1.6 models it
@@ -71,7 +74,11 @@ int main(void)
      * the 128 kHz oscillator (16 ms). Changing WDE/WDP needs the same timed
      * WDCE sequence, done by wdt_enable(). */
     wdt_enable(WDTO_15MS);
+    for (uint8_t served = 0; served < 5; ++served) {
+        _delay_loop_2(4000); /* 16000 cycles */
+        wdt_reset();
+    }
     for (;;) {
-        /* Deliberately no wdt_reset(). */
+        /* Hung: deliberately no wdt_reset() any more. */
     }
 }

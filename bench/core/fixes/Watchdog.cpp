@@ -7,7 +7,14 @@
 //    so a firmware using the watchdog as a periodic wake-up gets one interrupt
 //    and then none.
 //  - WDIF "is cleared by writing a logic one to the flag"; simavr keeps it.
+//  - A change of WDP in the timed sequence applies to the running watchdog
+//    (§11.9.2); simavr 1.6 compares the new WDP with itself (it reads the
+//    "old" value after storing the new) and keeps the old period until the
+//    watchdog is next enabled: the time-out is restarted here with the new
+//    one, counted from when the counter last started (WDR or enable).
 // The ATmega32's watchdog (simavr's "128" declaration, no WDIE) is left alone.
+#include <algorithm>
+
 extern "C" {
 #include <avr_watchdog.h>
 #include <sim_cycle_timers.h>
@@ -43,10 +50,32 @@ private:
         if (value == 0 && !avr_regbit_get(avr, self->wdt_->wde)) avr_regbit_clear(avr, self->wdt_->watchdog.raised);
     }
 
+    // simavr's watchdog time-out: of the pending cycle timers whose parameter
+    // is the module, the latest (the other clears WDCE four cycles on).
+    avr_cycle_timer_slot_p pending_timer() const {
+        avr_cycle_timer_slot_p latest = nullptr;
+        for (auto* t = avr_->cycle_timers.timer; t != nullptr; t = t->next) {
+            if (t->param == wdt_ && (latest == nullptr || t->when > latest->when)) latest = t;
+        }
+        return latest;
+    }
+
     static void on_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t addr, std::uint8_t value) {
         auto* self = static_cast<Watchdog*>(hook.context());
         const avr_regbit_t wdif = self->wdt_->watchdog.raised;
+        const avr_cycle_count_t period_before = self->wdt_->cycle_count;
+        const auto* before = self->pending_timer();
+        const avr_cycle_count_t when_before = before != nullptr ? before->when : 0;
         hook.write_original(avr, addr, value);
+        auto* after = self->pending_timer();
+        if (after != nullptr && before != nullptr && after->when == when_before && self->wdt_->cycle_count != period_before) {
+            // The same time-out, a new period: the counter started at
+            // when - old period and now ends at its start + the new period
+            // (at once if it is already past it: the datasheet's warning).
+            const avr_cycle_count_t started = when_before - std::min(when_before, period_before);
+            const avr_cycle_count_t due = std::max<avr_cycle_count_t>(started + self->wdt_->cycle_count, avr->cycle + 1);
+            avr_cycle_timer_register(avr, due - avr->cycle, after->timer, self->wdt_);
+        }
         if (wdif.reg == addr && (value & (wdif.mask << wdif.bit)) != 0) {
             if (self->wdt_->watchdog.pending) unpend_interrupt(avr, &self->wdt_->watchdog);
             avr_regbit_clear(avr, wdif);
