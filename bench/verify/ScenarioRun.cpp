@@ -312,19 +312,24 @@ private:
         if (it == vectors.end() || it->second.runs == 0) {
             return e.min_runs && *e.min_runs == 0 ? "" : name + " never ran";
         }
+        // Every bound it breaks, not only the first.
         const VectorProfile& v = it->second;
+        std::vector<std::string> broken;
         if (e.min_runs && v.runs < *e.min_runs) {
-            return name + " ran " + std::to_string(v.runs) + " times, expected at least " + std::to_string(*e.min_runs);
+            broken.push_back("ran " + std::to_string(v.runs) + " times, expected at least " + std::to_string(*e.min_runs));
         }
         if (e.max_cycles && v.inclusive_cycles.max() > *e.max_cycles) {
-            return name + " took up to " + std::to_string(v.inclusive_cycles.max()) + " cycles (median " +
-                   std::to_string(v.inclusive_cycles.median()) + "), expected at most " + std::to_string(*e.max_cycles);
+            broken.push_back("took up to " + std::to_string(v.inclusive_cycles.max()) + " cycles (median " +
+                             std::to_string(v.inclusive_cycles.median()) + "), expected at most " + std::to_string(*e.max_cycles));
         }
         if (e.max_latency_cycles && v.latency_cycles.max() > *e.max_latency_cycles) {
-            return name + " started up to " + std::to_string(v.latency_cycles.max()) +
-                   " cycles after its flag, expected at most " + std::to_string(*e.max_latency_cycles);
+            broken.push_back("started up to " + std::to_string(v.latency_cycles.max()) + " cycles after its flag, expected at most " +
+                             std::to_string(*e.max_latency_cycles));
         }
-        return "";
+        if (broken.empty()) return "";
+        std::string text = name;
+        for (std::size_t i = 0; i < broken.size(); ++i) text += (i == 0 ? " " : "; and ") + broken[i];
+        return text;
     }
     std::string operator()(const ExpectStack& e) {
         const Mcu& m = e.mcu.empty() ? bench_.mcu() : bench_.mcu(e.mcu);
