@@ -203,14 +203,17 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
         }
         return false;
     };
+    // Until the firmware is done as a run's job is (Bench::still_going: every
+    // line answered, every accepted move made, heaters at their targets, no
+    // step for settle_s), the first finding, or the bound.
+    const Picoseconds settle_ps = ps_from_seconds(g_config.settle_s, "AVRBENCH_FUZZ_SETTLE");
     while (mcu.cycle() < end && !mcu.halted() && !found()) {
-        if (!settling && sent()) {
-            settling = true;
-            end = std::min(end, mcu.cycle() + mcu.cycles_from_seconds(g_config.settle_s));
-        }
+        if (!settling && sent()) settling = true;
+        if (settling && !bench.still_going(settle_ps)) break;
         const Cycle from = mcu.cycle();
         const Cycle to = std::min(end, from + slice);
         bench.run_for(static_cast<double>(to - from) / mcu.frequency_hz());
+        bench.sample_heaters();
         if (mcu.cycle() == from) break;  // nothing moved (a stop): never spin
     }
     mcu.set_run_coverage(nullptr);

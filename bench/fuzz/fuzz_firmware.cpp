@@ -125,20 +125,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::snprintf(line, sizeof line, "avrbench fuzz: FINDING after %llu AVR instructions: %s",
                       static_cast<unsigned long long>(outcome.steps), outcome.detail);
         if (const char* seen = std::getenv("AVRBENCH_FUZZ_SEEN"); seen != nullptr && *seen != '\0') {
-            const std::string kind = avrbench::finding_kind(line);
+            // Each hit appends its root cause to <seen>.hits (the campaign
+            // counts the inputs per cause); <seen> lists each cause once.
+            const std::string cause = avrbench::finding_root_cause(line);
+            const std::string entry = cause + "\n";
+            const auto append = [&entry](const std::string& path) {
+                // One short append (O_APPEND): jobs running side by side do not mix lines.
+                const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+                if (fd < 0) return;
+                (void)!::write(fd, entry.data(), entry.size());
+                ::close(fd);
+            };
+            append(std::string(seen) + ".hits");
             std::ifstream in(seen);
             for (std::string known; std::getline(in, known);) {
                 // Reported already: keep fuzzing, but keep the input out of the
                 // corpus (-1), or inputs that crash at once would crowd it.
-                if (known == kind) return -1;
+                if (known == cause) return -1;
             }
-            // One short append (O_APPEND): jobs running side by side do not mix lines.
-            const int fd = ::open(seen, O_WRONLY | O_CREAT | O_APPEND, 0644);
-            if (fd >= 0) {
-                const std::string entry = kind + "\n";
-                (void)!::write(fd, entry.data(), entry.size());
-                ::close(fd);
-            }
+            append(seen);
         }
         std::fprintf(stderr, "%s\n", line);
         if (const char* dir = std::getenv("AVRBENCH_FUZZ_CRASH_DIR"); dir != nullptr && *dir != '\0') {

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "boards/BoardFile.hpp"
@@ -154,17 +155,26 @@ std::string replay(const Target& target, const std::vector<std::string>& env, co
     return at == std::string::npos ? "" : output.substr(at, output.find('\n', at) - at);
 }
 
-// Shrinks `bytes` while the target still reports the same kind of finding:
+// Replays one root cause's minimisation may take (docs/FUZZING.md).
+constexpr int kMinimizeReplays = 150;
+
+// Shrinks `bytes` while the target still reports the same root cause:
 // whole lines first, then single bytes (a greedy pass each; every try is a
-// replay, so the tries are bounded).
+// replay, so the tries are bounded, and so is the wall time: none after
+// `deadline`).
 std::string minimize(const Target& target, const std::vector<std::string>& env, const fs::path& scratch,
-                     std::string bytes, const std::string& kind) {
-    int budget = 150;
+                     std::string bytes, const std::string& cause,
+                     std::optional<std::chrono::steady_clock::time_point> deadline) {
+    int budget = kMinimizeReplays;
     const auto same = [&](const std::string& candidate) {
         if (budget-- <= 0) return false;
+        if (deadline && std::chrono::steady_clock::now() >= *deadline) {
+            budget = 0;
+            return false;
+        }
         std::ofstream(scratch, std::ios::binary) << candidate;
         const std::string found = replay(target, env, scratch);
-        return !found.empty() && finding_kind(found) == kind;
+        return !found.empty() && finding_root_cause(found) == cause;
     };
     for (bool shrunk = true; shrunk && budget > 0;) {
         shrunk = false;
@@ -251,6 +261,7 @@ Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>
     // stop (and restart) for a kind it or another job already found.
     const std::string seen = (out / "seen-findings.txt").string();
     fs::remove(seen);
+    fs::remove(seen + ".hits");
     std::vector<std::string> campaign_env = env;
     campaign_env.push_back("AVRBENCH_FUZZ_SEEN=" + seen);
     if (in_process) campaign_env.push_back("AVRBENCH_FUZZ_CRASH_DIR=" + findings.string());
@@ -443,7 +454,19 @@ struct FindingsRun {
     const std::string& family;
     const fs::path& findings;
     double bound_s;
+    // Minimisation stops here (a campaign bounded by --for alone); none
+    // with --runs, where the replays' count bounds it.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    fs::path hits;  // the target's count of inputs per root cause ("": none)
 };
+
+// The target's <seen>.hits: one line per input that hit a root cause.
+std::map<std::string, std::size_t> hits_per_cause(const fs::path& hits) {
+    std::map<std::string, std::size_t> count;
+    std::ifstream in(hits);
+    for (std::string line; std::getline(in, line);) ++count[line];
+    return count;
+}
 
 // Replays each reproducer once (the target prints the finding and aborts),
 // groups them, minimizes the shortest of each group and records its run.
@@ -455,8 +478,8 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
     const fs::path& findings = how.findings;
     const double bound_s = how.bound_s;
     const Target& target = campaign.target;
-    std::map<std::string, std::vector<fs::path>> by_finding;
-    std::map<std::string, std::string> example;  // finding -> the first replay's whole line
+    std::map<std::string, std::vector<fs::path>> by_cause;
+    std::map<std::string, std::string> example;  // root cause -> the first replay's whole line
     std::size_t not_reproduced = 0;
     std::vector<fs::path>& artifacts = campaign.artifacts;
     std::sort(artifacts.begin(), artifacts.end());
@@ -466,23 +489,25 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
             ++not_reproduced;  // e.g. libFuzzer's own crash report of a job, or a flaky bench: kept, not listed
             continue;
         }
-        const std::string finding = finding_kind(line);
-        by_finding[finding].push_back(artifact);
-        example.emplace(finding, line.substr(line.find("instructions: ") + 14));
+        const std::string cause = finding_root_cause(line);
+        by_cause[cause].push_back(artifact);
+        example.emplace(cause, line.substr(line.find("instructions: ") + 14));
     }
-    std::printf("  findings   %zu distinct (%zu reproducers in %s", by_finding.size(), artifacts.size(),
+    const auto hits = how.hits.empty() ? std::map<std::string, std::size_t>{} : hits_per_cause(how.hits);
+    std::printf("  findings   %zu distinct root causes (%zu reproducers in %s", by_cause.size(), artifacts.size(),
                 campaign.artifact_dir.c_str());
     if (not_reproduced != 0) std::printf("; %zu did not reproduce on replay", not_reproduced);
     std::printf(")\n");
     int index = 0;
-    for (auto& [finding, files] : by_finding) {
-        // The shortest reproducer of each, minimized (the same kind of
-        // finding must remain), recorded as a run with its VCD.
+    for (auto& [cause, files] : by_cause) {
+        // The shortest reproducer of each, minimized (the same root cause
+        // must remain), recorded as a run with its VCD.
         const fs::path shortest = *std::min_element(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
             return fs::file_size(a) < fs::file_size(b);
         });
         const std::string base = (findings / ("finding-" + std::to_string(++index))).string();
-        const std::string minimal = minimize(target, env, base + ".try", slurp(shortest.string()), finding);
+        const bool out_of_time = how.deadline && std::chrono::steady_clock::now() >= *how.deadline;
+        const std::string minimal = minimize(target, env, base + ".try", slurp(shortest.string()), cause, how.deadline);
         std::ofstream(base + ".gcode", std::ios::binary) << minimal;
         // Replayed the way the fuzz target sent it: lines through the port's
         // host, bytes that are not text included.
@@ -497,11 +522,14 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
             run.insert(run.end(), {"--family", family, "--gcode", base + ".gcode", "--gcode-bytes"});
         }
         run_logged(run, {}, base + ".txt");
-        std::printf("    %d. %s (%zu reproducers)\n       e.g. %s\n       minimized: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
-                    index, finding.c_str(), files.size(), example[finding].c_str(), minimal.size(),
+        const auto hit = hits.find(cause);
+        const std::size_t inputs = hit != hits.end() ? hit->second : files.size();
+        std::printf("    %d. %s (%zu input%s hit it)\n       e.g. %s\n       %s: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
+                    index, cause.c_str(), inputs, inputs == 1 ? "" : "s", example[cause].c_str(),
+                    out_of_time ? "not minimized (the --for budget was spent)" : "minimized", minimal.size(),
                     static_cast<std::uintmax_t>(fs::file_size(shortest)), base.c_str(), base.c_str(), base.c_str());
     }
-    return by_finding.empty() ? 0 : 1;
+    return by_cause.empty() ? 0 : 1;
 }
 
 }  // namespace
@@ -588,8 +616,24 @@ int fuzz_command(const FuzzArgs& args) {
                                           "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
                                           std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
     const auto started = std::chrono::steady_clock::now();
-    Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, seconds, bound_s, family)
-                                             : libfuzzer_campaign(args, env, out, corpus, findings, seconds, family);
+    // --for bounds the whole campaign: the engine gets four fifths of it and
+    // the replays, minimisation and recorded runs the rest, stopping at the
+    // end. With --runs the executions bound the engine, and each root
+    // cause's minimisation takes at most kMinimizeReplays replays, on any
+    // machine the same.
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    double engine_s = seconds;
+    if (args.runs == 0) {
+        engine_s = std::max(1.0, seconds * 0.8);
+        deadline = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+        std::printf("avrbench fuzz: %.0f s in all: fuzzing %.0f s, then replaying and minimising what it found until the end\n",
+                    seconds, engine_s);
+    } else {
+        std::printf("avrbench fuzz: minimising takes at most %d replays per root cause after the %lu executions\n",
+                    kMinimizeReplays, args.runs);
+    }
+    Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, engine_s, bound_s, family)
+                                             : libfuzzer_campaign(args, env, out, corpus, findings, engine_s, family);
     const double campaign_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     std::printf("  executions %lu in %.1f s (%.0f per second)\n", campaign.executions, campaign_s,
                 campaign_s > 0 ? static_cast<double>(campaign.executions) / campaign_s : 0.0);
@@ -602,7 +646,8 @@ int fuzz_command(const FuzzArgs& args) {
                     campaign.wall_timeouts);
     }
 
-    return report_findings(campaign, env, FindingsRun{args, run_firmware, family, findings, bound_s});
+    const fs::path hits = args.engine == "afl" ? fs::path() : out / "seen-findings.txt.hits";
+    return report_findings(campaign, env, FindingsRun{args, run_firmware, family, findings, bound_s, deadline, hits});
 }
 
 }  // namespace avrbench

@@ -489,6 +489,8 @@ IdleResult Bench::run_until_idle_ps(Picoseconds max_ps, Picoseconds settle_ps) {
     return noting_what_is_going(run_until_done(max_ps, settle_ps), settle_ps);
 }
 
+void Bench::sample_heaters() { heat_->sample(now_ps()); }
+
 IdleResult Bench::noting_what_is_going(IdleResult r, Picoseconds settle_ps) {
     left_going_.clear();
     if (r != IdleResult::Idle) still_going(settle_ps, &left_going_);
@@ -504,7 +506,7 @@ IdleResult Bench::run_until_done(Picoseconds max_ps, Picoseconds settle_ps) {
             if (host->failed()) return IdleResult::HostFailed;
         }
         const Picoseconds now = now_ps();
-        heat_->sample(now);
+        sample_heaters();
         if (!still_going(settle_ps)) return IdleResult::Idle;
         if (now >= end) return IdleResult::TimeLimit;
         if (user_stop_requested()) return IdleResult::Interrupted;

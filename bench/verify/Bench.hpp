@@ -110,6 +110,10 @@ public:
     // edge, nor a line either way on a port, for `settle_ps` or 2.5 times
     // the longest step interval of the run (up to 250 ms) if that is longer.
     bool still_going(Picoseconds settle_ps, std::vector<std::string>* why = nullptr) const;
+    // Reads the heaters' temperatures for still_going's "no longer changing"
+    // (run_until_idle does it between its slices; a caller running its own
+    // slices does it after each).
+    void sample_heaters();
     // What was still going when the last run_until_idle ended otherwise than idle.
     const std::vector<std::string>& left_going() const { return left_going_; }
     // Runs until done (see still_going) or until `max_ps` of simulated time
