@@ -1,4 +1,6 @@
 #include "boards/BoardFile.hpp"
+
+#include "parts/HostConnector.hpp"
 #include "boards/YamlKeys.hpp"
 
 #include "core/Time.hpp"
@@ -461,7 +463,9 @@ void parse_serial(const YAML::Node& root, const std::string& path, BoardSpec& sp
                     s.family = value;
                 } else if (key == "line_timeout") {
                     s.line_timeout_s = seconds_from_ps(parse_duration_ps(value, loc + ": line_timeout"));
-                    if (!(s.line_timeout_s > 0)) throw BadInput(loc + ": line_timeout must be longer than 0");
+                    if (!(s.line_timeout_s >= kShortestLineTimeout_s)) {
+                        throw BadInput(loc + ": line_timeout must be at least 100us: no firmware answers faster");
+                    }
                 } else {
                     throw BadInput(loc + ": serial '" + s.name + "': unknown key '" + key +
                                    "' (expected mcu, usart, flow, rx_buffer, family, line_timeout)");
@@ -546,7 +550,10 @@ void check_references(const BoardSpec& spec) {
 // The `serial:` section of earlier board files, as what it always meant: a
 // serial_host part on the USART's TXD and RXD pins (parts/SerialHost.hpp),
 // with a deprecation line naming the form that replaces it.
-void translate_serial_ports(BoardSpec& spec) {
+// The deprecation lines to tell once the board has loaded (not before an
+// error in it: one line for one problem).
+std::vector<std::string> translate_serial_ports(BoardSpec& spec) {
+    std::vector<std::string> deprecations;
     for (const SerialDecl& s : spec.serial) {
         const McuDecl& mcu = *spec.find_mcu(s.mcu);  // check_references found it
         const auto pins = usart_pins(mcu.type, s.usart);
@@ -575,12 +582,13 @@ void translate_serial_ports(BoardSpec& spec) {
         }
         spec.nets.push_back({rx_net, {{mcu.name, txd, s.location}, {s.name, "rx", s.location}}, s.location});
         spec.nets.push_back({tx_net, {{s.name, "tx", s.location}, {mcu.name, rxd, s.location}}, s.location});
-        notice(s.location + ": 'serial:' is deprecated; declare the port as a part on the USART's pins: parts: " + s.name +
-               ": {type: serial_host, family: " + s.family + ", flow: " + s.flow + "}, nets: " + rx_net + ": [" + mcu.name +
-               "." + txd + ", " + s.name + ".rx], " + tx_net + ": [" + s.name + ".tx, " + mcu.name + "." + rxd +
-               "] (docs/BOARDS.md)");
+        deprecations.push_back(s.location + ": 'serial:' is deprecated; declare the port as a part on the USART's pins: parts: " +
+                               s.name + ": {type: serial_host, family: " + s.family + ", flow: " + s.flow + "}, nets: " + rx_net +
+                               ": [" + mcu.name + "." + txd + ", " + s.name + ".rx], " + tx_net + ": [" + s.name + ".tx, " +
+                               mcu.name + "." + rxd + "] (docs/BOARDS.md)");
     }
     spec.serial.clear();
+    return deprecations;
 }
 
 }  // namespace
@@ -602,8 +610,9 @@ BoardSpec parse_board(const std::string& text, const std::string& path, int dept
     if (base) spec = merge_with_base(std::move(*base), std::move(spec), path);
     check_references(spec);
     if (depth == 0 && !spec.serial.empty()) {
-        translate_serial_ports(spec);
+        const std::vector<std::string> deprecations = translate_serial_ports(spec);
         check_references(spec);
+        for (const std::string& line : deprecations) notice(line);
     }
     return spec;
 }

@@ -35,9 +35,17 @@ void check_output_path(const std::string& path, const std::string& what) {
     if (!S_ISDIR(st.st_mode)) throw BadInput(what + ": " + escaped(path) + ": " + escaped(folder) + " is not a folder");
     if (::access(folder.c_str(), W_OK) != 0) throw BadInput(what + ": " + escaped(path) + ": the folder " + escaped(folder) + " is not writable");
     if (::lstat(path.c_str(), &st) == 0) {
-        if (S_ISLNK(st.st_mode) && ::stat(path.c_str(), &st) != 0) return;  // a dangling link: replaced by the file
+        // A link is refused, whatever it points to: replacing it would put the
+        // output where the link is (/dev/stderr is one) and leave its target
+        // as it was, which is neither what the name promised nor safe.
+        if (S_ISLNK(st.st_mode)) {
+            throw BadInput(what + ": " + escaped(path) + ": is a symbolic link; the bench writes only to a file of its own name");
+        }
         if (S_ISDIR(st.st_mode)) throw BadInput(what + ": " + escaped(path) + ": is a folder");
         if (!S_ISREG(st.st_mode)) throw BadInput(what + ": " + escaped(path) + ": is not a regular file (a device, FIFO or socket)");
+        if ((st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0) {
+            throw BadInput(what + ": " + escaped(path) + ": is read-only (no write permission); the bench does not replace it");
+        }
     }
 }
 
@@ -50,7 +58,15 @@ OutputFile::OutputFile(std::string path, std::string what) : path_(std::move(pat
     const int fd = ::mkstemp(buf.data());
     if (fd < 0) throw BadInput(what_ + ": " + escaped(path_) + ": cannot create a file there: " + std::strerror(errno));
     temp_path_ = buf.data();
-    ::fchmod(fd, 0644);
+    // A file written anew: 0644 (as the umask allows); one replaced keeps its mode.
+    struct stat existing {};
+    if (::stat(path_.c_str(), &existing) == 0 && S_ISREG(existing.st_mode)) {
+        ::fchmod(fd, existing.st_mode & 07777);
+    } else {
+        const mode_t mask = ::umask(0);
+        ::umask(mask);
+        ::fchmod(fd, 0644 & ~mask);
+    }
     file_ = ::fdopen(fd, "wb");
     if (file_ == nullptr) {
         ::close(fd);

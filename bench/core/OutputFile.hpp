@@ -7,7 +7,8 @@
 //    write leaves the target as it was;
 //  - the bench removes only the temporary file it created itself, never the
 //    target, and refuses targets that are not regular files (devices, FIFOs,
-//    directories).
+//    directories, symbolic links: never written through) or are read-only;
+//    a file it replaces keeps its mode.
 // Errors are BadInput "<what>: <path>: <reason>" (exit code 2).
 #pragma once
 

@@ -10,5 +10,12 @@ namespace avrbench {
 void install_user_stop_handlers();
 bool user_stop_requested();
 void request_user_stop();  // what the handlers do; also for tests
+void clear_user_stop();    // a front end that goes on after a stop (Python, between calls)
+
+// A front end whose signals arrive elsewhere (Python's, handled by the
+// interpreter) asks through `poll` whether to stop; user_stop_requested()
+// calls it at most every 20 ms of wall time, so a long run notices within
+// that. nullptr: none.
+void set_user_stop_poll(bool (*poll)());
 
 }  // namespace avrbench

@@ -37,4 +37,13 @@ std::optional<int> vector_number(const std::string& mcu_type, const std::string&
     return std::nullopt;
 }
 
+std::optional<int> vector_count(const std::string& mcu_type) {
+    std::optional<int> last;
+    for (const Entry& e : kEntries) {
+        if (mcu_type == e.mcu && (!last || e.vector > *last)) last = e.vector;
+    }
+    if (!last) return std::nullopt;
+    return *last + 1;
+}
+
 }  // namespace avrbench

@@ -12,5 +12,8 @@ namespace avrbench {
 std::string vector_name(const std::string& mcu_type, int vector);
 // The vector of a name ("TIMER1_COMPA" or "TIMER1_COMPA_vect"), if the type has it.
 std::optional<int> vector_number(const std::string& mcu_type, const std::string& name);
+// How many vectors the type has (its last named one plus one; 0 is reset),
+// if the table knows the type.
+std::optional<int> vector_count(const std::string& mcu_type);
 
 }  // namespace avrbench

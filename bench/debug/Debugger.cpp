@@ -142,6 +142,18 @@ void Debugger::listen() {
     }
 }
 
+void Debugger::check_targets(const std::vector<Mcu*>& mcus) const {
+    for (const auto& t : targets_) {
+        if (t->mcu_name.empty()) continue;
+        bool found = false;
+        for (Mcu* m : mcus) found = found || m->name() == t->mcu_name;
+        if (found) continue;
+        std::string names;
+        for (Mcu* m : mcus) names += (names.empty() ? "" : ", ") + m->name();
+        throw BadInput("--gdb: no MCU named '" + t->mcu_name + "' on this board (it has " + names + ")");
+    }
+}
+
 void Debugger::attach(const std::vector<Mcu*>& mcus, DebugRunView view) {
     mcus_ = mcus;
     view_ = std::move(view);
@@ -236,7 +248,7 @@ void Debugger::poll_interrupts() {
     for (auto& t : targets_) {
         if (t->detached || !t->waiting || !t->conn) continue;
         if (t->conn->poll_interrupt()) t->pending_reply = "S02";  // SIGINT, as a Ctrl-C in avr-gdb
-        if (!t->conn->open()) t->detached = true;
+        if (!t->conn->open()) debugger_lost(*t);
     }
 }
 
@@ -393,10 +405,8 @@ void Debugger::serve(Target& t, const std::string& stop_reply) {
     t.waiting = false;
     for (;;) {
         const auto packet = t.conn->read_packet();
-        if (!packet) {  // avr-gdb went away: the MCU runs on undebugged
-            t.detached = true;
-            t.breakpoints.clear();
-            t.watches.clear();
+        if (!packet) {
+            debugger_lost(t);
             return;
         }
         if (!handle(t, *packet)) return;
@@ -685,6 +695,20 @@ bool Debugger::handle_run_control(Target& t, const std::string& p) {
     t.mcu->request_stop();
     c.close();
     return false;
+}
+
+// avr-gdb went away without detaching (it was killed, its terminal closed):
+// nobody will look at the run any more, so it stops as at a kill, its
+// outputs written, rather than running on to its time limit unwatched.
+void Debugger::debugger_lost(Target& t) {
+    killed_ = true;
+    for (auto& other : targets_) {
+        other->detached = true;
+        other->breakpoints.clear();
+        other->watches.clear();
+    }
+    request_user_stop();
+    if (t.mcu != nullptr) t.mcu->request_stop();
 }
 
 bool Debugger::handle(Target& t, const std::string& p) {

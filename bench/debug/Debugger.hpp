@@ -70,6 +70,8 @@ public:
 
     // Opens every port and announces it (BadInput when one cannot be had).
     void listen();
+    // BadInput for a port's MCU the board does not have (before listen()).
+    void check_targets(const std::vector<Mcu*>& mcus) const;
     // Each run (the first and every replay): its MCUs in board order. The
     // first waits for avr-gdb on every port (BadInput after the timeout).
     void attach(const std::vector<Mcu*>& mcus, DebugRunView view);
@@ -94,6 +96,7 @@ private:
     Target* target_of(Mcu& mcu);
     bool resume_from_checkpoint(Target& t);
     void serve(Target& t, const std::string& stop_reply);
+    void debugger_lost(Target& t);
     bool handle(Target& t, const std::string& packet);  // false: the target runs again
     std::string handle_registers(Target& t, const std::string& packet);
     std::string handle_memory(Target& t, const std::string& packet);

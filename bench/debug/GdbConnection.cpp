@@ -59,20 +59,28 @@ void GdbConnection::close() {
 }
 
 int GdbConnection::read_byte() {
-    if (!pending_.empty()) {
-        const unsigned char c = static_cast<unsigned char>(pending_.front());
-        pending_.erase(0, 1);
-        return c;
+    if (unread() == 0) {
+        pending_.clear();
+        head_ = 0;
+        if (fd_ < 0) return -1;
+        char buf[4096];
+        for (;;) {
+            const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+            if (n > 0) {
+                pending_.assign(buf, static_cast<std::size_t>(n));
+                break;
+            }
+            if (n < 0 && errno == EINTR) continue;
+            close();
+            return -1;
+        }
     }
-    if (fd_ < 0) return -1;
-    unsigned char c = 0;
-    for (;;) {
-        const ssize_t n = ::recv(fd_, &c, 1, 0);
-        if (n == 1) return c;
-        if (n < 0 && errno == EINTR) continue;
-        close();
-        return -1;
+    const unsigned char c = static_cast<unsigned char>(pending_[head_++]);
+    if (head_ > 4096 && head_ * 2 > pending_.size()) {
+        pending_.erase(0, head_);
+        head_ = 0;
     }
+    return c;
 }
 
 bool GdbConnection::poll_interrupt() {
@@ -87,7 +95,7 @@ bool GdbConnection::poll_interrupt() {
         }
         pending_.append(buf, static_cast<std::size_t>(n));
     }
-    const auto at = pending_.find('\x03');
+    const auto at = pending_.find('\x03', head_);
     if (at == std::string::npos) return false;
     pending_.erase(at, 1);
     return true;
@@ -156,11 +164,15 @@ void GdbConnection::send_packet(const std::string& payload) {
             sent += static_cast<std::size_t>(n);
         }
         if (no_ack_) return;
-        // The acknowledgement; anything else that comes first is kept.
+        // The acknowledgement; anything else that comes first is kept, in
+        // front of what is still unread.
         std::string kept;
         int c = 0;
         while ((c = read_byte()) >= 0 && c != '+' && c != '-') kept += static_cast<char>(c);
-        pending_.insert(0, kept);
+        if (!kept.empty()) {
+            pending_ = kept + pending_.substr(head_);
+            head_ = 0;
+        }
         if (c != '-') return;
     }
 }

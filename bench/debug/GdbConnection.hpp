@@ -50,9 +50,14 @@ public:
 
 private:
     int read_byte();  // -1 when closed
+    std::size_t unread() const { return pending_.size() - head_; }
     int fd_;
     bool no_ack_ = false;
-    std::string pending_;  // bytes read by poll_interrupt, not yet consumed
+    // Bytes read and not yet consumed, from head_ on: consuming one moves
+    // head_ (the buffer is compacted when the consumed half is the larger),
+    // so a burst of input costs its length, not its length squared.
+    std::string pending_;
+    std::size_t head_ = 0;
 };
 
 // Hex helpers of the protocol.

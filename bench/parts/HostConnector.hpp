@@ -12,6 +12,11 @@ namespace avrbench {
 
 class Uart;
 
+// The shortest line timeout a board may give (0 aside, the family's): a
+// firmware's answer is at least a few frames after the line's last one
+// (an "ok" and its line end at 1 Mbaud take 40 us).
+constexpr double kShortestLineTimeout_s = 100e-6;
+
 // How a host talks to the firmware behind this connector (the spelling of
 // board files: stimulus/UartHost.hpp parses it).
 struct HostProtocol {

@@ -94,6 +94,9 @@ SerialHost::SerialHost(std::string name, Mcu& clock, const ParamValues& params)
     protocol_.flow = params.text("flow");
     protocol_.rx_buffer_bytes = static_cast<unsigned>(params.integer("rx_buffer"));
     protocol_.line_timeout_s = params.quantity("line_timeout");
+    if (protocol_.line_timeout_s != 0 && protocol_.line_timeout_s < kShortestLineTimeout_s) {
+        throw BadInput("part '" + this->name() + "': line_timeout must be 0 (the family's) or at least 100us: no firmware answers faster");
+    }
     if (params.has("error_pattern")) {
         protocol_.error_pattern = params.text("error_pattern");
         (void)TextPattern(protocol_.error_pattern, "part '" + this->name() + "': error_pattern");

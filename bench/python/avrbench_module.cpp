@@ -10,11 +10,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -23,7 +23,10 @@
 #include "core/Lockstep.hpp"
 #include "core/Mcu.hpp"
 #include "core/TimingProfile.hpp"
+#include "core/OutputFile.hpp"
+#include "core/TextPattern.hpp"
 #include "core/Units.hpp"
+#include "core/UserStop.hpp"
 #include "parts/Part.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/TimelineText.hpp"
@@ -54,6 +57,68 @@ Picoseconds duration_ps(const py::object& value, const char* what) {
     throw BadInput(std::string(what) + ": a duration like \"250ms\" or a number of seconds");
 }
 
+// Ctrl-C while the simulation runs with the GIL released: the interpreter's
+// SIGINT handler only marks the signal; the run loops poll
+// (core/UserStop.hpp) and, in the main thread, let Python run its handler.
+// The KeyboardInterrupt it raises is kept here and raised when the call
+// returns (within 20 ms of wall time, plus the slice running then).
+struct PendingPythonError {
+    PyObject* type = nullptr;
+    PyObject* value = nullptr;
+    PyObject* traceback = nullptr;
+};
+PendingPythonError g_interrupt;
+
+bool python_signal_pending() {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    PyErr_Fetch(&g_interrupt.type, &g_interrupt.value, &g_interrupt.traceback);
+    return true;
+}
+
+// One call that runs the simulation, interruptible by Ctrl-C. Made with the
+// GIL held; raise_if_interrupted() after the run (GIL held again).
+class InterruptibleRun {
+public:
+    InterruptibleRun() {
+        clear_user_stop();
+        set_user_stop_poll(&python_signal_pending);
+    }
+    ~InterruptibleRun() {
+        set_user_stop_poll(nullptr);
+        clear_user_stop();
+    }
+    InterruptibleRun(const InterruptibleRun&) = delete;
+    InterruptibleRun& operator=(const InterruptibleRun&) = delete;
+    void raise_if_interrupted() {
+        if (g_interrupt.type == nullptr) return;
+        PyErr_Restore(g_interrupt.type, g_interrupt.value, g_interrupt.traceback);
+        g_interrupt = {};
+        throw py::error_already_set();
+    }
+};
+
+// A recorded signal by the names people use: "scope.name" (uno.PB5,
+// x.position_mm, nets.x_step), or a net's or label's name alone (x_step,
+// led). -1 when none.
+long find_signal(const Timeline& t, const std::string& signal) {
+    const auto dot = signal.find('.');
+    if (dot != std::string::npos) {
+        const std::string scope = signal.substr(0, dot), name = signal.substr(dot + 1);
+        if (const long id = t.find(scope, name); id >= 0) return id;
+        for (const SignalAlias& a : t.aliases()) {
+            if (a.scope == scope && a.name == name) return static_cast<long>(a.target);
+        }
+        return -1;
+    }
+    for (const char* scope : {"nets", "labels"}) {
+        for (const SignalAlias& a : t.aliases()) {
+            if (a.scope == scope && a.name == signal) return static_cast<long>(a.target);
+        }
+    }
+    return -1;
+}
+
 class PyBench;
 
 // A serial port of the board: raw bytes in, lines out, read as the firmware
@@ -72,7 +137,8 @@ public:
 private:
     PyBench& bench_;
     std::string port_;
-    std::size_t cursor_ = 0;
+    std::size_t cursor_ = 0;   // the first byte of the next line
+    std::size_t scanned_ = 0;  // bytes looked at for its end
 };
 
 class PyBench {
@@ -83,23 +149,49 @@ public:
         BoardSpec spec = load_board_file(board);
         // "" is the board's first MCU (Bench(board, "fw.elf") in Python).
         if (auto first = firmware.extract(""); !first.empty()) firmware[spec.mcus.front().name] = first.mapped();
+        // The CLI's rules for the files a run reads and writes: every output
+        // a file of its own, none of them an input (a VCD over the firmware).
+        RunFiles files;
+        files.input(spec.path, "the board file");
+        for (const auto& [mcu, elf] : firmware) files.input(elf, "the firmware of " + mcu);
+        for (const auto& m : spec.mcus) {
+            files.input(m.bootloader, "an input of the board");
+            if (!m.firmware.empty() && firmware.count(m.name) == 0) files.input(m.firmware, "the firmware of " + m.name);
+        }
+        if (!vcd_.empty()) {
+            files.output(vcd_, "vcd");
+            files.output(with_extension(vcd_, ".gtkw"), "vcd's gtkwave save file");
+        }
+        if (!report_.empty()) files.output(report_, "report");
+        files.check();
         bench_ = std::make_unique<Bench>(std::move(spec), firmware);
         bench_->trace_board();
         if (profile) {
             for (Mcu* m : bench_->board().mcus()) m->enable_profile();
         }
     }
-    Bench& bench() { return *bench_; }
+    // BadInput once close() ran: a closed Bench runs nothing and reads nothing.
+    Bench& bench() {
+        if (closed_) throw BadInput("this Bench is closed (close() or the end of its `with` block); make a new one");
+        return *bench_;
+    }
+    bool closed() const { return closed_; }
 
     void run_for(const py::object& duration) {
-        const Picoseconds end = add_ps(bench_->now_ps(), duration_ps(duration, "run_for"));
-        py::gil_scoped_release release;
-        run_to(end);
+        const Picoseconds end = add_ps(bench().now_ps(), duration_ps(duration, "run_for"));
+        InterruptibleRun run;
+        {
+            py::gil_scoped_release release;
+            run_to(end);
+        }
+        run.raise_if_interrupted();
+        check_recorder();
     }
     // Runs in slices of `step` until `predicate()` is true; Timeout after `timeout`.
     void run_until(const py::function& predicate, const py::object& timeout, const py::object& step) {
-        const Picoseconds end = add_ps(bench_->now_ps(), duration_ps(timeout, "timeout"));
+        const Picoseconds end = add_ps(bench().now_ps(), duration_ps(timeout, "timeout"));
         const Picoseconds slice = std::max<Picoseconds>(1, duration_ps(step, "step"));
+        InterruptibleRun run;
         for (;;) {
             if (predicate().cast<bool>()) return;
             if (bench_->now_ps() >= end) throw Timeout("run_until: the condition did not hold within the timeout");
@@ -107,36 +199,62 @@ public:
                 py::gil_scoped_release release;
                 run_to(std::min(end, add_ps(bench_->now_ps(), slice)));
             }
+            run.raise_if_interrupted();
+            check_recorder();
         }
     }
     std::string run_until_idle(const py::object& max, const py::object& settle) {
         const Picoseconds max_ps = duration_ps(max, "max"), settle_ps = duration_ps(settle, "settle");
+        Bench& b = bench();
         IdleResult r;
+        InterruptibleRun run;
         {
             py::gil_scoped_release release;
-            r = bench_->run_until_idle_ps(max_ps, settle_ps);
+            r = b.run_until_idle_ps(max_ps, settle_ps);
         }
+        run.raise_if_interrupted();
+        check_recorder();
         return to_string(r);
     }
     bool run_until_sleep(const std::string& mcu, const py::object& timeout) {
-        Mcu& m = bench_->mcu(mcu);
+        Mcu& m = bench().mcu(mcu);
         const Cycle end = m.cycle() + m.cycles_from_seconds(seconds_from_ps(duration_ps(timeout, "timeout")));
-        py::gil_scoped_release release;
-        return m.run_until_sleep(end);
+        InterruptibleRun run;
+        bool slept = false;
+        {
+            py::gil_scoped_release release;
+            slept = m.run_until_sleep(end);
+        }
+        run.raise_if_interrupted();
+        return slept;
     }
-    double now() const { return bench_->now_seconds(); }
+    double now() { return bench().now_seconds(); }
 
-    std::vector<Finding> findings() const { return bench_->findings(); }
+    std::vector<Finding> findings() { return bench().findings(); }
 
-    // (cycles, values) of one recorded signal, "scope.name".
-    py::tuple timeline(const std::string& signal) const {
-        const auto dot = signal.find('.');
-        const long id = dot == std::string::npos ? -1 : bench_->timeline().find(signal.substr(0, dot), signal.substr(dot + 1));
-        if (id < 0) throw BadInput("timeline: no recorded signal '" + signal + "' (scope.name, e.g. uno.PB5)");
-        const SignalInfo& info = bench_->timeline().signals()[static_cast<std::size_t>(id)];
+    // The names timeline() takes: every recorded signal as "scope.name"
+    // ("uno.PB5", "nets.x_step", "x.position_mm"), aliases included.
+    std::vector<std::string> signal_names() {
+        std::vector<std::string> names;
+        const Timeline& t = bench().timeline();
+        for (const SignalInfo& info : t.signals()) names.push_back(info.scope + "." + info.name);
+        for (const auto& alias : t.aliases()) names.push_back(alias.scope + "." + alias.name);
+        return names;
+    }
+
+    // (cycles, values) of one recorded signal: "scope.name", or a net's,
+    // label's or part signal's name alone when it is one (x_step, led).
+    py::tuple timeline(const std::string& signal) {
+        const Timeline& t = bench().timeline();
+        const long id = find_signal(t, signal);
+        if (id < 0) {
+            throw BadInput("timeline: no recorded signal '" + signal + "' (a net or label name, or scope.name such as uno.PB5; "
+                           "timeline_signals lists them)");
+        }
+        const SignalInfo& info = t.signals()[static_cast<std::size_t>(id)];
         std::vector<std::uint64_t> cycles;
         std::vector<double> values;
-        for (const TimelineEvent& e : bench_->timeline().events()) {
+        for (const TimelineEvent& e : t.events()) {
             if (e.signal != static_cast<SignalId>(id)) continue;
             cycles.push_back(e.cycle);
             values.push_back(info.kind == SignalKind::Real ? e.value.real : static_cast<double>(e.value.bits));
@@ -145,20 +263,22 @@ public:
                               py::array_t<double>(static_cast<py::ssize_t>(values.size()), values.data()));
     }
     // The timeline in the golden format (trace/TimelineText.hpp), no inputs listed.
-    std::string timeline_text() const {
+    std::string timeline_text() {
+        Bench& b = bench();
         TimelineHeader header;
         header.bench_version = AVRBENCH_VERSION;
-        header.end_cycle = bench_->mcu().cycle();
-        header.end_clock_hz = bench_->mcu().frequency_hz();
-        return format_timeline_text(bench_->timeline(), header);
+        header.end_cycle = b.mcu().cycle();
+        header.end_clock_hz = b.mcu().frequency_hz();
+        return format_timeline_text(b.timeline(), header);
     }
     std::string profile_json(const std::string& mcu) {
-        const TimingProfiler* p = bench_->mcu(mcu).profile();
+        const TimingProfiler* p = bench().mcu(mcu).profile();
         if (p == nullptr) throw BadInput("profile: make the Bench with profile=True");
         return p->json();
     }
 
-    // Writes the VCD and the report asked for (unless `write` is false); the Bench stays usable.
+    // Writes the VCD and the report asked for (unless `write` is false);
+    // afterwards the Bench refuses every call (BadInput).
     void close(bool write) {
         if (closed_) return;
         closed_ = true;
@@ -174,16 +294,24 @@ public:
         }
     }
     PySerial& serial(const std::string& port) {
-        bench_->serial_port(port);  // BadInput for an unknown port
+        bench().serial_port(port);  // BadInput for an unknown port
         auto& s = serials_[port];
         if (!s) s = std::make_unique<PySerial>(*this, port);
         return *s;
     }
 
+    // Runs to `end` in slices of at most 10 ms simulated, so a Ctrl-C or the
+    // recorder's cap ends it at the next slice; with the GIL released.
     void run_to(Picoseconds end) {
-        while (bench_->now_ps() < end) {
-            if (bench_->board().run_until_ps(end) == StopReason::Halted) break;
+        while (bench_->now_ps() < end && !user_stop_requested() && !bench_->timeline().overflowed()) {
+            const Picoseconds slice_end = std::min(end, add_ps(bench_->now_ps(), 10 * kPsPerMs));
+            if (bench_->board().run_until_ps(slice_end) == StopReason::Halted) break;
         }
+    }
+    // The CLI's rule: a run whose timeline reached its cap is an error, not
+    // a quietly shortened record.
+    void check_recorder() {
+        if (bench_->timeline().overflowed()) throw BadInput(bench_->timeline().overflow_message());
     }
 
 private:
@@ -202,28 +330,33 @@ std::string PySerial::received() const { return bench_.bench().serial(port_).tra
 std::string PySerial::read_line(const py::object& timeout) {
     Bench& b = bench_.bench();
     const Picoseconds end = add_ps(b.now_ps(), duration_ps(timeout, "timeout"));
+    InterruptibleRun run;
     for (;;) {
-        const std::string text = b.serial(port_).transmitted_text();
-        const auto nl = text.find('\n', cursor_);
-        if (nl != std::string::npos) {
-            std::string line = text.substr(cursor_, nl - cursor_);
-            cursor_ = nl + 1;
+        // From where the last line ended: each byte is looked at once.
+        const std::vector<UartByte>& bytes = b.serial(port_).transmitted();
+        for (std::size_t i = scanned_; i < bytes.size(); ++i) {
+            if (bytes[i].value != '\n') continue;
+            std::string line;
+            line.reserve(i - cursor_);
+            for (std::size_t k = cursor_; k < i; ++k) line.push_back(static_cast<char>(bytes[k].value));
+            cursor_ = scanned_ = i + 1;
             if (!line.empty() && line.back() == '\r') line.pop_back();
             return line;
         }
+        scanned_ = bytes.size();
         if (b.now_ps() >= end) throw Timeout("serial " + (port_.empty() ? std::string("(first)") : port_) + ": no line within the timeout");
-        py::gil_scoped_release release;
-        bench_.run_to(std::min(end, add_ps(b.now_ps(), kPsPerMs)));
+        {
+            py::gil_scoped_release release;
+            bench_.run_to(std::min(end, add_ps(b.now_ps(), kPsPerMs)));
+        }
+        run.raise_if_interrupted();
     }
 }
 
 std::string PySerial::expect(const std::string& pattern, const py::object& timeout) {
-    std::regex re;
-    try {
-        re = std::regex(pattern);
-    } catch (const std::regex_error& e) {
-        throw BadInput("expect: '" + pattern + "' is not a regular expression: " + e.what());
-    }
+    // RE2 (core/TextPattern.hpp): linear in the line, no recursion, so a
+    // 200 kB line and a pattern such as (a|a)*b are safe.
+    const TextPattern re(pattern, "expect");
     Bench& b = bench_.bench();
     const Picoseconds end = add_ps(b.now_ps(), duration_ps(timeout, "timeout"));
     for (;;) {
@@ -235,7 +368,7 @@ std::string PySerial::expect(const std::string& pattern, const py::object& timeo
             throw Timeout("serial " + (port_.empty() ? std::string("(first)") : port_) + ": no line matching '" +
                           pattern + "' within the timeout");
         }
-        if (std::regex_search(line, re)) return line;
+        if (re.found_in(line)) return line;
     }
 }
 
@@ -244,6 +377,15 @@ void PySerial::stream_gcode(const std::string& path, const std::string& family, 
     if (!family.empty()) o.family = parse_firmware_family(family, "family");
     if (!flow.empty()) o.flow = parse_flow_control(flow, "flow");
     bench_.bench().host(port_, o).load_file(path);
+}
+
+// A readout is a count (steps, moves judged) or a measure: a whole number
+// comes back as a Python int, so `part.steps == 100` reads as it should.
+py::object readout_value(double v) {
+    if (std::isfinite(v) && v == std::floor(v) && std::abs(v) < 9007199254740992.0) {
+        return py::int_(static_cast<long long>(v));
+    }
+    return py::float_(v);
 }
 
 // A part: every signal it declares as an attribute, its faults as controls.
@@ -311,15 +453,15 @@ void bind_part(py::module_& m) {
         .def("inject_fault", [](Part& p, const std::string& fault) { p.inject_fault(fault, p.clock().cycle()); })
         .def_property_readonly("readouts", [](Part& p) {
             py::dict d;
-            for (const auto& r : p.readouts()) d[py::str(r.name)] = r.value();
+            for (const auto& r : p.readouts()) d[py::str(r.name)] = readout_value(r.value());
             return d;
         })
         .def("signal", [](Part& p, const std::string& name) {
             for (std::size_t i = 0; i < p.signals().size(); ++i) {
-                if (p.signals()[i].name == name) return p.signal_value(i);
+                if (p.signals()[i].name == name) return py::object(py::float_(p.signal_value(i)));
             }
             for (const auto& r : p.readouts()) {
-                if (r.name == name) return r.value();
+                if (r.name == name) return readout_value(r.value());
             }
             std::string names;
             for (const auto& s : p.signals()) names += (names.empty() ? "" : ", ") + s.name;
@@ -345,6 +487,8 @@ void bind_bench(py::module_& m) {
         .def("run_until", &PyBench::run_until, py::arg("predicate"), py::arg("timeout"), py::arg("step"))
         .def("run_until_idle", &PyBench::run_until_idle, py::arg("max"), py::arg("settle"))
         .def_property_readonly("left_going", [](PyBench& b) { return b.bench().left_going(); })
+        .def_property_readonly("closed", &PyBench::closed)
+        .def_property_readonly("timeline_signals", &PyBench::signal_names)
         .def("run_until_sleep", &PyBench::run_until_sleep, py::arg("mcu"), py::arg("timeout"))
         .def_property_readonly("now", &PyBench::now)
         .def("mcu", [](PyBench& b, const std::string& name) { return &b.bench().mcu(name); },
@@ -388,8 +532,13 @@ PYBIND11_MODULE(_avrbench, m) {
         py::gil_scoped_acquire gil;  // boards load with the GIL held today; a notice must not depend on it
         if (PyErr_WarnEx(PyExc_DeprecationWarning, line.c_str(), 1) < 0) throw py::error_already_set();
     });
-    static py::exception<BadInput> bad_input(m, "BadInput");
-    static py::exception<Timeout> timeout(m, "Timeout");
+    // avrbench.Error, and below it the CLI's exit codes 2 and 3.
+    static py::exception<std::runtime_error> error(m, "Error");  // NOLINT: one per module
+    static py::exception<BadInput> bad_input(m, "BadInput", error.ptr());
+    static py::exception<Timeout> timeout(m, "Timeout", error.ptr());
+    for (PyObject* type : {error.ptr(), bad_input.ptr(), timeout.ptr()}) {
+        py::setattr(py::handle(type), "__module__", py::str("avrbench"));
+    }
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);

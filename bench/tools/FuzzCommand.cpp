@@ -9,6 +9,7 @@
 // records one run per distinct finding with `avrbench run` (summary + VCD).
 #include "tools/FuzzCommand.hpp"
 
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cctype>
+#include <cerrno>
 #include <cstring>
 #include <fcntl.h>
 #include <cstdio>
@@ -32,6 +34,7 @@
 #include "debug/RunViews.hpp"
 #include "fuzz/FuzzFindings.hpp"
 #include "core/Units.hpp"
+#include "core/UserStop.hpp"
 #include "stimulus/GcodeMutator.hpp"
 #include "stimulus/UartHost.hpp"
 #include "tools/Commands.hpp"
@@ -108,11 +111,22 @@ pid_t spawn_logged(const std::vector<std::string>& argv, const std::vector<std::
     return pid;
 }
 
+// Waits for the child, passing a Ctrl-C or SIGTERM of ours on to it (a
+// fuzzing engine ends its campaign on SIGTERM): polled every 20 ms, so a
+// stop is honoured within that, even one that came before the wait.
 int wait_for(pid_t pid) {
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0) {
+    bool passed_on = false;
+    for (;;) {
+        const pid_t r = waitpid(pid, &status, WNOHANG);
+        if (r == pid) return status;
+        if (r < 0 && errno != EINTR) return status;
+        if (!passed_on && user_stop_requested()) {
+            ::kill(pid, SIGTERM);
+            passed_on = true;
+        }
+        ::usleep(20'000);
     }
-    return status;
 }
 
 // Runs argv with `env` added; stdout+stderr to `log`. Returns the exit status.
@@ -286,7 +300,10 @@ Campaign libfuzzer_campaign(const FuzzArgs& args, const std::vector<std::string>
             }
         }
     }
-    if (progress.empty()) throw BadInput(log + ": libFuzzer reported no progress (see the log)");
+    if (progress.empty()) {
+        if (user_stop_requested()) return campaign;  // stopped before its first status line
+        throw BadInput(log + ": libFuzzer reported no progress (see the log)");
+    }
     campaign.executions = progress.back().first;
     campaign.coverage_start = progress.front().second;
     campaign.coverage_end = progress.back().second;
@@ -411,6 +428,7 @@ Campaign afl_campaign(const FuzzArgs& args, const std::vector<std::string>& env,
         all_ran = all_ran && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     }
     if (!fs::exists(sync / "main" / "fuzzer_stats")) {
+        if (user_stop_requested()) return campaign;
         throw BadInput((out / "afl-main.log").string() + ": AFL++ did not start fuzzing (" +
                        afl_abort_reason((out / "afl-main.log").string()) + ")");
     }
@@ -478,6 +496,13 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
     const fs::path& findings = how.findings;
     const double bound_s = how.bound_s;
     const Target& target = campaign.target;
+    if (user_stop_requested()) {
+        // Stopped (Ctrl-C, SIGTERM): what the engine kept stays for a later
+        // look; nothing is replayed, so the stop is honoured at once.
+        std::printf("  interrupted: %zu reproducers kept in %s, not replayed (replay one with --replay FILE)\n",
+                    campaign.artifacts.size(), campaign.artifact_dir.c_str());
+        return 130;
+    }
     std::map<std::string, std::vector<fs::path>> by_cause;
     std::map<std::string, std::string> example;  // root cause -> the first replay's whole line
     std::size_t not_reproduced = 0;
@@ -572,7 +597,48 @@ int replay_command(const FuzzArgs& args) {
     return exit_code(run.verdict(true));
 }
 
-int fuzz_command(const FuzzArgs& args) {
+namespace {
+
+// Every argument checked before any work (a file written, an engine started).
+FuzzArgs checked(FuzzArgs args) {
+    if (!args.runs_text.empty()) {
+        const std::string& t = args.runs_text;
+        const bool digits = !t.empty() && t.size() <= 13 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+        args.runs = digits ? std::stoul(t) : 0;
+        constexpr unsigned long kMostRuns = 1'000'000'000'000ul;
+        if (!digits || args.runs < 1 || args.runs > kMostRuns) {
+            throw BadInput("--runs: '" + t + "' is not a count of executions from 1 to 10^12");
+        }
+    }
+    if (args.jobs < 1 || args.jobs > 64) throw BadInput("--jobs: " + std::to_string(args.jobs) + " is not from 1 to 64");
+    const Picoseconds bound = parse_duration_ps(args.bound, "--bound");
+    if (bound < kPsPerMs) throw BadInput("--bound: '" + args.bound + "' is under 1 ms: an input needs simulated time to run");
+    if (args.replay.empty()) {
+        // --out: a writable folder, or a new one in a writable folder.
+        std::error_code ec;
+        const fs::path out = args.out;
+        const auto writable = [](const fs::path& folder) { return ::access(folder.c_str(), W_OK | X_OK) == 0; };
+        if (fs::exists(fs::symlink_status(out, ec))) {
+            if (!fs::is_directory(fs::status(out, ec))) throw BadInput("--out: " + args.out + " is not a folder (the campaign writes a folder there)");
+            if (!writable(out)) throw BadInput("--out: the folder " + args.out + " is not writable");
+        } else {
+            fs::path parent = out.parent_path();
+            if (parent.empty()) parent = ".";
+            if (!fs::is_directory(parent, ec) || !writable(parent)) {
+                throw BadInput("--out: cannot make the folder " + args.out + " (" + parent.string() + " is not a writable folder)");
+            }
+        }
+        if (!args.corpus.empty()) {
+            if (!fs::is_directory(args.corpus, ec)) throw BadInput("--corpus: " + args.corpus + " is not a folder");
+        }
+    }
+    return args;
+}
+
+}  // namespace
+
+int fuzz_command(const FuzzArgs& raw_args) {
+    const FuzzArgs args = checked(raw_args);
     if (!args.replay.empty()) return replay_command(args);
     if (!args.gdb.empty() || args.break_at_finding || !args.break_at.empty() || !args.break_at_cycle.empty()) {
         throw BadInput("--gdb and the --break-at options need --replay FILE (a campaign runs without a debugger)");
@@ -586,8 +652,12 @@ int fuzz_command(const FuzzArgs& args) {
     const std::string& other_firmware = fw.other_firmware;
     const fs::path out = args.out;
     const fs::path corpus = out / "corpus", findings = out / "findings";
-    fs::create_directories(corpus);
-    fs::create_directories(findings);
+    {
+        std::error_code ec;
+        fs::create_directories(corpus, ec);
+        if (!ec) fs::create_directories(findings, ec);
+        if (ec) throw BadInput("--out: cannot make " + corpus.string() + " and " + findings.string() + ": " + ec.message());
+    }
     // Raw: a few bytes of seed 002's record protocol (M30, a G00 header);
     // coverage finds the rest.
     const std::vector<std::string> seeds =
@@ -598,11 +668,16 @@ int fuzz_command(const FuzzArgs& args) {
         std::error_code ec;
         if (!fs::is_directory(args.corpus, ec)) throw BadInput(args.corpus + ": --corpus is not a directory");
         std::size_t copied = 0;
-        for (const auto& entry : fs::directory_iterator(args.corpus)) {
-            if (!entry.is_regular_file()) continue;
-            fs::copy_file(entry.path(), corpus / ("user-" + entry.path().filename().string()), fs::copy_options::overwrite_existing);
+        for (const auto& entry : fs::directory_iterator(args.corpus, ec)) {
+            // A link that loops or leads nowhere is skipped; files are copied.
+            std::error_code file_ec;
+            if (!entry.is_regular_file(file_ec) || file_ec) continue;
+            fs::copy_file(entry.path(), corpus / ("user-" + entry.path().filename().string()), fs::copy_options::overwrite_existing,
+                          file_ec);
+            if (file_ec) throw BadInput("--corpus: " + entry.path().string() + ": cannot copy (" + file_ec.message() + ")");
             ++copied;
         }
+        if (ec) throw BadInput("--corpus: " + args.corpus + ": cannot read (" + ec.message() + ")");
         if (copied == 0) throw BadInput(args.corpus + ": --corpus holds no files");
     }
     {

@@ -11,6 +11,7 @@ struct FuzzArgs {
     std::string board;
     std::string duration = "60s";  // wall-clock time of the campaign (with --runs: its guard)
     unsigned long runs = 0;        // executions of the campaign (0: until --for ends)
+    std::string runs_text;         // --runs as given (checked: 1 to 10^12)
     std::string bound = "5s";      // simulated time one input may take
     std::string out = "fuzz-out";
     std::string family;  // "" = the board's
@@ -20,7 +21,7 @@ struct FuzzArgs {
     bool hang = false;            // a line unanswered when the bound ends is a finding
     std::string boot = "0.2s";    // raw: simulated time the firmware boots before the first input
     std::string engine = "libfuzzer";  // or "afl"
-    int jobs = 1;
+    int jobs = 1;                 // 1 to 64
     unsigned seed = 1;
     // --replay FILE: run one input as the campaign's target ran it (no
     // campaign), under avr-gdb with `debug.gdb`.

@@ -33,7 +33,7 @@ Command add_fuzz_command(CLI::App& app) {
     fuzz_cmd->add_option("--elf", fuzz.elf, "the firmware")->required();
     fuzz_cmd->add_option("--board", fuzz.board, "board file or standard board name; --elf runs on its serial port's MCU")->required();
     fuzz_cmd->add_option("--for", fuzz.duration, "wall-clock time of the campaign (default 60s; with --runs its upper bound)");
-    fuzz_cmd->add_option("--runs", fuzz.runs,
+    fuzz_cmd->add_option("--runs", fuzz.runs_text,
                          "executions of the campaign: with one job and a --seed, the same inputs on any machine "
                          "(libFuzzer -runs, AFL++ -E)");
     fuzz_cmd->add_option("--bound", fuzz.bound, "simulated time one input may take (default 5s; above the port's line timeout)");

@@ -326,6 +326,10 @@ public:
                 record(word[0] == '+' ? last_cycle_ + parse_cycles(word.substr(1)) : parse_cycles(word), value);
             }
         }
+        // A golden that records nothing passes every run: no check at all.
+        if (parsed_.timeline.signals().empty()) {
+            fail("holds no signal; a golden records the signals a run is checked on (avrbench golden update writes one)");
+        }
         if (into_ != nullptr) {
             for (auto& c : into_->changes) c.finish();
         }

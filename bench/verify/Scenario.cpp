@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -188,7 +189,7 @@ ScenarioStep parse_step(const Item& item, const std::string& path, const BoardNa
         names.check_serial(k, item.location);
         const std::string file = resolve(path, item.scalar_value());
         std::error_code ec;
-        if (!fs::is_regular_file(file, ec)) throw BadInput(item.location + ": send_file " + file + ": no such file");
+        check_input_file(file, item.location + ": send_file", kMaxGcodeFileBytes);
         step.action = SendFileStep{file};
     } else if (k == "delay") {
         step.action = DelayStep{parse_duration_ps(item.scalar_value(), item.location + ": delay")};
@@ -237,6 +238,11 @@ ExpectAction parse_timing_expectation(const Item& item, const BoardNames& names)
         const std::string vector = item.get("vector");
         if (!vector.empty() && std::isdigit(static_cast<unsigned char>(vector[0]))) {
             e.vector = static_cast<int>(parse_integer(vector, item.at("vector") + ": vector", 1, 127));
+            const std::string type = names.mcu_type(e.mcu);
+            if (const auto vectors = vector_count(type); vectors && e.vector >= *vectors) {
+                throw BadInput(item.at("vector") + ": the " + type + " has interrupt vectors 1 to " + std::to_string(*vectors - 1) +
+                               ", not " + std::to_string(e.vector));
+            }
         } else {
             const std::string type = names.mcu_type(e.mcu);
             const auto number = vector_number(type, vector);
@@ -395,7 +401,9 @@ void scenario_firmware(ScenarioSpec& spec, const BoardSpec& board, const YAML::N
         std::string value = scalar(kv.second, path, "firmware");
         const bool bare_name = value.find('/') == std::string::npos && value.find(".elf") == std::string::npos;
         value = bare_name ? (fs::path(firmware_dir) / (value + ".elf")).string() : resolve(path, value);
-        if (!fs::is_regular_file(value, ec)) throw BadInput(where(path, kv.second) + ": firmware " + value + ": no such file");
+        // A missing file, a device, a FIFO or a folder: one line saying which
+        // (ElfImage reads the file itself, with its own bounds).
+        check_input_file(value, where(path, kv.second) + ": firmware", std::numeric_limits<std::uint64_t>::max());
         spec.firmware[mcu] = value;
     }
     for (const auto& m : board.mcus) {

@@ -17,10 +17,60 @@ exceptions with the command-line tool's one-line messages: BadInput (what
 """
 import json as _json
 
-from ._avrbench import BadInput, Finding, Timeout  # noqa: F401
+from ._avrbench import BadInput, Error, Finding, Timeout  # noqa: F401
 from . import _avrbench
 
-__all__ = ["Bench", "BadInput", "Timeout", "Finding", "Part", "Net"]
+__all__ = ["Bench", "Error", "BadInput", "Timeout", "Finding", "Part", "Net", "Mcu", "Serial"]
+
+
+def _check_open(bench):
+    if bench._native.closed:
+        raise BadInput("this Bench is closed (close() or the end of its `with` block); make a new one")
+
+
+class _OfBench:
+    """A view of one piece of a Bench, refusing every use once the Bench is
+    closed (avrbench.BadInput), as the Bench itself does."""
+
+    def __init__(self, bench, native):
+        object.__setattr__(self, "_bench", bench)
+        object.__setattr__(self, "_native", native)
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        _check_open(self._bench)
+        return getattr(self._native, name)
+
+
+class Mcu(_OfBench):
+    """An MCU of the board: `.cycle`, `.seconds`, `.pc` (byte address),
+    `.sp`, `.sleeping`, `.halted`, `.frequency_hz`, `.name`, `.type`;
+    `.symbol(name)` a variable's value, `.read(symbol, size)` its bytes,
+    `.write(symbol, data)`."""
+
+    def __repr__(self):
+        return f"<avrbench.Mcu {self._native.name}>"
+
+
+class Serial(_OfBench):
+    """A serial port of the board, as a host program sees it.
+
+    write(data)           bytes to the firmware; each line in them is one the
+                          firmware must answer before run_until_idle is done
+    read_line(timeout)    the firmware's next line (without its line end);
+                          avrbench.Timeout when none comes within `timeout`
+    expect(pattern, timeout)  the next line matching the regular expression
+                          (RE2: linear time, no backreferences or lookaround)
+    stream_gcode(path, family="", flow="")  the board's G-code host sends
+                          the file with the port's protocol (family, flow:
+                          overrides, as `run --family/--flow`); a grbl family
+                          waits up to 10 s for grbl's welcome first
+    received              everything the firmware sent, as text
+    """
+
+    def __repr__(self):
+        return "<avrbench.Serial>"
 
 
 class Part:
@@ -28,8 +78,9 @@ class Part:
     attribute (`part.position_mm`, `part.block_degC`, `part.steps`), its
     faults are controls."""
 
-    def __init__(self, native):
+    def __init__(self, native, bench=None):
         object.__setattr__(self, "_native", native)
+        object.__setattr__(self, "_bench", bench)
 
     @property
     def name(self):
@@ -67,6 +118,8 @@ class Part:
     def __getattr__(self, name):
         if name.startswith("_"):
             raise AttributeError(name)
+        if self._bench is not None:
+            _check_open(self._bench)
         return self._native.signal(name)
 
     def __repr__(self):
@@ -153,14 +206,15 @@ class Bench:
 
     # --- the board ------------------------------------------------------
     def mcu(self, name=""):
-        return self._native.mcu(name)
+        """The MCU `name` (the board's first by default): an avrbench.Mcu."""
+        return Mcu(self, self._native.mcu(name))
 
     @property
     def mcus(self):
         return self._native.mcus
 
     def part(self, name):
-        return Part(self._native.part(name))
+        return Part(self._native.part(name), self)
 
     axis = part
     thermal = part
@@ -175,7 +229,9 @@ class Bench:
     pin = net
 
     def serial(self, port=""):
-        return self._native.serial(port)
+        """Serial port `port` of the board (its first by default): an
+        avrbench.Serial (help(avrbench.Serial) lists what it does)."""
+        return Serial(self, self._native.serial(port))
 
     @property
     def findings(self):
@@ -183,9 +239,15 @@ class Bench:
 
     # --- what was recorded ----------------------------------------------
     def timeline(self, signal):
-        """(cycles, values) of one recorded signal ("uno.PB5", "x.position_mm")
-        as numpy arrays."""
+        """(cycles, values) of one recorded signal as numpy arrays: a net's or
+        label's name ("x_step", "led") or "scope.name" ("uno.PB5",
+        "x.position_mm", "nets.x_step"); `timeline_signals` lists them."""
         return self._native.timeline(signal)
+
+    @property
+    def timeline_signals(self):
+        """Every name timeline() takes ("scope.name"), aliases included."""
+        return self._native.timeline_signals
 
     def timeline_text(self):
         """The timeline in the golden-timeline format (docs/SCENARIOS.md)."""
