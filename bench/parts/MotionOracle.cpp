@@ -275,16 +275,18 @@ void MotionOracle::commanded(const CommandedMove& move) {
 }
 
 bool MotionOracle::retract(std::size_t moves) {
-    if (lost_ || moves > commands_) return false;
+    if (moves > commands_) return false;
     const std::uint64_t first = commands_ - moves;
-    std::size_t drop = 0;
-    for (auto it = moves_.rbegin(); it != moves_.rend() && it->command >= first; ++it) {
-        const bool begun = it->progress > it->end_tolerance.maxCoeff() || it->end_reached || it->deviation_finding ||
-                           it->tool_finding;
-        if (begun && &*it == &moves_.front()) return false;
-        ++drop;
+    // The refused line's moves are the last told; a barrier (judging stopped
+    // on a later line the bench could not read) may stand after them, and
+    // stays: what was refused is still taken back, never judged.
+    for (const Tracked& m : moves_) {
+        if (m.barrier || m.command < first) continue;
+        const bool begun = m.progress > m.end_tolerance.maxCoeff() || m.end_reached || m.deviation_finding || m.tool_finding;
+        if (begun && &m == &moves_.front()) return false;
     }
-    moves_.erase(moves_.end() - static_cast<std::ptrdiff_t>(drop), moves_.end());
+    moves_.erase(std::remove_if(moves_.begin(), moves_.end(), [first](const Tracked& m) { return !m.barrier && m.command >= first; }),
+                 moves_.end());
     commands_ = first;
     return true;
 }

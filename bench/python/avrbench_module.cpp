@@ -144,7 +144,7 @@ private:
 class PyBench {
 public:
     PyBench(const std::string& board, std::map<std::string, std::string> firmware, std::string vcd, std::string report,
-            bool profile)
+            bool profile, std::size_t max_events)
         : vcd_(std::move(vcd)), report_(std::move(report)) {
         BoardSpec spec = load_board_file(board);
         // "" is the board's first MCU (Bench(board, "fw.elf") in Python).
@@ -165,6 +165,7 @@ public:
         if (!report_.empty()) files.output(report_, "report");
         files.check();
         bench_ = std::make_unique<Bench>(std::move(spec), firmware);
+        if (max_events != 0) bench_->timeline().set_max_held_events(max_events);
         bench_->trace_board();
         if (profile) {
             for (Mcu* m : bench_->board().mcus()) m->enable_profile();
@@ -481,8 +482,9 @@ void bind_serial(py::module_& m) {
 
 void bind_bench(py::module_& m) {
     py::class_<PyBench>(m, "Bench")
-        .def(py::init<const std::string&, std::map<std::string, std::string>, std::string, std::string, bool>(),
-             py::arg("board"), py::arg("firmware"), py::arg("vcd") = "", py::arg("report") = "", py::arg("profile") = false)
+        .def(py::init<const std::string&, std::map<std::string, std::string>, std::string, std::string, bool, std::size_t>(),
+             py::arg("board"), py::arg("firmware"), py::arg("vcd") = "", py::arg("report") = "", py::arg("profile") = false,
+             py::arg("max_events") = 0)
         .def("run_for", &PyBench::run_for)
         .def("run_until", &PyBench::run_until, py::arg("predicate"), py::arg("timeout"), py::arg("step"))
         .def("run_until_idle", &PyBench::run_until_idle, py::arg("max"), py::arg("settle"))

@@ -9,6 +9,8 @@
  * USART0 at 115200 baud (U2X0, UBRR0 = 16), polled. One command per line:
  *   G1 X<mm> Y<mm>   absolute, from the power-up position (0, 0); "ok" once
  *                    the move is made (one step event every 400 us)
+ *   G1 ... F0        refused with grbl's "error:22" (undefined feed rate),
+ *                    not moved
  * anything else is answered "ok" and ignored.
  */
 #include <avr/io.h>
@@ -73,6 +75,10 @@ int main(void)
     long x = 0, y = 0;
     for (;;) {
         read_line();
+        if (line[0] == 'G' && line[1] == '1' && strstr(line, "F0") != 0) {
+            put('e'); put('r'); put('r'); put('o'); put('r'); put(':'); put('2'); put('2'); put('\r'); put('\n');
+            continue;
+        }
         if (line[0] == 'G' && line[1] == '1' && line[2] == ' ') {
             const long tx = target_steps('X', x), ty = target_steps('Y', y);
             long dx = tx - x, dy = ty - y;

@@ -39,8 +39,11 @@ WALL_GUARD_S = 120.0  # a guard against a hang only; CPU time is the measure
 
 class Case:
     def __init__(self, name, args, expect=2, files=None, fifos=(), sparse=None, dirs=(), check_files=(), cwd=None,
-                 setup=None, says=""):
+                 setup=None, says="", python=None, stdout_has=""):
         self.name = name
+        self.python = python        # a script run by /usr/bin/python3 -c instead of the CLI (the module, GDB and
+                                    # signal drivers); it exits 0 when the bench behaved as documented
+        self.stdout_has = stdout_has  # a fragment stdout must hold
         self.says = says            # a fragment the error line must hold (so a case fails for the right reason)
         self.args = args            # argv after the CLI, with {w} for the case's folder
         self.expect = expect        # exit code (2: bad input, one line on stderr)
@@ -394,8 +397,172 @@ def cases(fw):
             continue
         out.append(Case(f"mmcu-{label}", ["run", "{w}/m.elf", "--for", "1ms", "-q"], expect=expect, files={"m.elf": elf},
                         says=".mmcu section" if expect == 2 else ""))
+    # Round three (issue 62): outputs through links and over read-only files.
+    def link_to_victim(folder):
+        os.symlink(os.path.join(folder, "victim.txt"), os.path.join(folder, "err.vcd"))
+    out.append(Case("out-vcd-symlink", ["run", blink, "--for", "1ms", "--vcd", "{w}/err.vcd", "-q"], files={"victim.txt": "keep me\n"},
+                    setup=link_to_victim, says="is a symbolic link"))
+    out.append(Case("out-vcd-dev-stderr", ["run", blink, "--for", "1ms", "--vcd", "/dev/stderr", "-q"], says="is a symbolic link"))
+    out.append(Case("out-vcd-read-only", ["run", blink, "--for", "1ms", "--vcd", "{w}/ro.vcd", "-q"], files={"ro.vcd": "mine\n"},
+                    setup=lambda folder: os.chmod(os.path.join(folder, "ro.vcd"), 0o400), says="is read-only"))
+    # Raw bytes into a bit-level serial port: streamed (not a scheduled event
+    # per bit up front), and counted as delivered at their stop bits: 10 ms
+    # at 9600 baud is 9 whole frames of 1.04 ms.
+    bit_board = ("board: bitlevel\nmcus:\n  uno: {type: atmega328p, clock: 16MHz}\nparts:\n  host: {type: serial_host, baud: 9600}\n"
+                 "nets:\n  host_rx: [uno.PB2, host.rx]\n  host_tx: [host.tx, uno.PB3]\n")
+    for label, size in (("4MiB", 4 << 20), ("16MiB", 16 << 20)):
+        out.append(Case(f"uart-in-bit-level-{label}", ["run", blink, "--board", "{w}/b.yaml", "--uart-in", "{w}/in.bin", "--for", "10ms"],
+                        expect=0, files={"b.yaml": bit_board, "in.bin": bytes(range(256)) * (size // 256)},
+                        stdout_has="0 bytes from firmware, 9 bytes to firmware"))
+    # Fuzz arguments, checked before any work.
+    fuzz = ["fuzz", "--elf", blink, "--board", "{w}/board.yaml", "--for", "2s"]
+    for label, extra, says in (("runs-negative", ["--runs", "-1"], "is not a count of executions"),
+                               ("runs-2^64", ["--runs", "18446744073709551616"], "is not a count of executions"),
+                               ("jobs-0", ["--jobs", "0"], "is not from 1 to 64"),
+                               ("bound-0", ["--bound", "0s"], "is under 1 ms"),
+                               ("out-file", ["--out", "{w}/board.yaml"], "is not a folder"),
+                               ("out-elf", ["--out", blink], "is not a folder"),
+                               ("out-dev-full", ["--out", "/dev/full"], "is not a folder"),
+                               ("out-missing-parent", ["--out", "{w}/no/such/out"], "is not a writable folder")):
+        out.append(Case(f"fuzz-{label}", fuzz + extra, files={"board.yaml": UNO_BOARD}, says=says))
+    def corpus_loop(folder):
+        os.makedirs(os.path.join(folder, "corpus"))
+        os.symlink("loop", os.path.join(folder, "corpus", "loop"))
+    out.append(Case("fuzz-corpus-symlink-loop", fuzz + ["--runs", "5", "--corpus", "{w}/corpus", "--out", "{w}/out"], expect=2,
+                    files={"board.yaml": UNO_BOARD}, setup=corpus_loop, says="holds no files"))
+    # A golden of nothing, a line timeout of nothing, a vector past the MCU's.
+    out.append(Case("golden-header-only", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                    files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(), "g.txt": "avrbench-timeline 1\n",
+                           "s.yaml": scenario_with(golden="g.txt")}, says="holds no signal"))
+    out.append(Case("serial-host-line-timeout-tiny", run_board,
+                    files={"board.yaml": UNO_BOARD.replace("{type: serial_host, flow: send_and_wait}",
+                                                           "{type: serial_host, line_timeout: 1e-13s}")},
+                    says="at least 100us"))
+    out.append(Case("scenario-isr-vector-26", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                    files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
+                           "s.yaml": scenario_with(extra="expect:\n  - isr: {vector: 26, min_runs: 1}\n")},
+                    says="has interrupt vectors 1 to 25"))
+    out.append(Case("scenario-firmware-dev-zero", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
+                    files={"board.yaml": UNO_BOARD, "s.yaml": scenario_with(firmware="{uno: /dev/zero}")},
+                    says="is a character device"))
+    # One line for one problem: nothing announced before the error.
+    out.append(Case("gdb-unknown-mcu", ["run", blink, "--board", "{w}/board.yaml", "--gdb", "nope=0", "--for", "1ms"],
+                    files={"board.yaml": UNO_BOARD}, says="no MCU named 'nope'"))
+    out.append(Case("serial-both-shapes", run_board, files={"board.yaml": UNO_BOARD + "serial:\n  other: {mcu: uno, usart: 0}\n"},
+                    says="already on another net"))
+
     # One trailing byte after the last tag: the section is one byte longer
     # than its tags, which padding cannot express; cut it instead.
+    return out
+
+
+# --- the Python module, the GDB server and signals (scripts driving them) ------
+
+# Each script gets the case's folder as sys.argv[1] and exits 0 when the bench
+# behaved as documented (an AssertionError otherwise); the runner's checks
+# (CPU time, memory, sanitizer reports, files left as they were) apply to it
+# and to the avrbench it starts.
+PY_HEAD = """
+import os, signal, socket, subprocess, sys, threading, time
+import avrbench
+w = sys.argv[1]
+fw = os.environ["AVRBENCH_FIRMWARE_DIR"]
+cli = os.environ["AVRBENCH_CLI"]
+def raises(kind, fn, says=""):
+    try:
+        fn()
+    except kind as e:
+        assert says in str(e), (says, str(e))
+        return
+    raise AssertionError(f"{fn} did not raise {kind.__name__}")
+"""
+
+
+def driver_cases(fw):
+    out = []
+    blink = fw["blink_timer1"]
+    out.append(Case("python-vcd-over-the-elf", None, expect=0, files={"fw.elf": open(blink, "rb").read()}, python=PY_HEAD + r"""
+raises(avrbench.BadInput, lambda: avrbench.Bench("arduino-uno", w + "/fw.elf", vcd=w + "/fw.elf"), "is also read as")
+"""))
+    out.append(Case("python-vcd-and-report-one-file", None, expect=0, python=PY_HEAD + r"""
+raises(avrbench.BadInput, lambda: avrbench.Bench("arduino-uno", fw + "/blink_timer1.elf", vcd=w + "/x", report=w + "/x"),
+       "give each output a file of its own")
+"""))
+    out.append(Case("python-vcd-symlink", None, expect=0, files={"victim.txt": "keep me\n"},
+                    setup=lambda folder: os.symlink(os.path.join(folder, "victim.txt"), os.path.join(folder, "l.vcd")),
+                    python=PY_HEAD + r"""
+raises(avrbench.BadInput, lambda: avrbench.Bench("arduino-uno", fw + "/blink_timer1.elf", vcd=w + "/l.vcd"), "symbolic link")
+"""))
+    # expect() on a 200 kB line: no recursion, no exponential time (RE2).
+    out.append(Case("python-expect-200kB-line", None, expect=0, python=PY_HEAD + r"""
+b = avrbench.Bench("arduino-uno", fw + "/uart_echo.elf")
+port = b.serial()
+port.write(b"a" * 200000 + b"\n")
+for pattern, size in ((".*x", 200000), ("^a*b$", 200000), ("(a|a)*b", 200000)):
+    raises(avrbench.Timeout, lambda: port.expect(pattern, timeout="30s"), "no line matching")
+raises(avrbench.BadInput, lambda: port.expect("(unclosed", timeout="1ms"), "is not a regular expression")
+"""))
+    # Ctrl-C during a long run: KeyboardInterrupt soon after, the outputs valid.
+    out.append(Case("python-sigint-in-run-for", None, expect=0, python=PY_HEAD + r"""
+b = avrbench.Bench("arduino-uno", fw + "/blink_timer1.elf", vcd=w + "/i.vcd")
+def interrupt():
+    time.sleep(0.5)
+    global sent
+    sent = time.monotonic()
+    os.kill(os.getpid(), signal.SIGINT)
+threading.Thread(target=interrupt).start()
+try:
+    b.run_for("1000s")
+    raise AssertionError("run_for ended without the KeyboardInterrupt")
+except KeyboardInterrupt:
+    late = time.monotonic() - sent
+assert late < 1.0, f"KeyboardInterrupt {late:.2f} s after SIGINT"
+assert 0 < b.now < 1000
+b.close()
+assert open(w + "/i.vcd").read(200).startswith("$"), "the VCD of the interrupted run is not a VCD"
+"""))
+    out.append(Case("python-event-cap-is-an-error", None, expect=0, python=PY_HEAD + r"""
+b = avrbench.Bench("arduino-uno", fw + "/blink_timer1.elf", max_events=5000)
+raises(avrbench.BadInput, lambda: b.run_for("30000s"), "the run recorded more than 5000")
+"""))
+    out.append(Case("python-closed-bench", None, expect=0, python=PY_HEAD + r"""
+b = avrbench.Bench("arduino-uno", fw + "/blink_timer1.elf")
+port, mcu, part = b.serial(), b.mcu(), None
+b.close()
+raises(avrbench.BadInput, lambda: b.run_for("1ms"), "closed")
+raises(avrbench.BadInput, lambda: port.write(b"x"), "closed")
+raises(avrbench.BadInput, lambda: mcu.pc, "closed")
+raises(avrbench.BadInput, lambda: b.run_until_idle(max="1ms"), "closed")
+assert issubclass(avrbench.BadInput, avrbench.Error) and issubclass(avrbench.Timeout, avrbench.Error)
+"""))
+    # The GDB server: 2 MB while it waits for an acknowledgement costs its
+    # length (the runner's 5 s of CPU), and a client that goes away ends the run.
+    out.append(Case("gdb-2MB-while-waiting-for-ack-and-client-gone", None, expect=0, python=PY_HEAD + r"""
+p = subprocess.Popen([cli, "run", fw + "/blink_timer1.elf", "--gdb", "0", "--for", "1000s", "-q"], stdout=subprocess.DEVNULL,
+                     stderr=subprocess.PIPE, text=True)
+line = p.stderr.readline()  # "gdb: MCU (first) waits for avr-gdb on 127.0.0.1:PORT ..."
+port = int(line.split("127.0.0.1:")[1].split()[0])
+s = socket.create_connection(("127.0.0.1", port))
+s.sendall(b"$?#3f")
+s.sendall(b"x" * 2000000)
+s.sendall(b"+$c#63")
+time.sleep(0.5)
+s.close()
+started = time.monotonic()
+p.wait(timeout=10)
+assert time.monotonic() - started < 5, "the run went on after its debugger left"
+"""))
+    # SIGTERM to a fuzz campaign: passed to the engine, exit 130 at once.
+    out.append(Case("fuzz-sigterm", None, expect=0, files={"board.yaml": UNO_BOARD}, python=PY_HEAD + r"""
+p = subprocess.Popen([cli, "fuzz", "--elf", fw + "/uart_echo.elf", "--board", w + "/board.yaml", "--for", "120s",
+                      "--out", w + "/out"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+time.sleep(3)
+p.send_signal(signal.SIGTERM)
+started = time.monotonic()
+code = p.wait(timeout=20)
+assert code == 130, code
+assert time.monotonic() - started < 2, "SIGTERM not honoured at once"
+"""))
     return out
 
 
@@ -435,15 +602,19 @@ def run(case):
     prepare(case, folder)
     watched = [os.path.join(folder, p) for p in case.check_files] + [os.path.join(folder, p) for p in case.files]
     before = {p: digest(p) for p in watched if not any(p.endswith(f) for f in case.fifos)}
-    argv = [ARGS.cli] + [a.replace("{w}", folder) for a in case.args]
     env = dict(os.environ, AVRBENCH_FIRMWARE_DIR=ARGS.firmware_dir)
+    if case.python is None:
+        argv = [ARGS.cli] + [a.replace("{w}", folder) for a in case.args]
+    else:
+        argv = ["/usr/bin/python3", "-c", case.python, folder]
+        env.update(PYTHONPATH=ARGS.python, AVRBENCH_CLI=ARGS.cli, AVRBENCH_SOURCE=ARGS.source)
     cwd = os.path.join(folder, case.cwd) if case.cwd else folder
     with open(os.path.join(folder, ".stdout"), "wb") as out, open(os.path.join(folder, ".stderr"), "wb") as err:
         started = time.monotonic()
         def limit():
             if ARGS.address_space_mb:  # for an unsanitized CLI only: ASan reserves terabytes of address space
                 resource.setrlimit(resource.RLIMIT_AS, (ARGS.address_space_mb << 20, ARGS.address_space_mb << 20))
-        process = subprocess.Popen(argv, stdin=subprocess.PIPE if "-" in case.args else subprocess.DEVNULL, stdout=out,
+        process = subprocess.Popen(argv, stdin=subprocess.PIPE if case.args and "-" in case.args else subprocess.DEVNULL, stdout=out,
                                    stderr=err, cwd=cwd, env=env, start_new_session=True, preexec_fn=limit)
         if process.stdin:
             try:
@@ -483,6 +654,8 @@ def run(case):
             problems.append(f"stderr is not one 'avrbench: error:' line: {stderr[:300]!r}")
         elif case.says and case.says not in lines[0]:
             problems.append(f"the error does not say '{case.says}'")
+    if case.stdout_has and case.stdout_has not in stdout:
+        problems.append(f"stdout does not hold '{case.stdout_has}'")
     if "\x1b" in stderr or "\x1b" in stdout:
         problems.append("an escape sequence reached the terminal")
     for p, d in before.items():
@@ -511,6 +684,8 @@ def main():
     parser.add_argument("--list", action="store_true")
     parser.add_argument("--only", default="", help="run the cases whose name contains this")
     parser.add_argument("--wall-guard", type=float, default=WALL_GUARD_S, help="seconds before a case counts as a hang")
+    parser.add_argument("--python", default="",
+                        help="the Python module's folder (build/python): the module's and the GDB server's cases run too")
     parser.add_argument("--address-space-mb", type=int, default=0,
                         help="cap each run's address space (protects the machine when trying an old, unsanitized CLI)")
     ARGS = parser.parse_args()
@@ -524,6 +699,13 @@ def main():
         if os.path.exists(path):
             fw[name] = path
     all_cases = cases(fw)
+    driven = driver_cases(fw)
+    if ARGS.python:
+        ARGS.python = os.path.abspath(ARGS.python)
+        all_cases += driven
+    else:
+        print(f"hostile inputs: {len(driven)} cases of the Python module, the GDB server and signals need --python "
+              "(a build with the module); not run here")
     names = [c.name for c in all_cases]
     assert len(names) == len(set(names)), "case names repeat"
     chosen = [c for c in all_cases if ARGS.only in c.name]

@@ -150,5 +150,31 @@ TEST(OracleResolution, AStrayBeyondTheQuantumIsStillAFinding) {
     EXPECT_TRUE(strays);
 }
 
+TEST(OracleResolution, ARefusedLineIsNeverJudgedEvenWhenALaterLineStoppedTheJudging) {
+    // grbl's character counting sends lines 2 and 3 before line 1's answer:
+    // line 2 ("1", a bare number) stops the oracle judging, then line 1
+    // comes back "error:22" and line 3 moves the machine away. The refused
+    // move was still taken back: no move-end-missed for a move the firmware
+    // never took (the grbl 1.1h campaign's false reds, docs/THIRD_PARTY.md).
+    const auto dir = test::scratch_dir("verdict-refused-after-loss");
+    const auto board = dir / "cc.yaml";
+    {
+        std::ofstream out(board);
+        out << "board: cnc-shield-cc\n"
+               "extends: arduino-uno-cnc-shield-v3\n"
+               "parts:\n"
+               "  host: {type: serial_host, flow: character_counting, rx_buffer: 128, family: generic}\n";
+    }
+    Bench bench(board.string(), test::firmware("dda_line"));
+    bench.host().add_lines("G1 X1 Y0.3 F0\n1\nG1 X0.5 Y0.5\n");
+    ASSERT_EQ(bench.run_until_idle(10.0), IdleResult::Idle) << bench.host().tail(6);
+    EXPECT_EQ(bench.host().errors(), 1u);
+    EXPECT_TRUE(bench.host().line_errored(0));
+    for (const Finding& f : bench.findings()) {
+        if (f.kind != UartHost::kHostProtocol) ADD_FAILURE() << f.describe();
+    }
+    EXPECT_NEAR(bench.axis("x").position_mm(), 100.5, 1e-9);  // line 3's move only
+}
+
 }  // namespace
 }  // namespace avrbench

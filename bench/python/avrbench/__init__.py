@@ -148,9 +148,11 @@ class Bench:
     """A board with its firmware. `firmware`: one ELF for the board's first
     MCU, or {mcu: elf}; MCUs not named run the board file's `firmware:`.
     `vcd` and `report` are written by close() (or leaving a `with` block);
-    `profile=True` collects each MCU's timing profile."""
+    `profile=True` collects each MCU's timing profile. `max_events`: the
+    most events the run may record (default 5*10^7, about 1.2 GB); a run
+    past it raises avrbench.BadInput, as the CLI exits 2."""
 
-    def __init__(self, board, firmware=None, *, vcd=None, report=None, profile=False):
+    def __init__(self, board, firmware=None, *, vcd=None, report=None, profile=False, max_events=0):
         if firmware is None:
             firmware = {}
         elif isinstance(firmware, (str, bytes)) or hasattr(firmware, "__fspath__"):
@@ -158,7 +160,9 @@ class Bench:
         elif not isinstance(firmware, dict):
             raise BadInput("firmware: an ELF path or a dict {mcu: elf}")
         firmware = {str(k): str(v) for k, v in firmware.items()}
-        self._native = _avrbench.Bench(str(board), firmware, str(vcd or ""), str(report or ""), bool(profile))
+        if not isinstance(max_events, int) or max_events < 0:
+            raise BadInput("max_events: a count of events, 0 for the default")
+        self._native = _avrbench.Bench(str(board), firmware, str(vcd or ""), str(report or ""), bool(profile), max_events)
 
     def __enter__(self):
         return self
