@@ -65,6 +65,10 @@ public:
     virtual AxisPositions power_up_mm() const { return {0.0, 0.0, 0.0}; }
     // The firmware waits here (G4) before the moves that follow.
     virtual void dwell() {}
+    // The line that made the judge stop (frame_lost) was refused by the
+    // firmware: its coordinates mean what they meant, judging goes on.
+    // False when it cannot (anything came after the stop).
+    virtual bool frame_restored() { return false; }
     // Another part judged the move of line `line` (quoted as in
     // CommandedMove::line): the machine cannot make it (a delta's
     // target-out-of-reach). Nobody waits for it to begin.

@@ -552,6 +552,14 @@ std::vector<Finding> MotionOracle::pending_findings() const {
     return out;
 }
 
+bool MotionOracle::frame_restored() {
+    if (!lost_ || moves_.empty() || !moves_.back().barrier) return false;
+    moves_.pop_back();
+    lost_ = false;
+    lost_why_.clear();
+    return true;
+}
+
 void MotionOracle::judged_elsewhere(const std::string& line) {
     for (Tracked& m : moves_) {
         if (m.line == line) m.unreachable = true;
@@ -607,7 +615,7 @@ std::optional<Finding> MotionOracle::unmade_verdict(const Eigen::Vector3d& p, Cy
 
 std::size_t MotionOracle::moves_judged_now() const {
     std::size_t judged = moves_judged_;
-    if (lost_ || moves_.empty() || moves_.front().barrier) return judged;
+    if (moves_.empty() || moves_.front().barrier) return judged;
     const Tracked& cur = moves_.front();
     const Eigen::Vector3d p = tool_position();
     const Cycle now = clock().cycle();
@@ -619,7 +627,7 @@ std::size_t MotionOracle::moves_judged_now() const {
     if (cursor_judged) ++judged;
     // The moves a finished job left unmade are judged together (unmade_verdict).
     const Cycle settle = std::min(rest_cycles_, clock().cycles_from_seconds(0.025));
-    if (job_answered_ && job_answered_() && now >= last_move_cycle_ + settle) {
+    if (!lost_ && job_answered_ && job_answered_() && now >= last_move_cycle_ + settle) {
         for (std::size_t i = cursor_judged ? 1 : 0; i < moves_.size() && !moves_[i].barrier && !moves_[i].after_dwell; ++i) {
             ++judged;
         }

@@ -75,6 +75,7 @@ public:
     void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
     void dwell() override { dwell_pending_ = true; }
     void judged_elsewhere(const std::string& line) override;
+    bool frame_restored() override;
 
     // For tests and front ends: moves judged so far, and whether judging stopped.
     std::size_t moves_judged() const { return moves_judged_now(); }

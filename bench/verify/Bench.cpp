@@ -267,6 +267,13 @@ struct SentLineFeed {
         Unanswered refused_line = std::move(unanswered.front());
         unanswered.pop_front();
         if (!refused || !refused_line.changed) return;
+        // The line that stopped the judging (G5, a work offset) was refused:
+        // the firmware's frame is what it was, and judging goes on.
+        const bool it_lost_the_frame = !refused_line.before.lost() && unanswered.empty() && path.lost();
+        if (it_lost_the_frame && refused_line.moves == 0 && judge->frame_restored()) {
+            path = std::move(refused_line.before);
+            return;
+        }
         std::size_t moves = refused_line.moves;
         bool renamed = refused_line.renamed;
         for (const auto& later : unanswered) {

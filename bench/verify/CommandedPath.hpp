@@ -38,6 +38,7 @@ public:
     // line the firmware refused, a copy from before it is put back.
     std::size_t moves_told() const { return moves_told_; }
     std::size_t renames_told() const { return renames_told_; }
+    bool lost() const { return lost_; }
     bool same_state(const CommandedPath& other) const;
 
 private:
