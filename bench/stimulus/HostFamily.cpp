@@ -176,6 +176,19 @@ AnswerKind classify_answer(FirmwareFamily family, std::string_view s) {
     return AnswerKind::Text;
 }
 
+bool is_busy_report(FirmwareFamily family, std::string_view s) {
+    switch (family) {
+        case FirmwareFamily::Marlin:
+        case FirmwareFamily::Prusa: return starts(s, "echo:busy:") || starts(s, "busy:");
+        case FirmwareFamily::Repetier: return starts(s, "busy:");
+        case FirmwareFamily::Teacup: return starts(s, "Waiting for target temp");
+        case FirmwareFamily::Grbl: return starts(s, "<") && !starts(s, "<Idle");
+        case FirmwareFamily::Sprinter:
+        case FirmwareFamily::Generic: return false;
+    }
+    return false;
+}
+
 namespace {
 
 // The first word of letter G, M, T or D with a number: "G5", or "G-code 5"

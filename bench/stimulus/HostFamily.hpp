@@ -48,6 +48,13 @@ const char* to_string(AnswerKind kind);
 // How `line` (without its line end) reads for `family`.
 AnswerKind classify_answer(FirmwareFamily family, std::string_view line);
 
+// A line by which the firmware says it is still working on something (a
+// keep-alive while it waits or moves): Marlin's and Prusa's "echo:busy:
+// processing" (HOST_KEEPALIVE_FEATURE), Repetier's "busy:processing",
+// Teacup's "Waiting for target temp" (M116, clock.c), grbl's status report
+// in any state but Idle ("<Run|...>"). A run is not done while they come.
+bool is_busy_report(FirmwareFamily family, std::string_view line);
+
 // The command an error line names, as its first G/M/T/D word ("M9999" from
 // `echo:Unknown command: "M9999"`, "G5" from Teacup's `E: Bad G-code 5`),
 // upper case, or "" when it names none.

@@ -325,6 +325,10 @@ void UartHost::on_line(Cycle cycle, std::string text) {
     if (!failed_ && !outstanding_.empty()) arm_line_timeout();
 
     const FirmwareFamily family = options_.family;
+    if (is_busy_report(family, text)) {
+        last_busy_cycle_ = cycle;
+        last_busy_text_ = text;
+    }
     AnswerKind kind = classify_answer(family, text);
     if (kind == AnswerKind::Text) {
         for (const TextPattern& p : error_patterns_) {
@@ -373,6 +377,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
                 } else {
                     ++oks_;
                     answered = acknowledge();
+                    last_busy_cycle_.reset();  // what it was busy with is answered
                 }
                 break;
             case AnswerKind::Fatal: {
@@ -386,7 +391,10 @@ void UartHost::on_line(Cycle cycle, std::string text) {
             case AnswerKind::ErrorNote:
             case AnswerKind::ResendError:
                 record_error(cycle, text);
-                if (kind == AnswerKind::Error) answered = acknowledge();
+                if (kind == AnswerKind::Error) {
+                    answered = acknowledge();
+                    last_busy_cycle_.reset();
+                }
                 if (kind == AnswerKind::ResendError) resend(cycle, text);
                 break;
             case AnswerKind::Alarm: {

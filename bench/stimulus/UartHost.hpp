@@ -239,6 +239,11 @@ public:
     // ok/error answers that arrived with no line outstanding.
     std::size_t unsolicited_acks() const { return unsolicited_acks_; }
     const std::vector<HostEvent>& events() const { return events_; }
+    // The last time the firmware said it is busy (stimulus/HostFamily.hpp
+    // is_busy_report) after its last answer (ok or error: a busy report
+    // while a line waited is about that line), with what it said.
+    std::optional<Cycle> last_busy_cycle() const { return last_busy_cycle_; }
+    const std::string& last_busy_text() const { return last_busy_text_; }
     const std::optional<std::string>& banner() const { return banner_; }
 
     // --- transcript ----------------------------------------------------------
@@ -333,6 +338,8 @@ private:
     std::size_t oks_ = 0, errors_ = 0, alarms_ = 0, fatals_ = 0, unsolicited_acks_ = 0;
     std::vector<HostEvent> events_;
     std::optional<std::size_t> failure_event_;
+    std::optional<Cycle> last_busy_cycle_;
+    std::string last_busy_text_;
     std::optional<std::string> banner_;
     std::vector<TranscriptEntry> transcript_;
     std::vector<LineListener> line_listeners_;

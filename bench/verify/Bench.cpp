@@ -430,6 +430,19 @@ bool Bench::still_going(Picoseconds settle_ps, std::vector<std::string>* why) co
         return why == nullptr;  // true: stop looking, the answer is known
     };
     for (const auto& [name, host] : hosts_) {
+        // A firmware that says it is busy (a keep-alive while it waits for
+        // its heater, or moves) is not done, whatever its answers say.
+        if (!host->failed() && host->last_busy_cycle()) {
+            const Mcu& m = *port_of(name).mcu;
+            const double ago_s = static_cast<double>(m.cycle() - *host->last_busy_cycle()) / m.frequency_hz();
+            if (ago_s <= host->line_timeout_s()) {
+                char line[96];
+                std::snprintf(line, sizeof line, ", %.3f s ago)", ago_s);
+                if (say("host " + name + ": the firmware says it is busy (" + quoted_line(host->last_busy_text()) + line)) {
+                    return true;
+                }
+            }
+        }
         if (host->finished()) continue;
         std::string text = "host " + name + ": ";
         if (!host->ready()) {

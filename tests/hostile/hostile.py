@@ -402,7 +402,10 @@ def cases(fw):
         os.symlink(os.path.join(folder, "victim.txt"), os.path.join(folder, "err.vcd"))
     out.append(Case("out-vcd-symlink", ["run", blink, "--for", "1ms", "--vcd", "{w}/err.vcd", "-q"], files={"victim.txt": "keep me\n"},
                     setup=link_to_victim, says="is a symbolic link"))
-    out.append(Case("out-vcd-dev-stderr", ["run", blink, "--for", "1ms", "--vcd", "/dev/stderr", "-q"], says="is a symbolic link"))
+    # The issue's /dev/stderr, made in the case's folder: a regression must not
+    # replace the machine's own link.
+    out.append(Case("out-vcd-link-to-stderr", ["run", blink, "--for", "1ms", "--vcd", "{w}/err.vcd", "-q"],
+                    setup=lambda folder: os.symlink("/proc/self/fd/2", os.path.join(folder, "err.vcd")), says="is a symbolic link"))
     out.append(Case("out-vcd-read-only", ["run", blink, "--for", "1ms", "--vcd", "{w}/ro.vcd", "-q"], files={"ro.vcd": "mine\n"},
                     setup=lambda folder: os.chmod(os.path.join(folder, "ro.vcd"), 0o400), says="is read-only"))
     # Raw bytes into a bit-level serial port: streamed (not a scheduled event
