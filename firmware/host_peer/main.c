@@ -33,7 +33,10 @@
  *   code is "Unknown G code: <line>" (MSG_UNKNOWN_CODE "Unknown %c code:
  *   %s") before the ok.
  * Teacup: "start" and a boot "ok"; each line "ok"; "M116" waits 5 s in
- *   silence, then "ok"; an unknown G or M code gets "E: Bad G-code <n>" /
+ *   silence, then "ok"; "QUEUED_M116" is Teacup's real M116: "ok" at once
+ *   (it is queued), then "Waiting for target temp" at once and every second
+ *   after for 4 s (clock.c's once-a-second report) while nothing else is
+ *   read; an unknown G or M code gets "E: Bad G-code <n>" /
  *   "E: Bad M-code <n>" before the ok (gcode_process.c); "*99" (a bad
  *   checksum) gets "rs N1 Expected checksum 17" and the ok the first time
  *   (gcode_parse.c: the line is not run).
@@ -234,6 +237,15 @@ int main(void)
     uint8_t checksum_failed = 0;
     for (;;) {
         read_line();
+        if (strcmp_P(line, PSTR("QUEUED_M116")) == 0) {
+            SAY("ok");
+            SAY("Waiting for target temp");
+            for (uint8_t s = 0; s < 4; ++s) {
+                _delay_ms(1000);
+                SAY("Waiting for target temp");
+            }
+            continue;
+        }
         if (strncmp_P(line, PSTR("M116"), 4) == 0) _delay_ms(5000);
         if (strstr_P(line, PSTR("*99")) != 0 && !checksum_failed) {
             checksum_failed = 1;

@@ -72,6 +72,25 @@ TEST(JobDone, AHeaterThatNeverHeatsIsDoneOnceItStopsChanging) {
     EXPECT_LT(bench->now_seconds(), 0.2 + HeatTargets::kQuietWindow_s + 1.0);
 }
 
+TEST(JobDone, AFirmwareThatSaysItIsBusyAfterItsAnswerIsNotDone) {
+    // Teacup answers M116 at once (it is queued) and then prints "Waiting
+    // for target temp" every second while it waits (host_peer_teacup's
+    // QUEUED_M116: one at once, four more a second apart). Done only once
+    // they stop: not before the last, 4 s after the ok at 0.2 s.
+    Bench bench("arduino-uno", test::firmware("host_peer_teacup"));
+    UartHostOptions o;
+    o.family = FirmwareFamily::Teacup;
+    bench.host("", o).add_lines("QUEUED_M116\n");
+    ASSERT_EQ(bench.run_until_idle(30.0), IdleResult::Idle) << bench.host().tail(8);
+    Cycle last_wait = 0;
+    for (const auto& e : bench.host().transcript()) {
+        if (e.direction == Direction::Received && e.text == "Waiting for target temp") last_wait = e.cycle;
+    }
+    ASSERT_GT(last_wait, 0u);
+    EXPECT_GT(bench.mcu().cycle(), last_wait);
+    EXPECT_GE(bench.now_seconds(), 4.2);
+}
+
 TEST(JobDone, TheCliEndsAJobPastItsLimitAsATimeoutSayingWhatWasGoing) {
     // Exit 3 (docs/CLI.md) and the heater named on stderr and in the summary.
     const auto dir = test::scratch_dir("verdict-job-done");
