@@ -38,6 +38,8 @@ struct CommandedMove {
     AxisPositions to_mm{};
     std::array<double, 2> centre_mm{};  // arcs: X, Y of the centre
     ArcRule arc_rule;                   // arcs: how the firmware draws them
+    // G1-G3: the feed the line asks for (its own F or the last one), if any.
+    std::optional<double> feed_mm_per_min;
     std::array<bool, 3> homed{};        // Home: the axes it homes
     std::string line;                   // "line 7 'G2 X60 Y50 I0 J-10'", for findings
 };
@@ -54,7 +56,9 @@ public:
     // From here on the bench cannot tell what the firmware's coordinates
     // mean (a line it could not read, a work offset, a G code it does not
     // model): stop judging until the end of the run.
-    virtual void frame_lost(const std::string& line) = 0;
+    // `why` says what about the line (default: its meaning differs between
+    // firmware).
+    virtual void frame_lost(const std::string& line, const std::string& why = "means different things to different firmware") = 0;
     // The firmware refused the line that gave the last `moves` moves (they
     // were told as the line went out): forget them. False when it cannot,
     // because the machine began one (the bench then loses the frame).

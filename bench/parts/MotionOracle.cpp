@@ -193,8 +193,8 @@ void MotionOracle::lose(const std::string& why) {
     moves_.push_back(barrier);
 }
 
-void MotionOracle::frame_lost(const std::string& line) {
-    lose(line + " means different things to different firmware");
+void MotionOracle::frame_lost(const std::string& line, const std::string& why) {
+    lose(line + " " + why);
 }
 
 void MotionOracle::position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) {
@@ -207,12 +207,15 @@ void MotionOracle::position_renamed(const AxisPositions& was_mm, const AxisPosit
 }
 
 void MotionOracle::commanded(const CommandedMove& move) {
+    // Numbered even when not kept (judging stopped): retract() counts the
+    // moves of a refused line and those told after it, kept or not.
+    const std::uint64_t command = commands_++;
     if (lost_) return;
     if (moves_.size() >= kMaxPendingMoves) return lose("the machine is more than 4096 accepted moves behind");
     Tracked t;
     t.kind = move.kind;
     t.line = move.line;
-    t.command = commands_++;
+    t.command = command;
     t.after_dwell = std::exchange(dwell_pending_, false);
     const bool home = move.kind == CommandedMove::Kind::Home;
     t.free = home || (move.kind == CommandedMove::Kind::Rapid ? !rapids_straight_ : !feeds_straight_);
@@ -235,6 +238,21 @@ void MotionOracle::commanded(const CommandedMove& move) {
         if (!move.to_mm[k]) return lose(move.line + " ends where the bench cannot know");
         t.to[i] = *move.to_mm[k] + *origin_mm_[k];
         t.origin[i] = *origin_mm_[k];
+    }
+    // A slow feed steps seldom: at F mm/min the carriage moving fastest does
+    // at least F / sqrt(3) of it, a step every step_mm sqrt(3) / (F / 60) s;
+    // the machine is at rest only after 2.5 times that without a step (the
+    // bench's own factor: a decelerating step is up to 2.47 times the one
+    // before, AVR446).
+    t.rest_cycles = rest_cycles_;
+    if (move.feed_mm_per_min && *move.feed_mm_per_min > 0 && effector_ == nullptr) {
+        double largest_step = 0;
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (carriages_[k] != nullptr) largest_step = std::max(largest_step, carriages_[k]->step_mm());
+        }
+        const double interval_s = largest_step * std::sqrt(3.0) / (*move.feed_mm_per_min / 60.0);
+        constexpr double kLongestRest_s = 60.0;  // a step a minute is a machine standing still
+        t.rest_cycles = std::max(rest_cycles_, clock().cycles_from_seconds(std::min(2.5 * interval_s, kLongestRest_s)));
     }
     const bool arc = move.kind == CommandedMove::Kind::ArcClockwise || move.kind == CommandedMove::Kind::ArcCounterClockwise;
     if (arc) {
@@ -451,16 +469,21 @@ void MotionOracle::on_carriage() {
     last_position_ = p;
 }
 
+Cycle MotionOracle::rest_cycles_now() const {
+    if (!moves_.empty() && !moves_.front().barrier) return moves_.front().rest_cycles;
+    return rest_cycles_;
+}
+
 void MotionOracle::arm_rest_check() {
     if (rest_check_armed_) return;
     rest_check_armed_ = true;
-    clock().scheduler().at(last_move_cycle_ + rest_cycles_, [this](Cycle) { on_rest_check(); });
+    clock().scheduler().at(last_move_cycle_ + rest_cycles_now(), [this](Cycle) { on_rest_check(); });
 }
 
 void MotionOracle::on_rest_check() {
     rest_check_armed_ = false;
     const Cycle now = clock().cycle();
-    if (now < last_move_cycle_ + rest_cycles_) return arm_rest_check();
+    if (now < last_move_cycle_ + rest_cycles_now()) return arm_rest_check();
     if (rest_judged_) return;
     rest_judged_ = true;
     if (auto f = rest_verdict(tool_position(), now)) {
@@ -537,10 +560,10 @@ std::vector<Finding> MotionOracle::pending_findings() const {
     std::vector<Finding> out;
     if (moves_.empty()) return out;
     const Cycle now = clock().cycle();
-    // The run's end is a rest once nothing moved for half the bench's own
-    // settle time (Bench::run_until_idle ends 50 ms after the last STEP; a
-    // motor's rotor settles a few ms after it).
-    const Cycle settle = std::min(rest_cycles_, clock().cycles_from_seconds(0.025));
+    // The run's end is a rest once nothing moved for the rest time in force
+    // (a run that ends done waited that long: Bench::still_going); a run cut
+    // off while the machine moves has its moves under way, not missed.
+    const Cycle settle = rest_cycles_now();
     if (now < last_move_cycle_ + settle) return out;
     const Eigen::Vector3d p = tool_position();
     if (!rest_judged_) {
@@ -570,7 +593,7 @@ bool MotionOracle::still_going(std::string* why) const {
     if (lost_ || moves_.empty() || moves_.front().barrier) return false;
     const Tracked& cur = moves_.front();
     const bool begun = cur.progress > cur.end_tolerance.maxCoeff() || cur.end_reached;
-    if (clock().cycle() < last_move_cycle_ + rest_cycles_) {
+    if (clock().cycle() < last_move_cycle_ + rest_cycles_now()) {
         // Moving (or within rest_time of it): on its way through the moves.
         if (cur.end_reached && moves_.size() == 1) return false;
         if (why != nullptr) {
@@ -619,7 +642,7 @@ std::size_t MotionOracle::moves_judged_now() const {
     const Tracked& cur = moves_.front();
     const Eigen::Vector3d p = tool_position();
     const Cycle now = clock().cycle();
-    const bool at_rest = now >= last_move_cycle_ + rest_cycles_;
+    const bool at_rest = now >= last_move_cycle_ + rest_cycles_now();
     // The cursor's move is judged once it reached its end, or the machine
     // came to rest anywhere but at its start (a rest verdict was given).
     const bool cursor_judged =

@@ -69,7 +69,7 @@ public:
 
     void commanded(const CommandedMove& move) override;
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;
-    void frame_lost(const std::string& line) override;
+    void frame_lost(const std::string& line, const std::string& why) override;
     bool retract(std::size_t moves) override;
     AxisPositions power_up_mm() const override { return start_mm_; }
     void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
@@ -113,6 +113,9 @@ private:
         bool rest_reported = false;
         bool after_dwell = false;  // a G4 came before it: it may still be waiting when a run ends
         bool unreachable = false;  // another part found the machine cannot make it
+        // How long the machine may stand between steps on this move and still
+        // be moving: rest_time, or longer for a slow feed.
+        Cycle rest_cycles = 0;
         // Findings recorded when the fault began, revised as it grows.
         std::optional<std::size_t> deviation_finding, tool_finding;
         double deviation_told = 0, tool_told = 0;
@@ -123,6 +126,8 @@ private:
     Eigen::Vector3d tool_position() const;
     void on_carriage();
     void arm_rest_check();
+    // The rest time in force: the cursor's move's, else rest_time.
+    Cycle rest_cycles_now() const;
     void on_rest_check();
     // Distance from p to the move's path (0 for free moves and barriers),
     // and how far along it p is (mm).

@@ -339,6 +339,12 @@ void UartHost::on_line(Cycle cycle, std::string text) {
         }
     }
     bool answered = false;  // a line acknowledged: the next may go out
+    // The line an ok or error answered (the oldest unanswered one), if any.
+    std::optional<std::size_t> answered_index;
+    const auto oldest = [this]() -> std::optional<std::size_t> {
+        if (outstanding_.empty()) return std::nullopt;
+        return outstanding_.front().index;
+    };
     if (!ready_ && options_.startup == Startup::WaitForBanner && !failed_) {
         if (family != FirmwareFamily::Generic) {
             // Everything before the welcome is discarded by the firmware's own
@@ -376,6 +382,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
                     }
                 } else {
                     ++oks_;
+                    answered_index = oldest();
                     answered = acknowledge();
                     last_busy_cycle_.reset();  // what it was busy with is answered
                 }
@@ -392,6 +399,7 @@ void UartHost::on_line(Cycle cycle, std::string text) {
             case AnswerKind::ResendError:
                 record_error(cycle, text);
                 if (kind == AnswerKind::Error) {
+                    answered_index = oldest();
                     answered = acknowledge();
                     last_busy_cycle_.reset();
                 }
@@ -409,6 +417,10 @@ void UartHost::on_line(Cycle cycle, std::string text) {
 
     // Listeners hear the answer before the next line goes out: a motion
     // judge takes back a refused line's moves before it reads the next.
+    if (answered_index) {
+        const bool refused = kind == AnswerKind::Error || line_errored(*answered_index);
+        for (auto& fn : answer_listeners_) fn(lines_[*answered_index], *answered_index, refused);
+    }
     for (auto& fn : line_listeners_) fn(entry);
     if (answered) {
         pump();

@@ -252,6 +252,11 @@ public:
     std::string tail(std::size_t n) const;
     // Called for every line received (after the host has handled it).
     void on_line_received(LineListener fn) { line_listeners_.push_back(std::move(fn)); }
+    // Called when an ok or error answers job line `index` (not a realtime
+    // byte; not a Resend's ok), `refused` when the answer or an error before
+    // it refused the line; before the next line goes out.
+    using AnswerListener = std::function<void(const GcodeLine& line, std::size_t index, bool refused)>;
+    void on_answer(AnswerListener fn) { answer_listeners_.push_back(std::move(fn)); }
     // Called when a job line first goes out (not for resends, nor for grbl's
     // real-time bytes), before the firmware has its first byte.
     using SentListener = std::function<void(const GcodeLine& line)>;
@@ -344,6 +349,7 @@ private:
     std::vector<TranscriptEntry> transcript_;
     std::vector<LineListener> line_listeners_;
     std::vector<SentListener> sent_listeners_;
+    std::vector<AnswerListener> answer_listeners_;
 };
 
 }  // namespace avrbench

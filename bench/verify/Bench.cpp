@@ -187,16 +187,10 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
         slot = std::make_unique<UartHost>(*serial.mcu, serial.link(), o);
         check_accepted_moves(*slot);
         // Heater targets from the lines the firmware took (not those it refused).
-        UartHost& h = *slot;
         Mcu& clock = *serial.mcu;
-        auto acknowledged = std::make_shared<std::size_t>(0);
-        h.on_line_received([this, &h, &clock, acknowledged](const TranscriptEntry&) {
-            for (; *acknowledged < h.lines_acknowledged(); ++*acknowledged) {
-                if (h.line_errored(*acknowledged)) continue;
-                const GcodeLine& line = h.lines()[*acknowledged];
-                heat_->accepted(line.text, ps_at_cycle(clock, clock.cycle()),
-                                "line " + std::to_string(line.number) + " " + quoted_line(line.text));
-            }
+        slot->on_answer([this, &clock](const GcodeLine& line, std::size_t, bool refused) {
+            if (refused) return;
+            heat_->accepted(line.text, ps_at_cycle(clock, clock.cycle()), "line " + std::to_string(line.number) + " " + quoted_line(line.text));
         });
     }
     return *slot;
@@ -238,27 +232,47 @@ namespace {
 // lines read again; where the judge cannot (the machine began one of those
 // moves) or a G92 is among them, the judge stops.
 struct SentLineFeed {
-    SentLineFeed(CommandedMoves& j, FirmwareFamily family) : judge(&j), path(j) {
+    SentLineFeed(CommandedMoves& j, FirmwareFamily family) : judge(&j), path(j), grbl(family == FirmwareFamily::Grbl) {
         const FamilyArcs arcs = family_arcs(family);
         path.set_arc_rule({arcs.tolerance_mm, arcs.segment_mm});
     }
     CommandedMoves* judge;
     CommandedPath path;
+    bool grbl;
+    // grbl picks its realtime commands out of the stream wherever they are,
+    // in a line it then refuses too: a feed hold '!', a reset ^X, the
+    // overrides and the safety door (0x80-0xA0, grbl 1.1 interface.md). The
+    // machine may then stop or change speed anywhere: judging stops for good.
+    static bool holds_or_overrides(const std::string& text) {
+        for (const char c : text) {
+            const auto b = static_cast<unsigned char>(c);
+            if (b == '!' || b == 0x18 || b >= 0x80) return true;
+        }
+        return false;
+    }
     struct Unanswered {
         GcodeLine line;
         CommandedPath before;  // the reading state before the line
         std::size_t moves = 0;
         bool renamed = false;
-        bool changed = false;  // it moved, renamed or changed a mode
+        bool changed = false;     // it moved, renamed or changed a mode
+        bool lost_frame = false;  // reading it stopped the judging
+        bool lost_for_good = false;  // and no refusal can undo that (grbl realtime bytes)
     };
     std::deque<Unanswered> unanswered;
 
     void sent(const GcodeLine& line) {
         Unanswered u{line, path};
-        path.accept(line.text, "line " + std::to_string(line.number) + " " + quoted_line(line.text));
+        const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
+        if (grbl && holds_or_overrides(line.text)) {
+            u.lost_for_good = true;
+            path.lose(quoted, "carries a grbl realtime command (a feed hold, reset or override: the machine may stop anywhere)");
+        }
+        path.accept(line.text, quoted);
         u.moves = path.moves_told() - u.before.moves_told();
         u.renamed = path.renames_told() != u.before.renames_told();
         u.changed = u.moves != 0 || u.renamed || !path.same_state(u.before);
+        u.lost_frame = path.lost() && !u.before.lost();
         unanswered.push_back(std::move(u));
     }
     void answered(const GcodeLine& line, bool refused) {
@@ -267,13 +281,6 @@ struct SentLineFeed {
         Unanswered refused_line = std::move(unanswered.front());
         unanswered.pop_front();
         if (!refused || !refused_line.changed) return;
-        // The line that stopped the judging (G5, a work offset) was refused:
-        // the firmware's frame is what it was, and judging goes on.
-        const bool it_lost_the_frame = !refused_line.before.lost() && unanswered.empty() && path.lost();
-        if (it_lost_the_frame && refused_line.moves == 0 && judge->frame_restored()) {
-            path = std::move(refused_line.before);
-            return;
-        }
         std::size_t moves = refused_line.moves;
         bool renamed = refused_line.renamed;
         for (const auto& later : unanswered) {
@@ -284,6 +291,13 @@ struct SentLineFeed {
             // The lines sent after it were read in a frame the firmware never
             // took: take their moves back where the judge can, then stop.
             if (renamed) (void)judge->retract(moves);
+            path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
+            return;
+        }
+        // The line that stopped the judging (G5, a bare number) was refused:
+        // the firmware's frame is what it was, and judging goes on with the
+        // lines after it read again.
+        if (refused_line.lost_frame && (refused_line.lost_for_good || !judge->frame_restored())) {
             path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
             return;
         }
@@ -311,14 +325,9 @@ void Bench::follow_sent_lines(UartHost& host) {
         *last_sent = line.number;
         for (auto& feed : *feeds) feed.sent(line);
     });
-    auto acknowledged = std::make_shared<std::size_t>(0);
-    host.on_line_received([&host, feeds, acknowledged](const TranscriptEntry& entry) {
-        if (host.lines_acknowledged() == *acknowledged) return;
-        *acknowledged = host.lines_acknowledged();
-        const GcodeLine& line = host.lines()[*acknowledged - 1];
-        // Refused: answered with an error, or with an error before its ok
-        // (Marlin's "Error:" or "echo:Unknown command", Teacup's "E:").
-        const bool refused = entry.text.rfind("ok", 0) != 0 || host.line_errored(*acknowledged - 1);
+    // Refused: answered with an error, or with an error before its ok
+    // (Marlin's "Error:" or "echo:Unknown command", Teacup's "E:").
+    host.on_answer([feeds](const GcodeLine& line, std::size_t, bool refused) {
         for (auto& feed : *feeds) feed.answered(line, refused);
     });
 }
@@ -331,19 +340,13 @@ void Bench::check_accepted_moves(UartHost& host) {
         if (checker != nullptr && checker->checks_move_commands()) robots.push_back(checker);
     }
     if (robots.empty()) return;
-    // Every answer that acknowledges a line (ok or error) moves
-    // lines_acknowledged() on by one, in the order the lines went out.
+    // Each answer, in the order the lines went out (stimulus/UartHost on_answer).
     struct Seen {
         CommandedTarget target;
-        std::size_t acknowledged = 0;
     };
     auto seen = std::make_shared<Seen>();
-    host.on_line_received([this, &host, robots, seen](const TranscriptEntry& entry) {
-        const std::size_t acknowledged = host.lines_acknowledged();
-        if (acknowledged == seen->acknowledged) return;
-        seen->acknowledged = acknowledged;
-        const GcodeLine& line = host.lines()[acknowledged - 1];
-        if (entry.text.rfind("ok", 0) != 0 || host.line_errored(acknowledged - 1)) {
+    host.on_answer([this, &host, robots, seen](const GcodeLine& line, std::size_t, bool refused) {
+        if (refused) {
             // An error: the firmware did not take the line (its axes stay as
             // they were). A refused target no robot reaches either is a
             // right answer, not a finding (findings() leaves it out).

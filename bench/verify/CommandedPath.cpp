@@ -24,9 +24,15 @@ void CommandedPath::lose(const std::string& quoted) {
     judge_->frame_lost(quoted);
 }
 
+void CommandedPath::lose(const std::string& quoted, const std::string& why) {
+    if (lost_) return;
+    lost_ = true;
+    judge_->frame_lost(quoted, why);
+}
+
 bool CommandedPath::same_state(const CommandedPath& other) const {
     return position_mm_ == other.position_mm_ && relative_ == other.relative_ && mm_per_unit_ == other.mm_per_unit_ &&
-           xy_plane_ == other.xy_plane_ && lost_ == other.lost_;
+           xy_plane_ == other.xy_plane_ && lost_ == other.lost_ && feed_mm_per_min_ == other.feed_mm_per_min_;
 }
 
 void CommandedPath::accept(std::string_view line, const std::string& quoted) {
@@ -71,6 +77,8 @@ void CommandedPath::accept(std::string_view line, const std::string& quoted) {
             default: return lose(quoted);
         }
     }
+    // F is modal, in the line's units per minute.
+    if (const auto f = word(*words, 'F'); f && *f > 0) feed_mm_per_min_ = *f * mm_per_unit_;
     if (!axis_code) {
         if (names_an_axis) lose(quoted);  // modal motion (grbl moves, Marlin refuses), or a G4 with X
         return;
@@ -129,6 +137,7 @@ void CommandedPath::move(int code, const std::array<std::optional<double>, 3>& w
                          : CommandedMove::Kind::ArcCounterClockwise;
     m.line = quoted;
     m.arc_rule = arc_rule_;
+    if (code != 0) m.feed_mm_per_min = feed_mm_per_min_;  // a rapid runs at the machine's own rate
     m.from_mm = position_mm_;
     for (std::size_t k = 0; k < 3; ++k) {
         if (!words_mm[k]) {

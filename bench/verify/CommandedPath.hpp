@@ -30,6 +30,7 @@ public:
     void accept(std::string_view line, const std::string& quoted);
     // Nothing after this line is judged (a refusal the judge cannot undo).
     void lose(const std::string& quoted);
+    void lose(const std::string& quoted, const std::string& why);
     // How the firmware draws arcs (its family's: FirmwareArcs in verify/Bench).
     void set_arc_rule(ArcRule rule) { arc_rule_ = rule; }
 
@@ -54,6 +55,7 @@ private:
     double mm_per_unit_ = 1.0;
     bool xy_plane_ = true;
     bool lost_ = false;
+    std::optional<double> feed_mm_per_min_;
     ArcRule arc_rule_;
 };
 

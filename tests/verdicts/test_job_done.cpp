@@ -195,5 +195,19 @@ TEST(OracleResolution, ARefusedLineIsNeverJudgedEvenWhenALaterLineStoppedTheJudg
     EXPECT_NEAR(bench.axis("x").position_mm(), 100.5, 1e-9);  // line 3's move only
 }
 
+TEST(OracleResolution, AGrblRealtimeByteInALineStopsTheJudgingForGood) {
+    // grbl takes '!' (feed hold) out of the stream wherever it is, even in a
+    // line it refuses: the machine may stop anywhere, so the oracle stops
+    // judging and never calls the held move missed (the grbl 1.1h
+    // campaign's "G1Z2F1 / Y1 F50 *0 !" false red). host_peer_grbl answers
+    // every line and moves nothing.
+    Bench bench("arduino-uno-cnc-shield-v3", test::firmware("host_peer_grbl"));
+    bench.host().add_lines("G1 X1 F100 !\n");
+    ASSERT_EQ(bench.run_until_idle(20.0), IdleResult::Idle) << bench.host().tail(6);
+    const auto& oracle = bench.board().part_as<MotionOracle>("motion");
+    EXPECT_FALSE(oracle.judging());
+    for (const Finding& f : bench.findings()) ADD_FAILURE() << f.describe();
+}
+
 }  // namespace
 }  // namespace avrbench

@@ -30,7 +30,7 @@ struct Recorded final : CommandedMoves {
     std::vector<std::string> lost;
     void commanded(const CommandedMove& m) override { moves.push_back(m); }
     void position_renamed(const AxisPositions& was, const AxisPositions& now) override { renames.push_back({was, now}); }
-    void frame_lost(const std::string& line) override { lost.push_back(line); }
+    void frame_lost(const std::string& line, const std::string&) override { lost.push_back(line); }
     bool retract(std::size_t n) override {
         moves.resize(moves.size() - std::min(n, moves.size()));
         return true;
