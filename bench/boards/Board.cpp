@@ -1,12 +1,12 @@
 #include "boards/Board.hpp"
 
-#include "core/McuPins.hpp"
+#include "periph/ports/McuPins.hpp"
 
 #include <cmath>
 #include <set>
 
 #include "parts/PartRegistry.hpp"
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 #include "core/Units.hpp"
 
 namespace avrbench {
@@ -91,7 +91,7 @@ void Board::build_parts() {
     // the file's order) that joins one of them to an MCU pin (the net's last
     // MCU pin, when it has several); else the board's first MCU. Across
     // clocks, parts and MCUs meet only on nets, which the lockstep times
-    // exactly (core/Lockstep.hpp).
+    // exactly (mcu/Lockstep.hpp).
     std::map<std::string, std::string> group_of;  // part -> its group's representative part
     const auto find = [&group_of](std::string name) {
         while (group_of.count(name) != 0 && group_of[name] != name) name = group_of[name];

@@ -9,9 +9,9 @@
 
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
-#include "core/Lockstep.hpp"
-#include "core/Mcu.hpp"
-#include "core/Twi.hpp"
+#include "mcu/Lockstep.hpp"
+#include "mcu/Mcu.hpp"
+#include "periph/twi/Twi.hpp"
 #include "parts/Part.hpp"
 #include "wiring/McuPinTerminal.hpp"
 #include "wiring/Net.hpp"
@@ -54,7 +54,7 @@ public:
     // "uno.PD2", or a label name from the board file.
     Pin& pin(const std::string& endpoint_or_label);
     // Whether MCU pins hand a repeating timer output to their nets as one
-    // periodic wave (core/PeriodicOutput.hpp; on by default). Off: every edge
+    // periodic wave (periph/timer/PeriodicOutput.hpp; on by default). Off: every edge
     // goes through the net (`avrbench run --no-periodic-waves`).
     void set_periodic_waves(bool on);
     // Drives an MCU pin from outside (a scenario's stimulus) as a push-pull

@@ -22,7 +22,7 @@
 
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
-#include "core/McuPins.hpp"
+#include "periph/ports/McuPins.hpp"
 #include "core/Notice.hpp"
 #include "parts/PartRegistry.hpp"
 #include "core/Units.hpp"

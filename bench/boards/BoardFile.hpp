@@ -41,12 +41,12 @@ struct McuDecl {
     std::uint32_t clock_hz = 0;
     std::string firmware;  // optional default ELF, resolved relative to the board file
     // Optional boot loader (Intel HEX, resolved relative to the board file)
-    // and fuse bytes low, high, extended (core/BootSection.hpp).
+    // and fuse bytes low, high, extended (periph/memory/BootSection.hpp).
     std::string bootloader;
     std::optional<std::array<std::uint8_t, 3>> fuses;
     std::optional<std::uint8_t> lock_bits;  // the lock byte (Boot Lock Bits)
     // `watchdog_resets: expected`: a firmware that resets itself by design;
-    // its watchdog resets are no findings (core/Mcu.hpp McuOptions).
+    // its watchdog resets are no findings (mcu/Mcu.hpp McuOptions).
     bool watchdog_resets_expected = false;
     std::string location;
 };

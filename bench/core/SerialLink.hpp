@@ -1,6 +1,6 @@
 // A serial line seen from the host's end, byte by byte: what a G-code
 // sender, a pty bridge or a file of raw bytes needs, whatever carries the
-// bytes. A USART's hardware (core/Uart) is one; a host on two GPIO pins that
+// bytes. A USART's hardware (periph/usart/Uart) is one; a host on two GPIO pins that
 // the firmware bit-bangs (parts/SerialHost) is another.
 #pragma once
 

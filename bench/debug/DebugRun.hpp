@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "debug/Debugger.hpp"
-#include "verify/BoardRun.hpp"
-#include "verify/McuRun.hpp"
+#include "run/BoardRun.hpp"
+#include "run/McuRun.hpp"
 
 namespace avrbench {
 

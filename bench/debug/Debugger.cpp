@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "core/Errors.hpp"
-#include "core/Lockstep.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Lockstep.hpp"
+#include "mcu/Mcu.hpp"
 #include "core/Scheduler.hpp"
 #include "core/UserStop.hpp"
 #include "debug/DataAccess.hpp"

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "core/DebugHook.hpp"
+#include "mcu/DebugHook.hpp"
 #include "core/Finding.hpp"
 #include "core/Time.hpp"
 

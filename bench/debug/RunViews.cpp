@@ -7,13 +7,13 @@
 #include "boards/Board.hpp"
 #include "core/Errors.hpp"
 #include "core/Units.hpp"
-#include "core/McuPins.hpp"
-#include "core/Mcu.hpp"
+#include "periph/ports/McuPins.hpp"
+#include "mcu/Mcu.hpp"
 #include "parts/Part.hpp"
 #include "stimulus/UartHost.hpp"
 #include "trace/Timeline.hpp"
-#include "verify/Bench.hpp"
-#include "verify/McuRun.hpp"
+#include "run/Bench.hpp"
+#include "run/McuRun.hpp"
 #include "wiring/Net.hpp"
 
 namespace avrbench {

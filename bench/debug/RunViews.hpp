@@ -1,7 +1,7 @@
 // What `monitor` shows of a run besides the MCU the debugger stops: the
 // board's nets and parts (axis positions, temperatures: every signal a part
 // declares), the MCU's pins, the host's last lines and the timeline's last
-// events. One view per kind of run (verify/BoardRun, verify/McuRun).
+// events. One view per kind of run (run/BoardRun, run/McuRun).
 #pragma once
 
 #include <optional>

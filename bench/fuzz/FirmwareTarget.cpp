@@ -17,7 +17,7 @@
 #include "SnapshotHeap.hpp"
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench::fuzz {
 

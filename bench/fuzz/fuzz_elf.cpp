@@ -1,5 +1,5 @@
 // The ELF loader on arbitrary bytes: BadInput or a loaded image, nothing else.
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
 #include "FuzzInput.hpp"
 

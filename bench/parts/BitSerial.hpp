@@ -12,7 +12,7 @@
 #include <functional>
 #include <string>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "core/Time.hpp"
 
 namespace avrbench {

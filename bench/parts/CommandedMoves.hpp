@@ -1,7 +1,7 @@
 // What a part that judges the machine's motion is told about the motion the
 // firmware was commanded: the moves of the lines it accepted, in the
 // firmware's own coordinates (mm), in the order it accepted them. The bench
-// reads them from a host's G-code (verify/CommandedPath) or from the program
+// reads them from a host's G-code (run/CommandedPath) or from the program
 // a record job was made from, and hands them to every part with this
 // interface (parts/MotionOracle), without knowing its type.
 #pragma once

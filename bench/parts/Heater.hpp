@@ -4,7 +4,7 @@
 // on-resistance and wiring, 0 unless given) into its plant's node; the energy
 // is integrated exactly between edges (in cycles of its clock).
 //
-// A hardware PWM the timer hands out as a periodic wave (core/PeriodicOutput
+// A hardware PWM the timer hands out as a periodic wave (periph/timer/PeriodicOutput
 // .hpp; only while nobody records the heater's signals) heats with its mean
 // power instead: the on-time is still counted exactly, but the plant sees
 // P * duty. Accepted for periods up to kMaxAveragedPeriod_s = 2.5 ms (the
@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "core/PeriodicOutput.hpp"
+#include "periph/timer/PeriodicOutput.hpp"
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 #include "core/Errors.hpp"
 
 namespace avrbench {

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "core/Finding.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "parts/PortType.hpp"
 #include "wiring/Net.hpp"
 
@@ -211,7 +211,7 @@ protected:
         (void)level;
     }
     // A periodic wave arrives on input `pin` in place of its edges
-    // (core/PeriodicOutput.hpp); false refuses. Until end_input_wave,
+    // (periph/timer/PeriodicOutput.hpp); false refuses. Until end_input_wave,
     // input_level(pin) keeps the wave's start level.
     virtual bool begin_input_wave(std::size_t pin, const PeriodicWave& wave) {
         (void)pin;

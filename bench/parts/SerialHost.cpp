@@ -3,10 +3,10 @@
 #include <cstdio>
 
 #include "core/Errors.hpp"
-#include "core/McuPins.hpp"
-#include "core/Pin.hpp"
+#include "periph/ports/McuPins.hpp"
+#include "periph/ports/Pin.hpp"
 #include "core/TextPattern.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/PartRegistry.hpp"
 
 namespace avrbench {

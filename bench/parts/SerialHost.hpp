@@ -12,7 +12,7 @@
 // Where the two nets reach the TXDn and RXDn pins of one USART (ATmega328P
 // Table 14-9, 2560 §13.3, m32 "Alternate Functions of Port D") the host works
 // at byte level on that USART, as a real adapter's bytes reach the receiver:
-// exact to the cycle and cheap (core/Uart; the host's frames are drawn on its
+// exact to the cycle and cheap (periph/usart/Uart; the host's frames are drawn on its
 // tx net all the same). On any other pins it works at bit level, as a
 // SoftwareSerial port needs: it decodes the frames the firmware bit-bangs on
 // `rx` and sends frames on `tx` at `baud` (parts/BitSerial; 8N1).

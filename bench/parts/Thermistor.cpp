@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 #include "core/Errors.hpp"
 #include "parts/ThermalBody.hpp"
 

@@ -7,7 +7,7 @@
 // The divider: "lower" leg (RAMPS 1.4, seed 001): pull-up from the reference
 // to the pin, NTC from the pin to GND, V = Vref·R/(R + R_pullup); "upper":
 // NTC from the reference to the pin, fixed resistor to GND. The voltage at
-// the moment a conversion starts goes to the MCU's ADC (core/Adc.hpp), which
+// the moment a conversion starts goes to the MCU's ADC (periph/adc/Adc.hpp), which
 // quantises it; optional Gaussian noise from a seeded generator.
 //
 // Faults: "open" (broken wire: R = ∞), "shorted" (R = 0), "detached" (the

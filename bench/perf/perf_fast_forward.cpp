@@ -1,7 +1,7 @@
-// Idle-loop fast-forward (core/IdleLoopSkip) on boards, plain run against
+// Idle-loop fast-forward (mcu/IdleLoopSkip) on boards, plain run against
 // skipping, medians of alternating runs of thread CPU time. Neither side
 // records anything (the CLI without --vcd), so timer outputs that repeat
-// reach the heaters as periodic waves on both sides (core/PeriodicOutput).
+// reach the heaters as periodic waves on both sides (periph/timer/PeriodicOutput).
 // Then the proof that skipping changes nothing: the untraced pair's end
 // state (cycle, registers, I/O and RAM, every part's summary line), and a
 // traced pair (every pin and part signal, as `avrbench run --vcd` records
@@ -18,7 +18,7 @@ extern "C" {
 
 #include "CpuTime.hpp"
 #include "boards/Board.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace {
 

@@ -29,7 +29,7 @@
 
 #include "CpuTime.hpp"
 #include "boards/Board.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace {
 

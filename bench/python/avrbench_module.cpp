@@ -20,9 +20,9 @@
 
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
-#include "core/Lockstep.hpp"
-#include "core/Mcu.hpp"
-#include "core/TimingProfile.hpp"
+#include "mcu/Lockstep.hpp"
+#include "mcu/Mcu.hpp"
+#include "mcu/TimingProfile.hpp"
 #include "core/OutputFile.hpp"
 #include "core/TextPattern.hpp"
 #include "core/Units.hpp"
@@ -32,7 +32,7 @@
 #include "trace/TimelineText.hpp"
 #include "trace/WaveformFiles.hpp"
 #include "core/Notice.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 #include "wiring/Net.hpp"
 
 namespace py = pybind11;

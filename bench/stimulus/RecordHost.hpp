@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "core/SerialLink.hpp"
 
 namespace avrbench {

@@ -15,7 +15,7 @@
 
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "core/Scheduler.hpp"
 
 namespace avrbench {

@@ -13,7 +13,7 @@
 #include "trace/Junit.hpp"
 #include "debug/Debugger.hpp"
 #include "debug/RunViews.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 #include "verify/Scenario.hpp"
 
 namespace avrbench {

@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
-#include "verify/BoardRun.hpp"
+#include "run/BoardRun.hpp"
 
 namespace avrbench {
 

@@ -39,8 +39,8 @@
 #include "stimulus/UartHost.hpp"
 #include "tools/Commands.hpp"
 #include "tools/FirmwareArgs.hpp"
-#include "verify/Bench.hpp"
-#include "verify/BoardRun.hpp"
+#include "run/Bench.hpp"
+#include "run/BoardRun.hpp"
 
 extern char** environ;
 

@@ -1,4 +1,4 @@
-// `avrbench run`: a firmware on a board (verify/BoardRun) or on a bare MCU.
+// `avrbench run`: a firmware on a board (run/BoardRun) or on a bare MCU.
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,12 +11,12 @@
 #include "cam/Chain.hpp"
 #include "cam/DxfReader.hpp"
 #include "cam/Records.hpp"
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "core/OutputFile.hpp"
-#include "core/TimingProfile.hpp"
+#include "mcu/TimingProfile.hpp"
 #include "core/Units.hpp"
 #include "core/UserStop.hpp"
 #include "debug/DebugRun.hpp"
@@ -26,7 +26,7 @@
 #include "tools/FirmwareArgs.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/WaveformFiles.hpp"
-#include "verify/McuRun.hpp"
+#include "run/McuRun.hpp"
 
 namespace avrbench {
 namespace {

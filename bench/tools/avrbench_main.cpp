@@ -1,6 +1,6 @@
 // The avrbench command line: parses, dispatches to a subcommand, and turns
 // errors into one line and an exit code (docs/CLI.md). Thin by design: every
-// subcommand runs through the library (verify/BoardRun, verify/Scenario, ...).
+// subcommand runs through the library (run/BoardRun, verify/Scenario, ...).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>

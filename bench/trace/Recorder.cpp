@@ -12,8 +12,8 @@ extern "C" {
 
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
-#include "core/McuPins.hpp"
-#include "core/Twi.hpp"
+#include "periph/ports/McuPins.hpp"
+#include "periph/twi/Twi.hpp"
 
 namespace avrbench {
 

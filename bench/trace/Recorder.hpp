@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "parts/Part.hpp"
 #include "trace/Timeline.hpp"
 

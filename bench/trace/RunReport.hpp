@@ -69,7 +69,7 @@ struct ComparisonView {
     std::vector<ChannelRow> channels;
 };
 
-// One MCU's timing profile (core/TimingProfile.hpp), as the report shows it.
+// One MCU's timing profile (mcu/TimingProfile.hpp), as the report shows it.
 struct TimingTable {
     std::string mcu;
     std::vector<std::string> facts;  // CPU load, stack, interrupts off: one line each

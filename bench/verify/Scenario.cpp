@@ -19,7 +19,7 @@
 #include "core/VectorNames.hpp"
 #include "core/Finding.hpp"
 #include "core/InputFile.hpp"
-#include "core/McuPins.hpp"
+#include "periph/ports/McuPins.hpp"
 #include "core/Units.hpp"
 
 namespace fs = std::filesystem;

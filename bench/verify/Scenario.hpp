@@ -51,7 +51,7 @@ struct ExpectText { std::string text; };
 struct ExpectFindingCount { std::uint64_t count = 0; };
 struct ExpectFindingKinds { std::vector<std::string> kinds; };  // as a multiset
 
-// Timing profile bounds (core/TimingProfile.hpp); `mcu` "" = the board's first.
+// Timing profile bounds (mcu/TimingProfile.hpp); `mcu` "" = the board's first.
 // A scenario with any of them profiles that MCU.
 struct ExpectIsr {
     std::string mcu;

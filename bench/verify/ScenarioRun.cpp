@@ -12,13 +12,13 @@
 #include "core/InputFile.hpp"
 #include "core/FileHash.hpp"
 #include "core/UserStop.hpp"
-#include "core/TimingProfile.hpp"
+#include "mcu/TimingProfile.hpp"
 #include "core/VectorNames.hpp"
 #include "trace/WaveformFiles.hpp"
 #include "trace/HtmlReport.hpp"
 #include "core/OutputFile.hpp"
 #include "trace/TimelineText.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 #include "verify/Scenario.hpp"
 
 namespace fs = std::filesystem;

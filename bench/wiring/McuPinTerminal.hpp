@@ -14,8 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "core/Mcu.hpp"
-#include "core/Pin.hpp"
+#include "mcu/Mcu.hpp"
+#include "periph/ports/Pin.hpp"
 #include "wiring/Net.hpp"
 
 struct avr_ioport_t;

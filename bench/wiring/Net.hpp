@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/Finding.hpp"
-#include "core/Mcu.hpp"
-#include "core/PeriodicOutput.hpp"
+#include "mcu/Mcu.hpp"
+#include "periph/timer/PeriodicOutput.hpp"
 #include "wiring/Drive.hpp"
 
 namespace avrbench {
@@ -39,7 +39,7 @@ public:
     // The net settled to `resolution` (delivered to every terminal, the
     // drivers included, whenever the resolution changes).
     virtual void receive(const Resolution& resolution) = 0;
-    // An MCU pin on the net repeats a periodic wave (core/PeriodicOutput.hpp)
+    // An MCU pin on the net repeats a periodic wave (periph/timer/PeriodicOutput.hpp)
     // instead of delivering its edges; true if this terminal follows it. The
     // net's resolution keeps the wave's start level meanwhile.
     virtual bool begin_wave(const PeriodicWave& wave) {

@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "boards/Board.hpp"
-#include "core/Adc.hpp"
-#include "core/Mcu.hpp"
+#include "periph/adc/Adc.hpp"
+#include "mcu/Mcu.hpp"
 #include "parts/SerialPeer.hpp"
 #include "support/Paths.hpp"
 

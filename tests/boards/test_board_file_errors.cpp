@@ -111,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"port_beside_a_pin", 11, "  x_carriage: [uno.PB2, x.carriage, x_min.axis]",
              "bad.yaml:11: net 'x_carriage' joins the pin uno.PB2 and the carriage port x.carriage: only analog "
              "outputs share a net with pins"},
-        // Boot loaders (core/BootSection.hpp): the fuses come with them.
+        // Boot loaders (periph/memory/BootSection.hpp): the fuses come with them.
         Case{"bootloader_without_fuses", 2, "  uno: {type: atmega328p, clock: 16MHz, bootloader: optiboot_atmega328.hex}",
              "bad.yaml:2: MCU 'uno': a bootloader needs its fuses (e.g. fuses: {low: 0xFF, high: 0xDE, extended: 0xFD})"},
         Case{"fuse_not_a_byte", 2, "  uno: {type: atmega328p, clock: 16MHz, fuses: {low: 0xFF, high: 0x1DE, extended: 0xFD}}",

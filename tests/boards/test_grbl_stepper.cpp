@@ -24,7 +24,7 @@ extern "C" {
 }
 
 #include "conformance_timers/TimerTestSupport.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 
 namespace avrbench::test::timers {
 namespace {

@@ -12,7 +12,7 @@
 #include "support/Paths.hpp"
 #include "support/PinLog.hpp"
 #include "support/RunCommand.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

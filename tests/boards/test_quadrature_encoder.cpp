@@ -11,7 +11,7 @@
 #include "support/Paths.hpp"
 #include "support/PinLog.hpp"
 #include "support/RunCommand.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 
 #include "boards/Board.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "parts/Axis.hpp"
 #include "support/Paths.hpp"
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "conformance_periph/PeriphSupport.hpp"
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 
 namespace avrbench {
 namespace {

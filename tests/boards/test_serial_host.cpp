@@ -5,11 +5,11 @@
 
 #include "boards/BoardFile.hpp"
 #include "core/Notice.hpp"
-#include "core/Pin.hpp"
-#include "core/Uart.hpp"
+#include "periph/ports/Pin.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/SerialHost.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

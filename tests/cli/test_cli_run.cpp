@@ -58,7 +58,7 @@ TEST(CliRun, TwoRunsGiveByteIdenticalVcds) {
 }
 
 // --simavr-core runs the same program on simavr's avr_run_one instead of
-// core/PredecodedCore: the same VCD byte for byte, on a board job with
+// mcu/PredecodedCore: the same VCD byte for byte, on a board job with
 // five MCUs (the printer demo's board, a short job) and on one MCU.
 TEST(CliRun, SimavrCoreGivesTheSameVcdAsThePredecodedCore) {
     const auto dir = test::scratch_dir("cli-simavr-core");

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "boards/Board.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/Axis.hpp"
 #include "parts/PenLift.hpp"
 #include "parts/StepDirDriver.hpp"

@@ -23,7 +23,7 @@
 #include "parts/HybridStepper.hpp"
 #include "parts/MotionOracle.hpp"
 #include "support/Paths.hpp"
-#include "verify/BoardRun.hpp"
+#include "run/BoardRun.hpp"
 
 namespace avrbench {
 namespace {

@@ -12,7 +12,7 @@
 #include "cam/DxfReader.hpp"
 #include "cam/Records.hpp"
 #include "core/Errors.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/Axis.hpp"
 #include "parts/PenLift.hpp"
 #include "stimulus/RecordHost.hpp"

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/McuSuffix.hpp"
 #include "support/Paths.hpp"
 #include "support/PinLog.hpp"

@@ -11,8 +11,8 @@ extern "C" {
 }
 
 #include "conformance_periph/PeriphSupport.hpp"
-#include "core/Adc.hpp"
-#include "core/fixes/Fix.hpp"
+#include "periph/adc/Adc.hpp"
+#include "periph/Fix.hpp"
 
 namespace avrbench {
 namespace {

@@ -6,7 +6,7 @@
 // and that instruction has completed.
 #include <gtest/gtest.h>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

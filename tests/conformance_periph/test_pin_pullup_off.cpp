@@ -5,7 +5,7 @@
 // level for an undriven input, 0 (docs/FIDELITY.md).
 #include <gtest/gtest.h>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "conformance_periph/PeriphSupport.hpp"
-#include "core/TimingProfile.hpp"
+#include "mcu/TimingProfile.hpp"
 
 namespace avrbench {
 namespace {
@@ -155,7 +155,7 @@ TEST_P(WatchdogModes, InterruptAndResetModeInterruptsThenResetsAndPinsTriState) 
     // at the reset itself (not when the new boot rewrites DDRB), two time-outs
     // after the watchdog was enabled, and rises again when the new boot drives it.
     // The firmware set the watchdog up and spins without WDR: a reset it
-    // asked for (core/WatchdogWatch.hpp), not a finding.
+    // asked for (periph/watchdog/WatchdogWatch.hpp), not a finding.
     EXPECT_TRUE(mcu.findings().empty()) << part.name;
     ASSERT_EQ(mcu.requested_resets().size(), 1u) << part.name;
     const Cycle reset_cycle = mcu.requested_resets()[0].cycle;
@@ -199,7 +199,7 @@ TEST(WatchdogAtmega32, ResetsAfterSixteenKCyclesOfTheOneMegahertzOscillatorThenS
     constexpr Cycle kPeriod = Cycle{16384} * 16;
     mcu.run_until(12 * kPeriod);
     // Enabled within the first 1000 cycles of boot 1, then a spin without
-    // WDR: a reset the firmware asked for (core/WatchdogWatch.hpp).
+    // WDR: a reset the firmware asked for (periph/watchdog/WatchdogWatch.hpp).
     EXPECT_TRUE(mcu.findings().empty());
     ASSERT_EQ(mcu.requested_resets().size(), 1u);
     EXPECT_GE(mcu.requested_resets()[0].cycle, kPeriod);

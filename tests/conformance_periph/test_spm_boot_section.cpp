@@ -25,9 +25,9 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

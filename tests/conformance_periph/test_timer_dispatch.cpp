@@ -10,8 +10,8 @@
 
 #include <cstdint>
 
-#include "core/Mcu.hpp"
-#include "core/Uart.hpp"
+#include "mcu/Mcu.hpp"
+#include "periph/usart/Uart.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

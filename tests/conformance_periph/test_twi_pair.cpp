@@ -11,7 +11,7 @@
 
 #include "boards/Board.hpp"
 #include "boards/BoardFile.hpp"
-#include "core/Twi.hpp"
+#include "periph/twi/Twi.hpp"
 #include "support/McuSuffix.hpp"
 #include "support/Paths.hpp"
 

@@ -9,7 +9,7 @@ extern "C" {
 }
 
 #include "conformance_periph/PeriphSupport.hpp"
-#include "core/fixes/Fix.hpp"
+#include "periph/Fix.hpp"
 #include "support/PinLog.hpp"
 
 namespace avrbench {

@@ -13,8 +13,8 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/McuSuffix.hpp"
 #include "support/Paths.hpp"
 #include "support/PinLog.hpp"

@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 

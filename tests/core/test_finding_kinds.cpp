@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "core/Finding.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 
 namespace avrbench {
 namespace {

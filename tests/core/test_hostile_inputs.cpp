@@ -25,7 +25,7 @@
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 #include "trace/TimelineText.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

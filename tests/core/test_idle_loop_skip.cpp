@@ -1,4 +1,4 @@
-// core/IdleLoopSkip on loops whose numbers can be worked out by hand. The
+// mcu/IdleLoopSkip on loops whose numbers can be worked out by hand. The
 // every-firmware exactness check is RunLoop.SkippingIdleLoopsEndsWhereAvrRunEndsOnEveryFirmware.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

@@ -1,4 +1,4 @@
-// core/IntelHex against records written by hand from Intel's "Hexadecimal
+// mcu/IntelHex against records written by hand from Intel's "Hexadecimal
 // Object File Format Specification" (rev. A): ':' count(1) address(2) type(1)
 // data checksum, the checksum being the two's complement of the byte sum.
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "core/Errors.hpp"
-#include "core/IntelHex.hpp"
+#include "mcu/IntelHex.hpp"
 
 namespace avrbench {
 namespace {

@@ -2,8 +2,8 @@
 // bounded by one instruction.
 #include <gtest/gtest.h>
 
-#include "core/ElfImage.hpp"
-#include "core/Lockstep.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Lockstep.hpp"
 #include "support/Paths.hpp"
 #include "trace/Recorder.hpp"
 

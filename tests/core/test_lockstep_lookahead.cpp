@@ -1,4 +1,4 @@
-// The lockstep's lookahead (core/Lockstep.hpp) changes only how fast a
+// The lockstep's lookahead (mcu/Lockstep.hpp) changes only how fast a
 // board runs: every board here is run twice, with lookahead and in strict
 // lockstep (every MCU's horizon its present time), and must end in the same
 // state - every MCU's cycle, PC and RAM, and every recorded event. Both runs
@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "boards/Board.hpp"
-#include "core/Lockstep.hpp"
+#include "mcu/Lockstep.hpp"
 #include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
 #include "trace/TimelineText.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

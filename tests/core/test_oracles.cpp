@@ -2,8 +2,8 @@
 // the PC and the nearest symbol.
 #include <gtest/gtest.h>
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

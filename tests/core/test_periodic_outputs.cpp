@@ -1,4 +1,4 @@
-// Compare outputs handed out as periodic waves (core/PeriodicOutput.hpp)
+// Compare outputs handed out as periodic waves (periph/timer/PeriodicOutput.hpp)
 // instead of an event per edge: the waves, expanded, must be exactly the
 // edges the timer model drives one by one, and the firmware must end in the
 // same state, on every firmware the build makes.
@@ -14,9 +14,9 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
-#include "core/PeriodicOutput.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
+#include "periph/timer/PeriodicOutput.hpp"
 #include "support/EveryFirmware.hpp"
 #include "support/Paths.hpp"
 

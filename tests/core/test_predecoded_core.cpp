@@ -1,4 +1,4 @@
-// core/PredecodedCore against simavr's avr_run_one, instruction by
+// mcu/PredecodedCore against simavr's avr_run_one, instruction by
 // instruction: every firmware the build makes runs on two MCUs, one on each
 // core, with the same serial input, and after every instruction the two
 // must agree on the cycle, PC, core state, interrupt state, all eight SREG
@@ -20,10 +20,10 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
-#include "core/PredecodedCore.hpp"
+#include "mcu/Mcu.hpp"
+#include "mcu/PredecodedCore.hpp"
 #include "support/EveryFirmware.hpp"
 #include "support/Paths.hpp"
 

@@ -1,4 +1,4 @@
-// core/SimavrStep (with and without skipping idle loops) against simavr's
+// mcu/SimavrStep (with and without skipping idle loops) against simavr's
 // own avr_run: every firmware the build
 // makes runs 20 ms both ways, with every pin and USART0 traced, and must end
 // in the same state (cycle, PC, registers, I/O and all of RAM, step count)
@@ -17,7 +17,7 @@ extern "C" {
 }
 
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/EveryFirmware.hpp"
 #include "support/Paths.hpp"
 #include "trace/Recorder.hpp"
@@ -49,7 +49,7 @@ TEST(RunLoop, SimavrStepEndsWhereAvrRunEndsOnEveryFirmware) {
     }
 }
 
-// The idle-loop skipper (core/IdleLoopSkip.hpp) against simavr's avr_run on
+// The idle-loop skipper (mcu/IdleLoopSkip.hpp) against simavr's avr_run on
 // the same set: the same end state and byte-identical timelines, in fewer
 // steps wherever a loop was skipped. It must also actually skip: waiting
 // for the next received byte (uart_echo), for TWINT (twi_master), or in

@@ -14,12 +14,12 @@
 #include <set>
 
 #include "boards/Board.hpp"
-#include "core/Lockstep.hpp"
+#include "mcu/Lockstep.hpp"
 #include "core/Units.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 #include "support/WallClockGuard.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

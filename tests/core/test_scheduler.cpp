@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

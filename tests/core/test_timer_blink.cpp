@@ -3,9 +3,9 @@
 // (OCR1A + 1) * prescaler cycles = (249 + 1) * 64 = 16000 cycles = 1 ms at 16 MHz.
 #include <gtest/gtest.h>
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 #include "trace/Recorder.hpp"
 

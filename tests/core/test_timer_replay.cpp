@@ -1,4 +1,4 @@
-// The timer model's replay of a steady period (core/fixes/TimerModel.cpp:
+// The timer model's replay of a steady period (periph/timer/TimerModel.cpp:
 // events taken from a record of one period instead of computed) against the
 // model computing every event: every firmware the build makes runs 20 ms
 // both ways, with every pin and USART0 traced and a few lines of serial
@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "core/fixes/Fixes.hpp"
+#include "periph/Fixes.hpp"
 #include "support/EveryFirmware.hpp"
 
 namespace avrbench {

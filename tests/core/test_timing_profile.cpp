@@ -1,12 +1,12 @@
-// The timing profile (core/TimingProfile.hpp) against hand counts from the
+// The timing profile (mcu/TimingProfile.hpp) against hand counts from the
 // firmware listings and the datasheet's interrupt response.
 #include <gtest/gtest.h>
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
-#include "core/TimingProfile.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
+#include "mcu/TimingProfile.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

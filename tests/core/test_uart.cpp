@@ -10,9 +10,9 @@ extern "C" {
 #include <sim_io.h>
 }
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {
@@ -29,7 +29,7 @@ TEST(Uart, FrameIsTenBitTimesAt115200WithU2x) {
     EXPECT_EQ(uart.cycles_per_frame(), kCyclesPerFrame);
 
     // The banner is written by polling UDRE0. The transmitter is double
-    // buffered (§20.6, core/fixes/UartTransmitter): the next byte waits in UDR
+    // buffered (§20.6, periph/usart/UartTransmitter): the next byte waits in UDR
     // while a frame is shifted out and follows its stop bit at once, so bytes
     // leave exactly one frame apart (each stamped at its start bit). A frame
     // of 11 bit times (simavr 1.6's parity-always count) would give 1496.

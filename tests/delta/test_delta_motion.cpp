@@ -15,7 +15,7 @@
 #include "parts/DeltaRobot.hpp"
 #include "parts/MotionOracle.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

@@ -1,5 +1,5 @@
 // The bench's check of the moves a delta firmware accepts (parts/DeltaRobot
-// check_accepted_move, wired to the host by verify/Bench): a G1 answered ok
+// check_accepted_move, wired to the host by run/Bench): a G1 answered ok
 // must be a point the arms reach with every servo inside its travel.
 // Targets and angles by hand from the thesis' inverse kinematics (digest
 // seed_004_delta.md §2, f = 233.2, e = 80, r_f = 60, r_e = 350 mm), with the
@@ -17,7 +17,7 @@
 
 #include "parts/DeltaRobot.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

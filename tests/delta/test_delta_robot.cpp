@@ -11,7 +11,7 @@
 
 #include "boards/Board.hpp"
 #include "core/FileHash.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/DeltaRobot.hpp"
 #include "parts/Electromagnet.hpp"
 #include "support/Paths.hpp"

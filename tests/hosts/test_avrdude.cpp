@@ -16,7 +16,7 @@
 #include <fstream>
 #include <string>
 
-#include "core/IntelHex.hpp"
+#include "mcu/IntelHex.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "boards/Board.hpp"
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "parts/HybridStepper.hpp"
 #include "parts/ShiftRegister595.hpp"
 #include "support/Paths.hpp"

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench::test {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "boards/Board.hpp"
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 #include "parts/HybridStepper.hpp"
 #include "parts/ThermalPlant.hpp"
 #include "support/Paths.hpp"

@@ -15,7 +15,7 @@
 #include "parts/Part.hpp"
 #include "report/HtmlReportTestSupport.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/TraceTestSupport.hpp"
 

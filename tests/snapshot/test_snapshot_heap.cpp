@@ -24,9 +24,9 @@
 
 #include "FirmwareTarget.hpp"
 #include "SnapshotHeap.hpp"
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
-#include "core/PredecodedCore.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
+#include "mcu/PredecodedCore.hpp"
 #include "support/Paths.hpp"
 
 namespace avrbench {

@@ -4,7 +4,7 @@
 // Error/Resend/ok triplet resends the line, a welcome mid-job is a restart.
 #include <gtest/gtest.h>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "stimulus/UartHost.hpp"
 #include "support/Paths.hpp"
 

@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <string>
 
-#include "core/Uart.hpp"
+#include "periph/usart/Uart.hpp"
 #include "stimulus/PtyBridge.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "core/ElfImage.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/ElfImage.hpp"
+#include "mcu/Mcu.hpp"
 #include "stimulus/UartHost.hpp"
 #include "support/Paths.hpp"
 

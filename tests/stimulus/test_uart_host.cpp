@@ -11,9 +11,9 @@
 #include <algorithm>
 #include <string>
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "stimulus/UartHost.hpp"
 #include "support/Paths.hpp"
 

@@ -15,9 +15,9 @@ extern "C" {
 #include <sim_avr.h>
 }
 
-#include "core/ElfImage.hpp"
+#include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/Timeline.hpp"

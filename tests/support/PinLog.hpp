@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 
 namespace avrbench::test {
 

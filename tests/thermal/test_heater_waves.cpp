@@ -1,5 +1,5 @@
 // A heater whose gate is a hardware PWM the timer hands out as a periodic
-// wave (core/PeriodicOutput.hpp, parts/Heater.hpp): the on-time is the one the
+// wave (periph/timer/PeriodicOutput.hpp, parts/Heater.hpp): the on-time is the one the
 // gate's edges give, the plant's temperatures stay within the bound the
 // averaging allows, and skipping idle loops changes nothing.
 #include <cmath>

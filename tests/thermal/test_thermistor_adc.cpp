@@ -1,6 +1,6 @@
 // The thermistor, its divider and the MCU's ADC: the codes a firmware reads,
 // against divider values computed by hand from datasheet resistances.
-// firmware/thermal/adc_probe converts its channels in a loop. core/Adc feeds
+// firmware/thermal/adc_probe converts its channels in a loop. periph/adc/Adc feeds
 // each channel's voltage (in mV, rounded) when a conversion starts; the
 // conversion is the core's (fixes/AdcConversion): ADC = Vin * 1024 / Vref,
 // truncated, clamped to 1023 (ATmega2560 §26.7).
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/Adc.hpp"
+#include "periph/adc/Adc.hpp"
 #include "parts/Heater.hpp"
 #include "parts/ThermalPlant.hpp"
 #include "parts/Thermistor.hpp"

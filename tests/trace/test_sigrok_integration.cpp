@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "core/Twi.hpp"
+#include "periph/twi/Twi.hpp"
 #include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
 #include "trace/VcdWriter.hpp"

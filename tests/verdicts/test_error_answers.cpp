@@ -5,7 +5,7 @@
 // byte for byte as written.
 #include <gtest/gtest.h>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "stimulus/UartHost.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"

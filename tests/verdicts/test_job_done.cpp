@@ -10,7 +10,7 @@
 #include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
-#include "verify/HeatTargets.hpp"
+#include "run/HeatTargets.hpp"
 
 namespace avrbench {
 namespace {

@@ -1,10 +1,10 @@
 // False reds: a watchdog reset the firmware asks for is not a crash
-// (core/WatchdogWatch.hpp); one that fires because it hung still is.
+// (periph/watchdog/WatchdogWatch.hpp); one that fires because it hung still is.
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "core/Mcu.hpp"
+#include "mcu/Mcu.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 

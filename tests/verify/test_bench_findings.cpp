@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
+#include "run/Bench.hpp"
 
 namespace avrbench {
 namespace {

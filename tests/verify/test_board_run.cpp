@@ -1,4 +1,4 @@
-// The library's board run as a C++ front end uses it (verify/BoardRun.hpp):
+// The library's board run as a C++ front end uses it (run/BoardRun.hpp):
 // the firmware by MCU name, a streamed VCD, the summary and the verdict.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
-#include "verify/BoardRun.hpp"
+#include "run/BoardRun.hpp"
 
 namespace avrbench {
 namespace {

@@ -1,5 +1,5 @@
 // The motion oracle (parts/MotionOracle) and the G-code reading that feeds it
-// (verify/CommandedPath): what the accepted lines command, by hand, and the
+// (run/CommandedPath): what the accepted lines command, by hand, and the
 // seed systems' wrong motion reported by the run (issue 40 item 1). Each run
 // here is bounded in simulated time; ctest's limit is the wall-clock guard.
 #include <gtest/gtest.h>
@@ -16,9 +16,9 @@
 #include "parts/MotionOracle.hpp"
 #include "printer3d/PrinterBench.hpp"
 #include "support/Paths.hpp"
-#include "verify/Bench.hpp"
-#include "verify/BoardRun.hpp"
-#include "verify/CommandedPath.hpp"
+#include "run/Bench.hpp"
+#include "run/BoardRun.hpp"
+#include "run/CommandedPath.hpp"
 
 namespace avrbench {
 namespace {
