@@ -11,10 +11,13 @@ namespace avrbench {
 
 namespace fuzz_findings_detail {
 
-// The shape of a G-code line: its command, the first word's letter and
-// whole number ("G3S1Y1I0J2" -> "G3", "N5 M104 S200" -> "M104", "G X1" ->
-// "G"): the lines one root cause answers to differ in their arguments, and a
-// fuzzer varies those without end.
+// The shape of a G-code line: its command, the first word's letter and,
+// for a command letter (G, M, T), its whole number of up to four digits
+// ("G3S1Y1I0J2" -> "G3", "N5 M104 S200" -> "M104", "G X1" -> "G",
+// "G69661" -> "G", "X65090 Y1" -> "X"): the lines one root cause answers to
+// differ in their arguments, and a fuzzer varies those without end (a
+// campaign on grbl_stepper told 69 "root causes" apart by an axis word's
+// number).
 inline std::string line_shape(const std::string& line) {
     std::size_t i = 0;
     const auto skip_blanks = [&] {
@@ -28,10 +31,14 @@ inline std::string line_shape(const std::string& line) {
         skip_blanks();
     }
     if (i >= line.size() || !std::isalpha(static_cast<unsigned char>(line[i]))) return "no command";
-    std::string shape(1, static_cast<char>(std::toupper(static_cast<unsigned char>(line[i++]))));
+    const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(line[i++])));
+    std::string shape(1, letter);
+    if (letter != 'G' && letter != 'M' && letter != 'T') return shape;
     while (i < line.size() && line[i] == '0' && i + 1 < line.size() && std::isdigit(static_cast<unsigned char>(line[i + 1]))) ++i;
-    while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) shape.push_back(line[i++]);
-    return shape;
+    std::string number;
+    while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) number.push_back(line[i++]);
+    constexpr std::size_t kLongestCode = 4;  // M7219 is Marlin's longest; no firmware has a five-digit code
+    return number.size() <= kLongestCode ? shape + number : shape;
 }
 
 // "sym+0x1c" -> "sym"; "0x1234" stays.

@@ -59,10 +59,24 @@ public:
     // `why` says what about the line (default: its meaning differs between
     // firmware).
     virtual void frame_lost(const std::string& line, const std::string& why = "means different things to different firmware") = 0;
+    // From this moment the machine may stop anywhere, even on a move it is
+    // making or has queued (grbl's feed hold '!', its reset, its overrides,
+    // picked out of the stream as they arrive): stop judging, those moves
+    // included. Default: as frame_lost.
+    virtual void stop_now(const std::string& line, const std::string& why) { frame_lost(line, why); }
     // The firmware refused the line that gave the last `moves` moves (they
-    // were told as the line went out): forget them. False when it cannot,
-    // because the machine began one (the bench then loses the frame).
-    virtual bool retract(std::size_t moves) = 0;
+    // were told as the line went out, with the lines sent after it): forget
+    // them. `stop_after`: reading the refused line or one after it stopped
+    // the judging (frame_lost); that stop goes too, as does one the judge
+    // made itself on those moves - the bench reads the later lines again,
+    // and a stop comes back if its line does. False when it cannot, because
+    // the machine began one (the bench then loses the frame).
+    virtual bool retract(std::size_t moves, bool stop_after) = 0;
+    // The firmware's software endstops, per axis (low, high; either may be
+    // absent), in its coordinates: it clamps a line's end to them (Marlin's
+    // and Repetier's MIN/MAX_SOFTWARE_ENDSTOPS). None by default.
+    using SoftLimits = std::array<std::array<std::optional<double>, 2>, 3>;
+    virtual SoftLimits soft_limits_mm() const { return {}; }
     // Where the firmware's own position is at power-up, in its coordinates:
     // 0 for firmware that counts from where the machine starts; a firmware
     // with another modal default (seed 004's delta: Z -310) says so.
@@ -70,8 +84,9 @@ public:
     // The firmware waits here (G4) before the moves that follow.
     virtual void dwell() {}
     // The line that made the judge stop (frame_lost) was refused by the
-    // firmware: its coordinates mean what they meant, judging goes on.
-    // False when it cannot (anything came after the stop).
+    // firmware: its coordinates mean what they meant, judging goes on (true
+    // also when the retract of that line already undid the stop). False
+    // when it cannot (anything came after the stop).
     virtual bool frame_restored() { return false; }
     // Another part judged the move of line `line` (quoted as in
     // CommandedMove::line): the machine cannot make it (a delta's

@@ -76,6 +76,15 @@ std::vector<ParamSpec> MotionOracle::param_specs() {
         specs.push_back({.name = "start_" + a, .type = PT::Quantity, .dimension = D::Length, .default_value = "0mm",
                          .source = "the firmware: the position it takes itself to be at before the first move (most: 0)",
                          .help = "the firmware's own " + a + " at power-up, in its coordinates", .min = -10.0, .max = 10.0});
+        for (const char* end : {"min", "max"}) {
+            specs.push_back({.name = "soft_" + std::string(end) + "_" + a, .type = PT::Quantity, .dimension = D::Length,
+                             .source = "the firmware's configuration: Marlin's " + std::string(1, kAxisLetters[axis - 'x']) +
+                                           "_" + (end[1] == 'i' ? "MIN" : "MAX") +
+                                           "_POS with its software endstops on (Configuration.h), Repetier's likewise",
+                             .help = "the firmware's software endstop, in its coordinates: it clamps a line's " + a +
+                                     " to it, and an arc that crosses it is not judged (absent: none)",
+                             .min = -10.0, .max = 10.0});
+        }
         specs.push_back({.name = "home_" + a, .type = PT::Quantity, .dimension = D::Length,
                          .source = "the board: where the firmware's homing puts its zero (a switch's trip point)",
                          .help = "where " + a + " = 0 is on the carriage after G28 (absent: G28 ends judging)",
@@ -97,6 +106,11 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
         if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
         start_mm_[k] = params.quantity("start_" + a) * 1e3;
         if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
+        if (params.has("soft_min_" + a)) soft_limits_mm_[k][0] = params.quantity("soft_min_" + a) * 1e3;
+        if (params.has("soft_max_" + a)) soft_limits_mm_[k][1] = params.quantity("soft_max_" + a) * 1e3;
+        if (soft_limits_mm_[k][0] && soft_limits_mm_[k][1] && !(*soft_limits_mm_[k][0] < *soft_limits_mm_[k][1])) {
+            throw BadInput("part '" + this->name() + "': soft_min_" + a + " must be below soft_max_" + a);
+        }
         require_port<Carriage>(a, false, "the " + std::string(1, kAxisLetters[k]) + " axis' carriage",
                                [this, k](Carriage& c) {
                                    carriages_[k] = &c;
@@ -184,16 +198,29 @@ Eigen::Vector3d MotionOracle::tool_position() const {
     return p;
 }
 
-void MotionOracle::lose(const std::string& why) {
+void MotionOracle::lose(const std::string& why, bool by_move) {
     if (lost_) return;
     lost_ = true;
     lost_why_ = why;
     Tracked barrier;
     barrier.barrier = true;
+    barrier.command = commands_;
+    barrier.barrier_by_move = by_move;
     moves_.push_back(barrier);
 }
 
 void MotionOracle::frame_lost(const std::string& line, const std::string& why) {
+    lose(line + " " + why);
+}
+
+void MotionOracle::stop_now(const std::string& line, const std::string& why) {
+    // The moves under way or queued may end anywhere: none is judged. What
+    // the tool did until now was told already (a stray before the hold).
+    moves_judged_ += static_cast<std::size_t>(std::count_if(moves_.begin(), moves_.end(), [](const Tracked& m) {
+        return !m.barrier && (m.end_reached || m.progress > m.end_tolerance.maxCoeff());
+    }));
+    moves_.clear();
+    lost_ = false;
     lose(line + " " + why);
 }
 
@@ -211,7 +238,7 @@ void MotionOracle::commanded(const CommandedMove& move) {
     // moves of a refused line and those told after it, kept or not.
     const std::uint64_t command = commands_++;
     if (lost_) return;
-    if (moves_.size() >= kMaxPendingMoves) return lose("the machine is more than 4096 accepted moves behind");
+    if (moves_.size() >= kMaxPendingMoves) return lose("the machine is more than 4096 accepted moves behind", true);
     Tracked t;
     t.kind = move.kind;
     t.line = move.line;
@@ -224,18 +251,19 @@ void MotionOracle::commanded(const CommandedMove& move) {
         const auto i = static_cast<Eigen::Index>(k);
         const double step = end_tolerance_mm_ ? *end_tolerance_mm_ : carriages_[k]->step_mm();  // (an effector: given)
         t.end_tolerance[i] = step + 1e-9;
-        if (!origin_mm_[k] || !move.from_mm[k]) return lose(move.line + " starts where the bench cannot know");
+        if (!origin_mm_[k] || !move.from_mm[k]) return lose(move.line + " starts where the bench cannot know", true);
         t.from[i] = *move.from_mm[k] + *origin_mm_[k];
         if (home && move.homed[k]) {
             origin_mm_[k] = home_mm_[k];
             if (!origin_mm_[k]) {
                 return lose(move.line + " homes " + kAxisLetters[k] + " and the board gives no home_" +
-                            static_cast<char>(kAxisLetters[k] - 'A' + 'a'));
+                                static_cast<char>(kAxisLetters[k] - 'A' + 'a'),
+                            true);
             }
             // Where a switch trips is not a step-exact place.
             t.end_tolerance[i] = std::max(t.end_tolerance[i], path_tolerance_mm_);
         }
-        if (!move.to_mm[k]) return lose(move.line + " ends where the bench cannot know");
+        if (!move.to_mm[k]) return lose(move.line + " ends where the bench cannot know", true);
         t.to[i] = *move.to_mm[k] + *origin_mm_[k];
         t.origin[i] = *origin_mm_[k];
     }
@@ -274,6 +302,18 @@ void MotionOracle::commanded(const CommandedMove& move) {
     }
     if (!arc || t.kind == CommandedMove::Kind::Feed) t.length = (t.to - t.from).norm();
     t.tolerance = path_tolerance_mm_ + step_quantum_mm_ + (arc ? chord_error_mm(move.arc_rule, t.radius) : 0.0);
+    if (arc) {
+        // An arc whose end is off its circle has no one path: grbl refuses
+        // it (gcode.c, error:33 past 0.005 mm and 0.1 % of the radius),
+        // Marlin turns the start's radius through the angle and runs a line
+        // to the end, and a radius of 0 is a line to some, nothing to others.
+        const double end_radius = (t.to.head<2>() - t.centre).norm();
+        if (std::abs(end_radius - t.radius) > t.tolerance) {
+            return lose(move.line + " is an arc whose end is off its circle (radius " + mm_text(t.radius) + " mm at the start, " +
+                            mm_text(end_radius) + " mm at the end): firmware draw it in different ways",
+                        true);
+        }
+    }
     const bool z_and_xy = t.from.z() != t.to.z() && (t.from.head<2>() - t.to.head<2>()).norm() > 0;
     if (z_before_xy_ && z_and_xy && !arc && !home) {
         Tracked z_alone = t;
@@ -292,20 +332,30 @@ void MotionOracle::commanded(const CommandedMove& move) {
     advance(p);
 }
 
-bool MotionOracle::retract(std::size_t moves) {
+bool MotionOracle::retract(std::size_t moves, bool stop_after) {
     if (moves > commands_) return false;
     const std::uint64_t first = commands_ - moves;
-    // The refused line's moves are the last told; a barrier (judging stopped
-    // on a later line the bench could not read) may stand after them, and
-    // stays: what was refused is still taken back, never judged.
+    // The refused line's moves are the last told, with those of the lines
+    // after it. The stop in judging that one of them made goes too: the
+    // grbl 1.1h campaign kept line 3 '0''s stop after refused line 1, so the
+    // re-read line 2 'G1X1F5' was never told and line 4 was judged from
+    // where line 2 should have taken the tool (docs/THIRD_PARTY.md).
     for (const Tracked& m : moves_) {
         if (m.barrier || m.command < first) continue;
         const bool begun = m.progress > m.end_tolerance.maxCoeff() || m.end_reached || m.deviation_finding || m.tool_finding;
         if (begun && &m == &moves_.front()) return false;
     }
-    moves_.erase(std::remove_if(moves_.begin(), moves_.end(), [first](const Tracked& m) { return !m.barrier && m.command >= first; }),
-                 moves_.end());
+    const auto taken_back = [first, stop_after](const Tracked& m) {
+        if (!m.barrier) return m.command >= first;
+        // Made on a move of those lines, or on reading one of them.
+        return m.barrier_by_move ? m.command > first : stop_after && m.command >= first;
+    };
+    moves_.erase(std::remove_if(moves_.begin(), moves_.end(), taken_back), moves_.end());
     commands_ = first;
+    if (lost_ && std::none_of(moves_.begin(), moves_.end(), [](const Tracked& m) { return m.barrier; })) {
+        lost_ = false;
+        lost_why_.clear();
+    }
     return true;
 }
 
@@ -576,7 +626,8 @@ std::vector<Finding> MotionOracle::pending_findings() const {
 }
 
 bool MotionOracle::frame_restored() {
-    if (!lost_ || moves_.empty() || !moves_.back().barrier) return false;
+    if (!lost_) return true;  // the retract of the line took its stop back
+    if (moves_.empty() || !moves_.back().barrier) return false;
     moves_.pop_back();
     lost_ = false;
     lost_why_.clear();

@@ -70,8 +70,10 @@ public:
     void commanded(const CommandedMove& move) override;
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;
     void frame_lost(const std::string& line, const std::string& why) override;
-    bool retract(std::size_t moves) override;
+    void stop_now(const std::string& line, const std::string& why) override;
+    bool retract(std::size_t moves, bool stop_after) override;
     AxisPositions power_up_mm() const override { return start_mm_; }
+    SoftLimits soft_limits_mm() const override { return soft_limits_mm_; }
     void job_answered_by(std::function<bool()> all_answered) override { job_answered_ = std::move(all_answered); }
     void dwell() override { dwell_pending_ = true; }
     void judged_elsewhere(const std::string& line) override;
@@ -86,8 +88,11 @@ private:
     struct Tracked {
         CommandedMove::Kind kind = CommandedMove::Kind::Feed;
         std::string line;
-        std::uint64_t command = 0;  // which commanded() call (a Z-first line makes two moves of one)
+        // Which commanded() call (a Z-first line makes two moves of one); a
+        // barrier: how many had been made when judging stopped.
+        std::uint64_t command = 0;
         bool barrier = false;  // after a lost frame: absorbs all motion, never ends
+        bool barrier_by_move = false;  // made by the oracle on move `command - 1`
         bool free = false;     // its path is not judged (a rapid on `rapids: any`, homing)
         Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();
         Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // carriage = firmware + origin
@@ -152,7 +157,7 @@ private:
     bool ends_within(const Tracked& m, const Eigen::Vector3d& p, const Eigen::Vector3d& target) const;
     Finding make_finding(FindingKind kind, Cycle cycle, std::string detail) const;
     std::string firmware_text(const Tracked& m, const Eigen::Vector3d& carriage_mm) const;
-    void lose(const std::string& why);
+    void lose(const std::string& why, bool by_move = false);
 
     std::array<Carriage*, 3> carriages_{};
     Effector* effector_ = nullptr;
@@ -165,6 +170,7 @@ private:
     bool rapids_straight_;
     bool feeds_straight_;
     AxisPositions start_mm_{0.0, 0.0, 0.0};
+    SoftLimits soft_limits_mm_{};
     bool z_before_xy_;
     Cycle rest_cycles_;
     std::array<std::optional<double>, 3> origin_given_mm_{};

@@ -239,17 +239,31 @@ struct SentLineFeed {
     CommandedMoves* judge;
     CommandedPath path;
     bool grbl;
-    // grbl picks its realtime commands out of the stream wherever they are,
-    // in a line it then refuses too: a feed hold '!', a reset ^X, the
-    // overrides and the safety door (0x80-0xA0, grbl 1.1 interface.md). The
-    // machine may then stop or change speed anywhere: judging stops for good.
+    // grbl 1.1 picks its realtime commands out of the stream wherever they
+    // are, in a line it then refuses too (serial.c's receive interrupt, the
+    // CMD_ bytes of config.h): those that change how the machine moves are
+    // the feed hold '!', the reset ^X, the safety door 0x84, the jog cancel
+    // 0x85 and the feed and rapid overrides 0x90-0x97. The machine may then
+    // stop or change speed anywhere, on the moves it is making too: judging
+    // stops for good. '?', '~', the spindle and coolant overrides and any
+    // other byte over 0x7F never reach the line grbl reads.
+    static bool moves_differently(unsigned char b) {
+        return b == '!' || b == 0x18 || b == 0x84 || b == 0x85 || (b >= 0x90 && b <= 0x97);
+    }
     static bool holds_or_overrides(const std::string& text) {
+        return std::any_of(text.begin(), text.end(), [](char c) { return moves_differently(static_cast<unsigned char>(c)); });
+    }
+    static std::string line_grbl_reads(const std::string& text) {
+        std::string kept;
         for (const char c : text) {
             const auto b = static_cast<unsigned char>(c);
-            if (b == '!' || b == 0x18 || b >= 0x80) return true;
+            if (b == '?' || b == '~' || b == '!' || b == 0x18 || b > 0x7F) continue;
+            kept.push_back(c);
         }
-        return false;
+        return kept;
     }
+    static constexpr const char* kRealtimeWhy =
+        "carries a grbl realtime command (a feed hold, reset or override: the machine may stop anywhere)";
     struct Unanswered {
         GcodeLine line;
         CommandedPath before;  // the reading state before the line
@@ -266,14 +280,18 @@ struct SentLineFeed {
         const std::string quoted = "line " + std::to_string(line.number) + " " + quoted_line(line.text);
         if (grbl && holds_or_overrides(line.text)) {
             u.lost_for_good = true;
-            path.lose(quoted, "carries a grbl realtime command (a feed hold, reset or override: the machine may stop anywhere)");
+            path.stop_now(quoted, kRealtimeWhy);
         }
-        path.accept(line.text, quoted);
+        path.accept(grbl ? line_grbl_reads(line.text) : line.text, quoted);
         u.moves = path.moves_told() - u.before.moves_told();
         u.renamed = path.renames_told() != u.before.renames_told();
         u.changed = u.moves != 0 || u.renamed || !path.same_state(u.before);
         u.lost_frame = path.lost() && !u.before.lost();
         unanswered.push_back(std::move(u));
+    }
+    // Bytes sent outside the lines, at a time (--realtime).
+    void bytes_sent(const std::string& bytes) {
+        if (grbl && holds_or_overrides(bytes)) path.stop_now("the bytes " + quoted_line(bytes) + " sent on their own", kRealtimeWhy);
     }
     void answered(const GcodeLine& line, bool refused) {
         while (!unanswered.empty() && unanswered.front().line.number < line.number) unanswered.pop_front();
@@ -281,23 +299,30 @@ struct SentLineFeed {
         Unanswered refused_line = std::move(unanswered.front());
         unanswered.pop_front();
         if (!refused || !refused_line.changed) return;
+        // A realtime command in it or after it stopped the judging for good.
+        if (refused_line.lost_for_good ||
+            std::any_of(unanswered.begin(), unanswered.end(), [](const Unanswered& u) { return u.lost_for_good; })) {
+            return;
+        }
         std::size_t moves = refused_line.moves;
         bool renamed = refused_line.renamed;
+        bool stop_after = refused_line.lost_frame;
         for (const auto& later : unanswered) {
             moves += later.moves;
             renamed = renamed || later.renamed;
+            stop_after = stop_after || later.lost_frame;
         }
-        if (renamed || !judge->retract(moves)) {
+        if (renamed || !judge->retract(moves, stop_after)) {
             // The lines sent after it were read in a frame the firmware never
             // took: take their moves back where the judge can, then stop.
-            if (renamed) (void)judge->retract(moves);
+            if (renamed) (void)judge->retract(moves, stop_after);
             path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
             return;
         }
         // The line that stopped the judging (G5, a bare number) was refused:
         // the firmware's frame is what it was, and judging goes on with the
         // lines after it read again.
-        if (refused_line.lost_frame && (refused_line.lost_for_good || !judge->frame_restored())) {
+        if (refused_line.lost_frame && !judge->frame_restored()) {
             path.lose("line " + std::to_string(line.number) + " " + quoted_line(line.text) + ", refused,");
             return;
         }
@@ -329,6 +354,9 @@ void Bench::follow_sent_lines(UartHost& host) {
     // (Marlin's "Error:" or "echo:Unknown command", Teacup's "E:").
     host.on_answer([feeds](const GcodeLine& line, std::size_t, bool refused) {
         for (auto& feed : *feeds) feed.answered(line, refused);
+    });
+    host.on_bytes_sent([feeds](const std::string& bytes) {
+        for (auto& feed : *feeds) feed.bytes_sent(bytes);
     });
 }
 

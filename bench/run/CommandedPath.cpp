@@ -30,6 +30,12 @@ void CommandedPath::lose(const std::string& quoted, const std::string& why) {
     judge_->frame_lost(quoted, why);
 }
 
+void CommandedPath::stop_now(const std::string& quoted, const std::string& why) {
+    // Also when the reading was lost already: the moves before that still count.
+    lost_ = true;
+    judge_->stop_now(quoted, why);
+}
+
 bool CommandedPath::same_state(const CommandedPath& other) const {
     return position_mm_ == other.position_mm_ && relative_ == other.relative_ && mm_per_unit_ == other.mm_per_unit_ &&
            xy_plane_ == other.xy_plane_ && lost_ == other.lost_ && feed_mm_per_min_ == other.feed_mm_per_min_;
@@ -102,6 +108,7 @@ void CommandedPath::accept(std::string_view line, const std::string& quoted) {
         }
         case 92: {
             if (!names_an_axis) return lose(quoted);
+            if (any_soft_limit()) return lose(quoted, "renames the position, and firmware move their software endstops with it in different ways");
             AxisPositions was{}, now{};
             for (std::size_t k = 0; k < 3; ++k) {
                 if (!axis_words[k]) continue;
@@ -173,6 +180,15 @@ void CommandedPath::move(int code, const std::array<std::optional<double>, 3>& w
             }
         }
     }
+    if (arc && arc_crosses_soft_limits(m)) {
+        return lose(quoted, "is an arc that crosses the firmware's software endstops: firmware clamp or refuse it in different ways");
+    }
+    // Marlin's clamp_to_software_endstops: the line's end, axis by axis.
+    for (std::size_t k = 0; k < 3 && !arc; ++k) {
+        if (!m.to_mm[k]) continue;
+        if (soft_limits_mm_[k][0]) m.to_mm[k] = std::max(*m.to_mm[k], *soft_limits_mm_[k][0]);
+        if (soft_limits_mm_[k][1]) m.to_mm[k] = std::min(*m.to_mm[k], *soft_limits_mm_[k][1]);
+    }
     position_mm_ = m.to_mm;
     bool moves = arc;  // an arc back to its start is a full circle
     for (std::size_t k = 0; k < 3; ++k) moves = moves || m.from_mm[k] != m.to_mm[k];
@@ -180,6 +196,51 @@ void CommandedPath::move(int code, const std::array<std::optional<double>, 3>& w
         ++moves_told_;
         judge_->commanded(m);
     }
+}
+
+bool CommandedPath::any_soft_limit() const {
+    for (const auto& axis : soft_limits_mm_) {
+        if (axis[0] || axis[1]) return true;
+    }
+    return false;
+}
+
+bool CommandedPath::arc_crosses_soft_limits(const CommandedMove& m) const {
+    if (!any_soft_limit()) return false;
+    if (!m.from_mm[0] || !m.from_mm[1] || !m.to_mm[0] || !m.to_mm[1]) return true;  // unknown: assume it does
+    const double cx = m.centre_mm[0], cy = m.centre_mm[1];
+    const double sx = *m.from_mm[0] - cx, sy = *m.from_mm[1] - cy;
+    const double ex = *m.to_mm[0] - cx, ey = *m.to_mm[1] - cy;
+    const double r = std::hypot(sx, sy);
+    // The arc's X/Y extent: its ends, and the circle's extreme points at
+    // 0, 90, 180 and 270 degrees where the sweep passes them.
+    std::vector<std::array<double, 2>> points = {{*m.from_mm[0], *m.from_mm[1]}, {*m.to_mm[0], *m.to_mm[1]}};
+    const double two_pi = 2 * std::acos(-1.0);
+    auto wrap = [two_pi](double a) {
+        a = std::fmod(a, two_pi);
+        return a < 0 ? a + two_pi : a;
+    };
+    const bool ccw = m.kind == CommandedMove::Kind::ArcCounterClockwise;
+    const double a0 = std::atan2(sy, sx), a1 = std::atan2(ey, ex);
+    double sweep = ccw ? wrap(a1 - a0) : wrap(a0 - a1);
+    if (sweep < 1e-12) sweep = two_pi;
+    for (int q = 0; q < 4; ++q) {
+        const double a = q * two_pi / 4;
+        const double turned = ccw ? wrap(a - a0) : wrap(a0 - a);
+        if (turned <= sweep) points.push_back({cx + r * std::cos(a), cy + r * std::sin(a)});
+    }
+    constexpr double kSlack_mm = 1e-9;
+    for (const auto& p : points) {
+        for (std::size_t k = 0; k < 2; ++k) {
+            if (soft_limits_mm_[k][0] && p[k] < *soft_limits_mm_[k][0] - kSlack_mm) return true;
+            if (soft_limits_mm_[k][1] && p[k] > *soft_limits_mm_[k][1] + kSlack_mm) return true;
+        }
+    }
+    if (m.to_mm[2]) {
+        if (soft_limits_mm_[2][0] && *m.to_mm[2] < *soft_limits_mm_[2][0]) return true;
+        if (soft_limits_mm_[2][1] && *m.to_mm[2] > *soft_limits_mm_[2][1]) return true;
+    }
+    return false;
 }
 
 }  // namespace avrbench

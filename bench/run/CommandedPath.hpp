@@ -8,7 +8,10 @@
 // "*checksum"). Understood: G0/G1/G2/G3 (arcs in the XY plane by I/J or R),
 // G4, G17, G20/G21, G90/G91, G94, G28 (home the named axes, all when none is
 // named), G92 (rename the position), and words that do not move the machine
-// (M, T, S, F, E, P...). A line with axis words and no G (modal motion,
+// (M, T, S, F, E, P...). With software endstops (CommandedMoves::
+// soft_limits_mm) a line's end is clamped to them as Marlin does; an arc
+// that crosses one, or a G92 (the endstops move with it as firmware
+// differ), loses the frame. A line with axis words and no G (modal motion,
 // which grbl takes and Marlin refuses), any other G word (work offsets,
 // probing, G53, G28.1...) or a line outside the strict form loses the frame:
 // nothing after it is judged.
@@ -23,7 +26,8 @@ namespace avrbench {
 
 class CommandedPath {
 public:
-    explicit CommandedPath(CommandedMoves& judge) : judge_(&judge), position_mm_(judge.power_up_mm()) {}
+    explicit CommandedPath(CommandedMoves& judge)
+        : judge_(&judge), position_mm_(judge.power_up_mm()), soft_limits_mm_(judge.soft_limits_mm()) {}
     // A line the firmware takes (the bench hands it over as it is sent, so a
     // firmware that answers after the move is followed while it moves);
     // `quoted` names it in findings.
@@ -31,6 +35,9 @@ public:
     // Nothing after this line is judged (a refusal the judge cannot undo).
     void lose(const std::string& quoted);
     void lose(const std::string& quoted, const std::string& why);
+    // From now the machine may stop anywhere, on the moves it is making too
+    // (CommandedMoves::stop_now): nothing is judged from here.
+    void stop_now(const std::string& quoted, const std::string& why);
     // How the firmware draws arcs (its family's: FirmwareArcs in run/Bench).
     void set_arc_rule(ArcRule rule) { arc_rule_ = rule; }
 
@@ -57,6 +64,11 @@ private:
     bool lost_ = false;
     std::optional<double> feed_mm_per_min_;
     ArcRule arc_rule_;
+    CommandedMoves::SoftLimits soft_limits_mm_;  // the judge's: lines clamped to them
+    bool any_soft_limit() const;
+    // Whether an arc about `centre` from `from` to `to` (XY) reaches past an
+    // X or Y software endstop anywhere on its way.
+    bool arc_crosses_soft_limits(const CommandedMove& m) const;
 };
 
 }  // namespace avrbench

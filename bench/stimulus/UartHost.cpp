@@ -252,6 +252,7 @@ void UartHost::add_lines(std::string_view text) {
 void UartHost::send_bytes(const std::string& bytes) {
     transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, bytes, 0});
     uart_.send(bytes);
+    for (auto& fn : bytes_listeners_) fn(bytes);
 }
 
 void UartHost::send_bytes_at(const std::string& bytes, Cycle at_cycle) {
@@ -551,6 +552,7 @@ void UartHost::send_line(std::size_t index) {
         transcript_.push_back(TranscriptEntry{mcu_.cycle(), Direction::Sent, line.text, line.number});
         uart_.send(line.text);
         ++acknowledged_;
+        for (auto& fn : bytes_listeners_) fn(line.text);
         return;
     }
     const std::size_t bytes = line.text.size() + 1;

@@ -261,6 +261,11 @@ public:
     // real-time bytes), before the firmware has its first byte.
     using SentListener = std::function<void(const GcodeLine& line)>;
     void on_line_sent(SentListener fn) { sent_listeners_.push_back(std::move(fn)); }
+    // Called when bytes go out that are not a job line: grbl's real-time
+    // commands ('!', '?', '~' on a line of their own) and timed bytes
+    // (send_bytes_at, --realtime).
+    using BytesListener = std::function<void(const std::string& bytes)>;
+    void on_bytes_sent(BytesListener fn) { bytes_listeners_.push_back(std::move(fn)); }
 
     // --- running -------------------------------------------------------------
     // Runs the MCU until finished() or `max_seconds` of simulated time from
@@ -349,6 +354,7 @@ private:
     std::vector<TranscriptEntry> transcript_;
     std::vector<LineListener> line_listeners_;
     std::vector<SentListener> sent_listeners_;
+    std::vector<BytesListener> bytes_listeners_;
     std::vector<AnswerListener> answer_listeners_;
 };
 

@@ -28,10 +28,12 @@ struct Recorded final : CommandedMoves {
     std::vector<CommandedMove> moves;
     std::vector<std::pair<AxisPositions, AxisPositions>> renames;
     std::vector<std::string> lost;
+    SoftLimits limits{};
+    SoftLimits soft_limits_mm() const override { return limits; }
     void commanded(const CommandedMove& m) override { moves.push_back(m); }
     void position_renamed(const AxisPositions& was, const AxisPositions& now) override { renames.push_back({was, now}); }
     void frame_lost(const std::string& line, const std::string&) override { lost.push_back(line); }
-    bool retract(std::size_t n) override {
+    bool retract(std::size_t n, bool) override {
         moves.resize(moves.size() - std::min(n, moves.size()));
         return true;
     }
@@ -96,6 +98,33 @@ TEST(CommandedPath, HomingRenamingAndLinesThatLoseTheFrame) {
         EXPECT_EQ(lost.lost.size(), 1u) << line;
         EXPECT_TRUE(lost.moves.empty()) << line;
     }
+}
+
+// Marlin 1.1.9's software endstops (Configuration.h: X 0..X_BED_SIZE 200,
+// Y 0..200, Z 0..Z_MAX_POS 135 in tonyj321's tree): clamp_to_software_endstops
+// puts a line's end on them axis by axis, so G1 X-1 from 0 moves nothing and
+// G1 X250 Y50 ends at X200 Y50. An arc that crosses one is clamped segment
+// by segment: its path is no circle, so it is not judged (the Marlin
+// campaign's G3 X0 J4 from (0, 0): a circle about (0, 4) through X -4).
+TEST(CommandedPath, SoftwareEndstopsClampALinesEndAndStopTheJudgingOfAnArcThatCrossesThem) {
+    Recorded r;
+    r.limits = {{{0.0, 200.0}, {0.0, 200.0}, {0.0, 135.0}}};
+    CommandedPath path(r);
+    feed(path, {"G1 X-1", "G1 X250 Y50 Z200", "G91", "G1 X10", "G90", "G2 X190 Y50 I-5 J0"});
+    ASSERT_EQ(r.moves.size(), 2u);  // G1 X-1 and the relative X10 from X200 end where they start
+    EXPECT_EQ(r.moves[0].to_mm, (AxisPositions{200.0, 50.0, 135.0}));
+    EXPECT_EQ(r.moves[1].kind, CommandedMove::Kind::ArcClockwise);  // about (195, 50), R 5: inside
+    EXPECT_TRUE(r.lost.empty());
+    feed(path, {"G1 X5 Y5", "G3 X5 Y5 I0 J4"});  // about (5, 9), R 4: X from 1 to 9, Y from 5 to 13
+    EXPECT_TRUE(r.lost.empty());
+    feed(path, {"G1 X0 Y0", "G3 X0 Y0 I0 J4"});  // about (0, 4): X down to -4
+    ASSERT_EQ(r.lost.size(), 1u);
+    EXPECT_EQ(r.lost[0], "'G3 X0 Y0 I0 J4'");
+    Recorded renamed;
+    renamed.limits = r.limits;
+    CommandedPath p2(renamed);
+    feed(p2, {"G92 X10"});
+    EXPECT_EQ(renamed.lost.size(), 1u);
 }
 
 // Seed 002's plot job as `avrbench run --dxf` makes it (bench/tools/RunCommand.cpp).
