@@ -30,13 +30,6 @@
 namespace avrbench {
 namespace {
 
-std::string where(const std::string& path, const YAML::Node& node) { return yaml_where(path, node); }
-
-std::string scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
-    if (!node.IsScalar()) throw BadInput(where(path, node) + ": " + what + " must be a single value");
-    return node.Scalar();
-}
-
 bool valid_name(const std::string& name) {
     if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
     for (char c : name) {
@@ -46,12 +39,12 @@ bool valid_name(const std::string& name) {
 }
 
 Endpoint parse_endpoint(const YAML::Node& node, const std::string& path) {
-    const std::string text = scalar(node, path, "a net endpoint");
+    const std::string text = yaml_scalar(node, path, "a net endpoint");
     const auto dot = text.find('.');
     if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() || text.find('.', dot + 1) != std::string::npos) {
-        throw BadInput(where(path, node) + ": '" + text + "' is not an endpoint (expected mcu.PIN or part.pin)");
+        throw BadInput(yaml_where(path, node) + ": '" + text + "' is not an endpoint (expected mcu.PIN or part.pin)");
     }
-    return Endpoint{text.substr(0, dot), text.substr(dot + 1), where(path, node)};
+    return Endpoint{text.substr(0, dot), text.substr(dot + 1), yaml_where(path, node)};
 }
 
 void check_name(const std::string& name, const std::string& location, const char* what, std::set<std::string>& seen) {
@@ -244,21 +237,21 @@ std::uint8_t parse_byte(const std::string& text, const std::string& what) {
 // `fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}`: all three bytes, as
 // avrdude's -U lfuse/hfuse/efuse and Arduino's boards.txt give them.
 std::array<std::uint8_t, 3> parse_fuses(const YAML::Node& node, const std::string& path, const std::string& what) {
-    if (!node.IsMap()) throw BadInput(where(path, node) + ": " + what + " must be a map {low: 0xFF, high: 0xDE, extended: 0xFD}");
+    if (!node.IsMap()) throw BadInput(yaml_where(path, node) + ": " + what + " must be a map {low: 0xFF, high: 0xDE, extended: 0xFD}");
     std::array<std::uint8_t, 3> fuses{};
     std::array<bool, 3> given{};
     static const std::array<std::string, 3> kNames = {"low", "high", "extended"};
     for (const auto& kv : node) {
         const std::string key = kv.first.Scalar();
-        const std::string loc = where(path, kv.first);
+        const std::string loc = yaml_where(path, kv.first);
         std::size_t index = 0;
         while (index < kNames.size() && kNames[index] != key) ++index;
         if (index == kNames.size()) throw BadInput(loc + ": " + what + ": unknown fuse '" + key + "' (expected low, high, extended)");
-        fuses[index] = parse_byte(scalar(kv.second, path, key), loc + ": " + what + ": " + key);
+        fuses[index] = parse_byte(yaml_scalar(kv.second, path, key), loc + ": " + what + ": " + key);
         given[index] = true;
     }
     for (std::size_t i = 0; i < kNames.size(); ++i) {
-        if (!given[i]) throw BadInput(where(path, node) + ": " + what + ": missing '" + kNames[i] + "' (give low, high and extended)");
+        if (!given[i]) throw BadInput(yaml_where(path, node) + ": " + what + ": missing '" + kNames[i] + "' (give low, high and extended)");
     }
     return fuses;
 }
@@ -266,8 +259,8 @@ std::array<std::uint8_t, 3> parse_fuses(const YAML::Node& node, const std::strin
 // `extends: ramps-1.4`: the base board, a standard board's name or a file
 // relative to this one.
 BoardSpec load_base(const YAML::Node& node, const std::string& path, int depth) {
-    const std::string loc = where(path, node);
-    const std::string name = scalar(node, path, "extends");
+    const std::string loc = yaml_where(path, node);
+    const std::string name = yaml_scalar(node, path, "extends");
     // Four levels are plenty for variants of variants; more is a loop.
     if (depth >= 4) throw BadInput(loc + ": 'extends' nests more than 4 boards deep (a board that extends itself?)");
     std::string base_path = name;
@@ -308,23 +301,23 @@ void parse_header(const YAML::Node& root, const std::string& path, BoardSpec& sp
     for (const auto& kv : root) {
         const std::string key = kv.first.Scalar();
         if (kSections.count(key) == 0) {
-            throw BadInput(where(path, kv.first) + ": unknown section '" + key +
+            throw BadInput(yaml_where(path, kv.first) + ": unknown section '" + key +
                            "' (expected board, description, extends, mcus, parts, nets, serial, labels)");
         }
     }
     if (root["board"]) {
         // A name people type and the summary prints: letters, digits, '_', '-', '.'.
-        spec.name = scalar(root["board"], path, "board");
+        spec.name = yaml_scalar(root["board"], path, "board");
         const bool printable_name = !spec.name.empty() && spec.name.size() <= 64 &&
                                     std::all_of(spec.name.begin(), spec.name.end(), [](char c) {
                                         return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
                                     });
         if (!printable_name) {
-            throw BadInput(where(path, root["board"]) + ": board name " + quoted_text(spec.name) +
+            throw BadInput(yaml_where(path, root["board"]) + ": board name " + quoted_text(spec.name) +
                            " is not 1 to 64 letters, digits, '_', '-' or '.'");
         }
     }
-    if (root["description"]) spec.description = scalar(root["description"], path, "description");
+    if (root["description"]) spec.description = yaml_scalar(root["description"], path, "description");
 
 }
 
@@ -333,28 +326,28 @@ void parse_mcus(const YAML::Node& root, const std::string& path, bool has_base, 
     if (!has_base && (!mcus || !mcus.IsMap() || mcus.size() == 0)) {
         throw BadInput(path + ":1: the board needs an 'mcus' map with at least one MCU");
     }
-    if (mcus && !mcus.IsMap()) throw BadInput(where(path, mcus) + ": 'mcus' must be a map of MCU name to type and clock");
+    if (mcus && !mcus.IsMap()) throw BadInput(yaml_where(path, mcus) + ": 'mcus' must be a map of MCU name to type and clock");
     if (mcus && mcus.size() > kMaxMcusPerBoard) {
-        throw BadInput(where(path, mcus) + ": " + std::to_string(mcus.size()) + " MCUs; a board holds at most " +
+        throw BadInput(yaml_where(path, mcus) + ": " + std::to_string(mcus.size()) + " MCUs; a board holds at most " +
                        std::to_string(kMaxMcusPerBoard) + " (their lockstep costs grow with the square of the count)");
     }
     for (const auto& kv : mcus) {
         McuDecl m;
         m.name = kv.first.Scalar();
-        m.location = where(path, kv.first);
+        m.location = yaml_where(path, kv.first);
         check_name(m.name, m.location, "MCU", names);
         if (!kv.second.IsMap()) throw BadInput(m.location + ": MCU '" + m.name + "' must be a map with type and clock");
         for (const auto& field : kv.second) {
             const std::string key = field.first.Scalar();
-            const std::string loc = where(path, field.first);
-            if (key == "type") m.type = scalar(field.second, path, "type");
-            else if (key == "clock") m.clock_hz = parse_frequency_hz(scalar(field.second, path, "clock"), loc + ": MCU '" + m.name + "': clock");
-            else if (key == "firmware") m.firmware = scalar(field.second, path, "firmware");
-            else if (key == "bootloader") m.bootloader = scalar(field.second, path, "bootloader");
+            const std::string loc = yaml_where(path, field.first);
+            if (key == "type") m.type = yaml_scalar(field.second, path, "type");
+            else if (key == "clock") m.clock_hz = parse_frequency_hz(yaml_scalar(field.second, path, "clock"), loc + ": MCU '" + m.name + "': clock");
+            else if (key == "firmware") m.firmware = yaml_scalar(field.second, path, "firmware");
+            else if (key == "bootloader") m.bootloader = yaml_scalar(field.second, path, "bootloader");
             else if (key == "fuses") m.fuses = parse_fuses(field.second, path, "MCU '" + m.name + "': fuses");
-            else if (key == "lock") m.lock_bits = parse_byte(scalar(field.second, path, "lock"), loc + ": MCU '" + m.name + "': lock");
+            else if (key == "lock") m.lock_bits = parse_byte(yaml_scalar(field.second, path, "lock"), loc + ": MCU '" + m.name + "': lock");
             else if (key == "watchdog_resets") {
-                const std::string value = scalar(field.second, path, "watchdog_resets");
+                const std::string value = yaml_scalar(field.second, path, "watchdog_resets");
                 if (value != "expected" && value != "findings") {
                     throw BadInput(loc + ": MCU '" + m.name + "': watchdog_resets '" + value + "' is not expected or findings");
                 }
@@ -379,19 +372,19 @@ void parse_mcus(const YAML::Node& root, const std::string& path, bool has_base, 
 void parse_parts(const YAML::Node& root, const std::string& path, BoardSpec& spec, std::set<std::string>& names) {
     // An empty section (`parts:` with nothing under it) is a board without parts.
     if (const YAML::Node parts = root["parts"]; parts && !parts.IsNull()) {
-        if (!parts.IsMap()) throw BadInput(where(path, parts) + ": 'parts' must be a map of part name to its settings");
+        if (!parts.IsMap()) throw BadInput(yaml_where(path, parts) + ": 'parts' must be a map of part name to its settings");
         for (const auto& kv : parts) {
             PartDecl p;
             p.name = kv.first.Scalar();
-            p.location = where(path, kv.first);
+            p.location = yaml_where(path, kv.first);
             check_name(p.name, p.location, "part", names);
             if (!kv.second.IsMap()) throw BadInput(p.location + ": part '" + p.name + "' must be a map with a type");
             for (const auto& field : kv.second) {
                 const std::string key = field.first.Scalar();
                 if (key == "type") {
-                    p.type = scalar(field.second, path, "type");
+                    p.type = yaml_scalar(field.second, path, "type");
                 } else {
-                    p.params.push_back({key, scalar(field.second, path, "parameter " + key), where(path, field.first)});
+                    p.params.push_back({key, yaml_scalar(field.second, path, "parameter " + key), yaml_where(path, field.first)});
                 }
             }
             if (p.type.empty()) throw BadInput(p.location + ": part '" + p.name + "': missing 'type'");
@@ -403,12 +396,12 @@ void parse_parts(const YAML::Node& root, const std::string& path, BoardSpec& spe
 
 void parse_nets(const YAML::Node& root, const std::string& path, BoardSpec& spec) {
     if (const YAML::Node nets = root["nets"]; nets && !nets.IsNull()) {
-        if (!nets.IsMap()) throw BadInput(where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
+        if (!nets.IsMap()) throw BadInput(yaml_where(path, nets) + ": 'nets' must be a map of net name to its endpoints");
         std::set<std::string> net_names;
         for (const auto& kv : nets) {
             NetDecl n;
             n.name = kv.first.Scalar();
-            n.location = where(path, kv.first);
+            n.location = yaml_where(path, kv.first);
             check_name(n.name, n.location, "net", net_names);
             if (!kv.second.IsSequence() || kv.second.size() < 2) {
                 throw BadInput(n.location + ": net '" + n.name + "' must list at least two endpoints, e.g. [uno.PD2, x_driver.step]");
@@ -424,19 +417,19 @@ void parse_nets(const YAML::Node& root, const std::string& path, BoardSpec& spec
 
 void parse_serial(const YAML::Node& root, const std::string& path, BoardSpec& spec, std::set<std::string>& names) {
     if (const YAML::Node serial = root["serial"]; serial && !serial.IsNull()) {
-        if (!serial.IsMap()) throw BadInput(where(path, serial) + ": 'serial' must be a map of port name to its settings");
+        if (!serial.IsMap()) throw BadInput(yaml_where(path, serial) + ": 'serial' must be a map of port name to its settings");
         for (const auto& kv : serial) {
             SerialDecl s;
             s.name = kv.first.Scalar();
-            s.location = where(path, kv.first);
+            s.location = yaml_where(path, kv.first);
             check_name(s.name, s.location, "serial port", names);
             if (!kv.second.IsMap()) {
-                throw BadInput(where(path, kv.second) + ": serial port '" + s.name + "' must be a map {mcu, usart, flow, ...}");
+                throw BadInput(yaml_where(path, kv.second) + ": serial port '" + s.name + "' must be a map {mcu, usart, flow, ...}");
             }
             for (const auto& field : kv.second) {
                 const std::string key = field.first.Scalar();
-                const std::string loc = where(path, field.first);
-                const std::string value = scalar(field.second, path, key);
+                const std::string loc = yaml_where(path, field.first);
+                const std::string value = yaml_scalar(field.second, path, key);
                 if (key == "mcu") {
                     s.mcu = value;
                 } else if (key == "usart") {
@@ -479,12 +472,12 @@ void parse_serial(const YAML::Node& root, const std::string& path, BoardSpec& sp
 
 void parse_labels(const YAML::Node& root, const std::string& path, BoardSpec& spec) {
     if (const YAML::Node labels = root["labels"]; labels && !labels.IsNull()) {
-        if (!labels.IsMap()) throw BadInput(where(path, labels) + ": 'labels' must be a map of name to endpoint");
+        if (!labels.IsMap()) throw BadInput(yaml_where(path, labels) + ": 'labels' must be a map of name to endpoint");
         std::set<std::string> label_names;
         for (const auto& kv : labels) {
             LabelDecl l;
             l.name = kv.first.Scalar();
-            l.location = where(path, kv.first);
+            l.location = yaml_where(path, kv.first);
             check_name(l.name, l.location, "label", label_names);
             l.endpoint = parse_endpoint(kv.second, path);
             spec.labels.push_back(std::move(l));

@@ -70,4 +70,9 @@ YAML::Node load_yaml(const std::string& text, const std::string& path) {
 
 void check_unique_keys(const YAML::Node& node, const std::string& path) { Walk(path).visit(node); }
 
+std::string yaml_scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
+    if (!node.IsScalar()) throw BadInput(yaml_where(path, node) + ": " + what + " must be a single value");
+    return node.Scalar();
+}
+
 }  // namespace avrbench

@@ -33,4 +33,7 @@ void check_unique_keys(const YAML::Node& node, const std::string& path);
 // "path:line" of a node.
 std::string yaml_where(const std::string& path, const YAML::Node& node);
 
+// A node's single value, or BadInput "path:line: <what> must be a single value".
+std::string yaml_scalar(const YAML::Node& node, const std::string& path, const std::string& what);
+
 }  // namespace avrbench

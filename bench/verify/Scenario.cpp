@@ -27,13 +27,6 @@ namespace fs = std::filesystem;
 namespace avrbench {
 namespace {
 
-std::string where(const std::string& path, const YAML::Node& node) { return yaml_where(path, node); }
-
-std::string scalar(const YAML::Node& node, const std::string& path, const std::string& what) {
-    if (!node.IsScalar()) throw BadInput(where(path, node) + ": " + what + " must be a single value");
-    return node.Scalar();
-}
-
 std::string resolve(const std::string& scenario_path, const std::string& relative) {
     if (relative.empty() || fs::path(relative).is_absolute()) return relative;
     return (fs::path(scenario_path).parent_path() / relative).lexically_normal().string();
@@ -79,23 +72,23 @@ struct Item {
                 std::string keys;
                 for (const auto& k : required) keys += (keys.empty() ? "" : ", ") + k;
                 for (const auto& k : optional) keys += (keys.empty() ? "" : ", ") + k;
-                throw BadInput(where(path, kv.first) + ": '" + kind + "' has no key '" + key + "' (keys: " + keys + ")");
+                throw BadInput(yaml_where(path, kv.first) + ": '" + kind + "' has no key '" + key + "' (keys: " + keys + ")");
             }
-            if (!kv.second.IsScalar()) throw BadInput(where(path, kv.second) + ": " + key + " must be a single value");
+            if (!kv.second.IsScalar()) throw BadInput(yaml_where(path, kv.second) + ": " + key + " must be a single value");
         }
         for (const auto& k : required) {
             if (!value[k]) throw BadInput(location + ": '" + kind + "' needs '" + k + "'");
         }
     }
     std::string get(const std::string& key) const { return value[key].Scalar(); }
-    std::string at(const std::string& key) const { return where(path, value[key]); }
+    std::string at(const std::string& key) const { return yaml_where(path, value[key]); }
     bool has(const std::string& key) const { return value.IsMap() && value[key]; }
 };
 
 Item read_item(const YAML::Node& node, const std::string& path, const std::set<std::string>& kinds, const char* what) {
-    if (!node.IsMap() || node.size() != 1) throw BadInput(where(path, node) + ": each " + what + " is one 'kind: value' entry");
+    if (!node.IsMap() || node.size() != 1) throw BadInput(yaml_where(path, node) + ": each " + what + " is one 'kind: value' entry");
     const auto kv = *node.begin();
-    Item item{scalar(kv.first, path, what), where(path, kv.first), kv.second, path};
+    Item item{yaml_scalar(kv.first, path, what), yaml_where(path, kv.first), kv.second, path};
     if (kinds.count(item.kind) == 0) {
         std::string list;
         for (const auto& k : kinds) list += (list.empty() ? "" : ", ") + k;
@@ -315,11 +308,11 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
             std::set<std::string> known;
             for (const FindingKind kind : FindingKind::all()) known.insert(kind.name());
             for (const auto& entry : item.value) {
-                const std::string kind = scalar(entry, item.path, "findings entry");
+                const std::string kind = yaml_scalar(entry, item.path, "findings entry");
                 if (known.count(kind) == 0) {
                     std::string list;
                     for (const auto& n : known) list += (list.empty() ? "" : ", ") + n;
-                    throw BadInput(where(item.path, entry) + ": unknown finding kind '" + kind + "' (known: " + list + ")");
+                    throw BadInput(yaml_where(item.path, entry) + ": unknown finding kind '" + kind + "' (known: " + list + ")");
                 }
                 kinds.kinds.push_back(kind);
             }
@@ -382,7 +375,7 @@ BoardSpec scenario_board(ScenarioSpec& spec, const std::string& path, const std:
         board = load_board_file(spec.board_path);
     } catch (const BadInput& e) {
         // A missing board names the scenario line that points at it.
-        if (!fs::is_regular_file(spec.board_path, ec)) throw BadInput(where(path, node) + ": board " + e.what());
+        if (!fs::is_regular_file(spec.board_path, ec)) throw BadInput(yaml_where(path, node) + ": board " + e.what());
         throw;
     }
     return board;
@@ -396,55 +389,55 @@ void scenario_firmware(ScenarioSpec& spec, const BoardSpec& board, const YAML::N
         throw BadInput(path + ":1: the scenario needs 'firmware: {mcu: name-or-path}'");
     }
     for (const auto& kv : root["firmware"]) {
-        const std::string mcu = scalar(kv.first, path, "MCU name");
-        if (board.find_mcu(mcu) == nullptr) throw BadInput(where(path, kv.first) + ": the board has no MCU '" + mcu + "'");
-        std::string value = scalar(kv.second, path, "firmware");
+        const std::string mcu = yaml_scalar(kv.first, path, "MCU name");
+        if (board.find_mcu(mcu) == nullptr) throw BadInput(yaml_where(path, kv.first) + ": the board has no MCU '" + mcu + "'");
+        std::string value = yaml_scalar(kv.second, path, "firmware");
         const bool bare_name = value.find('/') == std::string::npos && value.find(".elf") == std::string::npos;
         value = bare_name ? (fs::path(firmware_dir) / (value + ".elf")).string() : resolve(path, value);
         // A missing file, a device, a FIFO or a folder: one line saying which
         // (ElfImage reads the file itself, with its own bounds).
-        check_input_file(value, where(path, kv.second) + ": firmware", std::numeric_limits<std::uint64_t>::max());
+        check_input_file(value, yaml_where(path, kv.second) + ": firmware", std::numeric_limits<std::uint64_t>::max());
         spec.firmware[mcu] = value;
     }
     for (const auto& m : board.mcus) {
         if (spec.firmware.count(m.name) == 0 && m.firmware.empty()) {
-            throw BadInput(where(path, root["firmware"]) + ": MCU '" + m.name + "' of the board has no firmware");
+            throw BadInput(yaml_where(path, root["firmware"]) + ": MCU '" + m.name + "' of the board has no firmware");
         }
     }
 }
 
 // `host: {family, line_timeout, error_pattern}`.
 void scenario_host(ScenarioSpec& spec, const YAML::Node& host, const BoardNames& names, const std::string& path) {
-    if (!host.IsMap()) throw BadInput(where(path, host) + ": 'host' is a map {family, line_timeout, error_pattern}");
-    names.check_serial("host", where(path, host));
+    if (!host.IsMap()) throw BadInput(yaml_where(path, host) + ": 'host' is a map {family, line_timeout, error_pattern}");
+    names.check_serial("host", yaml_where(path, host));
     for (const auto& kv : host) {
-        const std::string key = scalar(kv.first, path, "host key");
-        const std::string value = scalar(kv.second, path, key);
+        const std::string key = yaml_scalar(kv.first, path, "host key");
+        const std::string value = yaml_scalar(kv.second, path, key);
         if (key == "family") {
-            (void)parse_firmware_family(value, where(path, kv.second));
+            (void)parse_firmware_family(value, yaml_where(path, kv.second));
             spec.host_family = value;
         } else if (key == "error_pattern") {
-            (void)TextPattern(value, where(path, kv.second) + ": error_pattern");
+            (void)TextPattern(value, yaml_where(path, kv.second) + ": error_pattern");
             spec.host_error_pattern = value;
         } else if (key == "line_timeout") {
-            spec.host_line_timeout_ps = parse_duration_ps(value, where(path, kv.second) + ": line_timeout");
-            if (*spec.host_line_timeout_ps == 0) throw BadInput(where(path, kv.second) + ": line_timeout must be longer than 0");
+            spec.host_line_timeout_ps = parse_duration_ps(value, yaml_where(path, kv.second) + ": line_timeout");
+            if (*spec.host_line_timeout_ps == 0) throw BadInput(yaml_where(path, kv.second) + ": line_timeout must be longer than 0");
         } else {
-            throw BadInput(where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout, error_pattern)");
+            throw BadInput(yaml_where(path, kv.first) + ": unknown host key '" + key + "' (family, line_timeout, error_pattern)");
         }
     }
 }
 
 // One entry of `tolerances:` {signals, rule, cycles, relative, window, band}.
 ChannelRule parse_tolerance(const YAML::Node& t, const std::string& path) {
-    const std::string loc = where(path, t);
+    const std::string loc = yaml_where(path, t);
     if (!t.IsMap()) throw BadInput(loc + ": a tolerance is a map {signals, rule, ...}");
     ChannelRule rule;
     bool has_signals = false;
     for (const auto& kv : t) {
         const std::string key = kv.first.Scalar();
-        const std::string value = scalar(kv.second, path, key);
-        const std::string at = where(path, kv.second) + ": " + key;
+        const std::string value = yaml_scalar(kv.second, path, key);
+        const std::string at = yaml_where(path, kv.second) + ": " + key;
         auto non_negative = [&](double v) {
             if (v < 0) throw BadInput(at + ": '" + value + "' must not be negative");
             return v;
@@ -453,7 +446,7 @@ ChannelRule parse_tolerance(const YAML::Node& t, const std::string& path) {
             rule.pattern = value;
             has_signals = true;
         } else if (key == "rule") {
-            rule.kind = parse_rule(value, where(path, kv.second));
+            rule.kind = parse_rule(value, yaml_where(path, kv.second));
         } else if (key == "cycles") {
             rule.tolerance_cycles = static_cast<double>(parse_integer(value, at, 0, kMaxCount));
         } else if (key == "relative") {
@@ -464,7 +457,7 @@ ChannelRule parse_tolerance(const YAML::Node& t, const std::string& path) {
         } else if (key == "band") {
             rule.band = non_negative(parse_quantity(value, Dimension::Dimensionless, at));
         } else {
-            throw BadInput(where(path, kv.first) + ": unknown tolerance key '" + key +
+            throw BadInput(yaml_where(path, kv.first) + ": unknown tolerance key '" + key +
                            "' (signals, rule, cycles, relative, window, band)");
         }
     }
@@ -479,28 +472,28 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
                                                 "steps",  "expect",      "golden", "golden_signals", "tolerances"};
     for (const auto& kv : root) {
         if (kKeys.count(kv.first.Scalar()) == 0) {
-            throw BadInput(where(path, kv.first) + ": unknown key '" + kv.first.Scalar() +
+            throw BadInput(yaml_where(path, kv.first) + ": unknown key '" + kv.first.Scalar() +
                            "' (expected name, description, board, firmware, time_limit, host, steps, expect, golden, "
                            "golden_signals, tolerances)");
         }
     }
     ScenarioSpec spec;
     spec.path = path;
-    spec.name = root["name"] ? checked_name(scalar(root["name"], path, "name"), where(path, root["name"]))
+    spec.name = root["name"] ? checked_name(yaml_scalar(root["name"], path, "name"), yaml_where(path, root["name"]))
                              : checked_name(fs::path(path).stem().string(), path + ":1");
-    if (root["description"]) spec.description = scalar(root["description"], path, "description");
+    if (root["description"]) spec.description = yaml_scalar(root["description"], path, "description");
     if (!root["board"]) throw BadInput(path + ":1: the scenario needs 'board'");
-    const std::string board_value = scalar(root["board"], path, "board");
+    const std::string board_value = yaml_scalar(root["board"], path, "board");
     const BoardSpec board = scenario_board(spec, path, board_value, root["board"]);
     const BoardNames names(board);
     scenario_firmware(spec, board, root, path, firmware_dir);
     if (root["time_limit"]) {
-        spec.time_limit_ps = parse_duration_ps(scalar(root["time_limit"], path, "time_limit"), where(path, root["time_limit"]) + ": time_limit");
+        spec.time_limit_ps = parse_duration_ps(yaml_scalar(root["time_limit"], path, "time_limit"), yaml_where(path, root["time_limit"]) + ": time_limit");
     }
     if (const YAML::Node host = root["host"]) scenario_host(spec, host, names, path);
     auto sequence = [&](const char* key) {
         const YAML::Node node = root[key];
-        if (node && !node.IsSequence() && !node.IsNull()) throw BadInput(where(path, node) + ": '" + key + "' is a list");
+        if (node && !node.IsSequence() && !node.IsNull()) throw BadInput(yaml_where(path, node) + ": '" + key + "' is a list");
         return node;
     };
     static const std::set<std::string> kSteps = {"wait_for_text", "send", "send_file", "wait_idle", "wait_pin",
@@ -512,9 +505,9 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
     if (const YAML::Node expect = sequence("expect")) {
         for (const auto& node : expect) spec.expectations.push_back(parse_expectation(read_item(node, path, kExpect, "expectation"), names));
     }
-    if (root["golden"]) spec.golden_path = resolve(path, scalar(root["golden"], path, "golden"));
+    if (root["golden"]) spec.golden_path = resolve(path, yaml_scalar(root["golden"], path, "golden"));
     if (const YAML::Node globs = sequence("golden_signals")) {
-        for (const auto& g : globs) spec.golden_signals.push_back(scalar(g, path, "golden_signals entry"));
+        for (const auto& g : globs) spec.golden_signals.push_back(yaml_scalar(g, path, "golden_signals entry"));
     }
     if (const YAML::Node tolerances = sequence("tolerances")) {
         for (const auto& t : tolerances) spec.tolerances.push_back(parse_tolerance(t, path));
