@@ -94,6 +94,6 @@ thread_local std::uint64_t recorded_findings = 0;
 }  // namespace
 
 std::uint64_t findings_recorded() { return recorded_findings; }
-void count_finding_recorded() { ++recorded_findings; }
+void finding_log_detail::count_recorded() { ++recorded_findings; }
 
 }  // namespace avrbench

@@ -78,7 +78,32 @@ std::vector<std::string> summarize_findings(const std::vector<Finding>& findings
 // net, a part, a host): a debugger's --break-at-finding compares it after
 // every instruction instead of asking each of them.
 std::uint64_t findings_recorded();
-// Called by whoever records a finding.
-void count_finding_recorded();
+
+namespace finding_log_detail {
+void count_recorded();
+}  // namespace finding_log_detail
+
+// Where an owner (an MCU, a net, a part, a host) keeps what it records:
+// each counted once, as it is recorded (findings_recorded). The only way a
+// finding is counted.
+template <typename T>
+class FindingLog {
+public:
+    // Returns its index, for revise().
+    std::size_t record(T item) {
+        items_.push_back(std::move(item));
+        finding_log_detail::count_recorded();
+        return items_.size() - 1;
+    }
+    // A finding told when its fault began, its text rewritten as it grows.
+    T& revise(std::size_t index) { return items_.at(index); }
+    const std::vector<T>& all() const { return items_; }
+    const T& back() const { return items_.back(); }
+    std::size_t size() const { return items_.size(); }
+    bool empty() const { return items_.empty(); }
+
+private:
+    std::vector<T> items_;
+};
 
 }  // namespace avrbench

@@ -698,8 +698,7 @@ void Mcu::add_finding(FindingKind kind, std::uint32_t pc_bytes, std::string deta
     f.pc_bytes = pc_bytes;
     f.symbol = describe_pc(pc_bytes);
     f.detail = std::move(detail);
-    findings_.push_back(std::move(f));
-    count_finding_recorded();
+    findings_.record(std::move(f));
     if (halt) {
         halted_ = true;
         halt_reason_ = findings_.back().describe();

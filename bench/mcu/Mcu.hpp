@@ -212,7 +212,7 @@ public:
     // The ADC: analog sources per channel, pin -> channel (periph/adc/Adc.hpp).
     Adc& adc() { return *adc_; }
 
-    const std::vector<Finding>& findings() const { return findings_; }
+    const std::vector<Finding>& findings() const { return findings_.all(); }
     // The I/O register (data address) holding PUD, the pull-up disable bit
     // (MCUCR or SFIOR by family); 0 for a part without one.
     std::uint16_t pud_register() const;
@@ -347,7 +347,7 @@ private:
     PeerSync* peer_sync_ = nullptr;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
-    std::vector<Finding> findings_;
+    FindingLog<Finding> findings_;
 
     // Oracle thresholds, precomputed so the hot loop only compares.
     std::uint32_t code_end_bytes_ = 0;        // first flash byte past .text

@@ -49,31 +49,31 @@ std::vector<ParamSpec> Axis::param_specs() {
 Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
     : Part(std::move(name), clock), rotary_(params.text("kind") == "rotary") {
     if (rotary_) {
-        if (!params.has("steps_per_rev")) throw BadInput("part '" + this->name() + "': a rotary axis needs steps_per_rev");
+        if (!params.has("steps_per_rev")) throw part_error(this->name(), "a rotary axis needs steps_per_rev");
         const double steps_per_rev = params.quantity("steps_per_rev");
         // A 1.8 deg motor at 256 microsteps makes 51200 steps/rev; 1e7 covers any gearing.
         if (!(steps_per_rev > 0 && steps_per_rev <= 1e7)) {
-            throw BadInput("part '" + this->name() + "': steps_per_rev must be above 0 and at most 1e7");
+            throw part_error(this->name(), "steps_per_rev must be above 0 and at most 1e7");
         }
         steps_per_unit_ = steps_per_rev;
     } else {
-        if (!params.has("steps_per_mm")) throw BadInput("part '" + this->name() + "': a linear axis needs steps_per_mm");
-        if (!params.has("travel")) throw BadInput("part '" + this->name() + "': a linear axis needs travel");
+        if (!params.has("steps_per_mm")) throw part_error(this->name(), "a linear axis needs steps_per_mm");
+        if (!params.has("travel")) throw part_error(this->name(), "a linear axis needs travel");
         // Ranges real machines span with room: lead screws at 256 microsteps
         // reach a few thousand steps/mm; no bench axis is longer than 100 m.
         const double steps_per_mm = params.quantity("steps_per_mm");
         if (!(steps_per_mm >= 1e-3 && steps_per_mm <= 1e6)) {
-            throw BadInput("part '" + this->name() + "': steps_per_mm must be from 0.001 to 1e6");
+            throw part_error(this->name(), "steps_per_mm must be from 0.001 to 1e6");
         }
         if (!(params.quantity("travel") > 0 && params.quantity("travel") <= 100)) {
-            throw BadInput("part '" + this->name() + "': travel must be longer than 0 and at most 100 m");
+            throw part_error(this->name(), "travel must be longer than 0 and at most 100 m");
         }
         steps_per_unit_ = steps_per_mm * 1e3;
         travel_m_ = params.quantity("travel");
         start_m_ = params.quantity("start_position");
         trace_deadband_m_ = params.quantity("trace_deadband");
         if (start_m_ < 0 || start_m_ > travel_m_) {
-            throw BadInput("part '" + this->name() + "': start_position outside 0..travel");
+            throw part_error(this->name(), "start_position outside 0..travel");
         }
         provide_port<Carriage>("carriage", *this, "the carriage position limit switches watch");
     }

@@ -18,7 +18,7 @@ namespace avrbench {
 
 class Axis final : public Part, public Carriage {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kAxisOutOfTravel;  // axis-out-of-travel
     static std::vector<ParamSpec> param_specs();
 

@@ -54,12 +54,12 @@ DeltaRobot::DeltaRobot(std::string name, Mcu& clock, const ParamValues& params) 
     geometry_.forearm_mm = params.quantity("forearm") * 1e3;
     if (!(geometry_.base_side_mm > geometry_.effector_side_mm) || !(geometry_.upper_arm_mm > 0) ||
         !(geometry_.forearm_mm > geometry_.upper_arm_mm)) {
-        throw BadInput("part '" + this->name() + "': needs base_side > effector_side and forearm > upper_arm > 0");
+        throw part_error(this->name(), "needs base_side > effector_side and forearm > upper_arm > 0");
     }
     for (int k = 0; k < 3; ++k) offset_deg_[static_cast<std::size_t>(k)] = params.quantity("offset" + std::to_string(k + 1)) * kRadToDeg;
     check_moves_ = params.text("move_commands") == "base_frame";
     const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    if (!(interval > 0)) throw part_error(this->name(), "sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     for (int k = 0; k < 3; ++k) {
         const auto arm = static_cast<std::size_t>(k);

@@ -23,7 +23,7 @@ namespace avrbench {
 
 class DeltaRobot final : public Part, public Effector, public AcceptedMoves {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kTargetOutOfReach;  // target-out-of-reach
     static std::vector<ParamSpec> param_specs();
 

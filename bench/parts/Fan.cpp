@@ -32,7 +32,7 @@ Fan::Fan(std::string name, Mcu& clock, const ParamValues& params) : Part(std::mo
     tau_s_ = params.quantity("spin_time_constant");
     const double interval = params.quantity("sample_interval");
     if (tau_s_ < 0 || !(interval > 0)) {
-        throw BadInput("part '" + this->name() + "': spin_time_constant and sample_interval must be positive");
+        throw part_error(this->name(), "spin_time_constant and sample_interval must be positive");
     }
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     pwm_pin_ = add_pin("pwm", TerminalRole::Input);

@@ -46,7 +46,7 @@ HallEndstop::HallEndstop(std::string name, Mcu& clock, const ParamValues& params
       release_G_(params.quantity("release_G")),
       supply_v_(params.quantity("supply")),
       sensitivity_v_per_G_(params.quantity("sensitivity_mV_per_G") * 1e-3) {
-    if (!(release_G_ < operate_G_)) throw BadInput("part '" + this->name() + "': release_G must be below operate_G");
+    if (!(release_G_ < operate_G_)) throw part_error(this->name(), "release_G must be below operate_G");
     out_pin_ = add_pin("out", TerminalRole::Output);
     provide_analog("analog", [this](Cycle) { return analog_volts_now(); }, "the linear output, for an ADC pin");
     sig_field_ = add_signal({"field_G", true, "G", "", ""}, 0);
@@ -57,7 +57,7 @@ HallEndstop::HallEndstop(std::string name, Mcu& clock, const ParamValues& params
 void HallEndstop::connect_axis(Carriage& axis) {
     axis_ = &axis;
     if (sensor_mm_ < 0 || sensor_mm_ > axis.travel_mm()) {
-        throw BadInput("part '" + name() + "': position must lie within the axis' travel (0.." +
+        throw part_error(name(), "position must lie within the axis' travel (0.." +
                        std::to_string(axis.travel_mm()) + " mm)");
     }
     axis.on_move([this](double) { update(); });

@@ -51,20 +51,20 @@ const std::map<std::string, std::map<std::string, std::string>>& Heater::presets
 Heater::Heater(std::string name, Mcu& clock, const ParamValues& params)
     : Part(std::move(name), clock), node_(params.text("node")) {
     if (!params.has("supply") || !params.has("resistance")) {
-        throw BadInput("part '" + this->name() + "': a custom heater needs supply and resistance");
+        throw part_error(this->name(), "a custom heater needs supply and resistance");
     }
     const double v = params.quantity("supply");
     const double r = params.quantity("resistance");
     const double rs = params.quantity("series_resistance");
-    if (!(r > 0)) throw BadInput("part '" + this->name() + "': resistance must be positive");
-    if (!(rs >= 0)) throw BadInput("part '" + this->name() + "': the switch resistance must not be negative");
-    if (!(v >= 0)) throw BadInput("part '" + this->name() + "': the supply voltage must not be negative");
+    if (!(r > 0)) throw part_error(this->name(), "resistance must be positive");
+    if (!(rs >= 0)) throw part_error(this->name(), "the switch resistance must not be negative");
+    if (!(v >= 0)) throw part_error(this->name(), "the supply voltage must not be negative");
     // P = I^2 R with I = V / (R + R_series).
     power_on_W_ = v * v * r / ((r + rs) * (r + rs));
     gate_active_level_ = params.text("gate_active") == "high";
     gate_pin_ = add_pin("gate", TerminalRole::Input);
     const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    if (!(interval > 0)) throw part_error(this->name(), "sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     require_port<ThermalBody>("body", true, "the thermal_plant it heats",
                               [this](ThermalBody& body, Part& plant) { connect_body(body, plant); });
@@ -75,7 +75,7 @@ void Heater::connect_body(ThermalBody& body, Part& plant) {
     try {
         source_ = plant_->add_heat_source(node_, power_on_W_);
     } catch (const BadInput& e) {
-        throw BadInput("part '" + name() + "': " + e.what());
+        throw part_error(name(), e.what());
     }
     sig_on_ = add_signal({"on", false, "", "heater-on", plant.name()}, 0);
     sig_duty_ = add_signal({"duty", true, "", "heater-duty", plant.name()}, 0);

@@ -48,7 +48,7 @@ std::pair<int, int> output_pair(const std::string& text, const std::string& part
     int plus = 0, minus = 0;
     char comma = 0;
     if (!(in >> plus >> comma >> minus) || comma != ',' || !(in >> std::ws).eof()) {
-        throw BadInput("part '" + part + "': " + param + " '" + text + "' is not two outputs 'plus,minus' (e.g. 1,2)");
+        throw part_error(part, param + " '" + text + "' is not two outputs 'plus,minus' (e.g. 1,2)");
     }
     return {plus, minus};
 }
@@ -58,7 +58,7 @@ HybridStepperModel::Params model_params(const ParamValues& p, const std::string&
     const double step = p.quantity("step_angle");
     const double teeth = kTwoPi / (4 * step);
     if (step <= 0 || std::fabs(teeth - std::round(teeth)) > 1e-6) {
-        throw BadInput("part '" + name + "': step_angle must be 90 degrees divided by a whole number of rotor teeth "
+        throw part_error(name, "step_angle must be 90 degrees divided by a whole number of rotor teeth "
                        "(1.8deg: 50 teeth, 0.9deg: 100)");
     }
     m.rotor_teeth = static_cast<int>(std::lround(teeth));
@@ -73,10 +73,10 @@ HybridStepperModel::Params model_params(const ParamValues& p, const std::string&
     m.max_step_s = p.quantity("max_step");
     m.chopper_tau_s = p.quantity("chopper_tau");
     if (m.resistance_ohm <= 0 || m.inductance_h <= 0 || m.torque_constant_nm_per_a <= 0 || m.inertia_kg_m2 <= 0) {
-        throw BadInput("part '" + name + "': resistance, inductance, torque_constant and inertia must be positive");
+        throw part_error(name, "resistance, inductance, torque_constant and inertia must be positive");
     }
     if (m.max_step_s <= 0 || m.max_step_s > 1e-3 || m.chopper_tau_s <= 0) {
-        throw BadInput("part '" + name + "': max_step must be in (0, 1ms], chopper_tau positive");
+        throw part_error(name, "max_step must be in (0, 1ms], chopper_tau positive");
     }
     return m;
 }
@@ -191,7 +191,7 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
           for (const char* needed : {"resistance", "inductance", "torque_constant", "detent_torque", "rotor_inertia",
                                      "viscous_damping", "coulomb_friction"}) {
               if (!params.has(needed)) {
-                  throw BadInput("part '" + this->name() + "': give " + needed + " (or a preset that has it)");
+                  throw part_error(this->name(), "give " + std::string(needed) + " (or a preset that has it)");
               }
           }
           return model_params(params, this->name());
@@ -199,7 +199,7 @@ HybridStepper::HybridStepper(std::string name, Mcu& clock, const ParamValues& pa
     seconds_per_cycle_ = 1.0 / clock.frequency_hz();
     auto cycles = [&](const char* param) {
         const double s = params.quantity(param);
-        if (s <= 0) throw BadInput("part '" + this->name() + "': " + param + " must be positive");
+        if (s <= 0) throw part_error(this->name(), std::string(param) + " must be positive");
         return static_cast<Cycle>(std::max(1.0, std::round(s * clock.frequency_hz())));
     };
     sample_cycles_ = cycles("sample_period");
@@ -263,7 +263,7 @@ void HybridStepper::listen(DriveSource& source) {
 void HybridStepper::connect_windings(DriveSource& source) {
     for (const WindingTap& tap : taps_) {
         const std::string problem = source.tap_problem(tap);
-        if (!problem.empty()) throw BadInput("part '" + name() + "': " + problem);
+        if (!problem.empty()) throw part_error(name(), problem);
     }
     source_ = &source;
     angle_from_source_ = source.commands_angle();

@@ -33,7 +33,7 @@ namespace avrbench {
 
 class HybridStepper final : public Part, public ShaftMotion {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kMotorStall;  // motor-stall
     static std::vector<ParamSpec> param_specs(bool unipolar);
     static const std::map<std::string, std::map<std::string, std::string>>& presets();

@@ -38,7 +38,7 @@ L293D::L293D(std::string name, Mcu& clock, const ParamValues& params)
       clamp_v_(params.quantity("v_clamp")),
       r_out_ohm_(params.quantity("r_out")) {
     if (supply_v_ < 4.5 || supply_v_ > 36) {
-        throw BadInput("part '" + this->name() + "': supply must be within the L293D's 4.5..36 V");
+        throw part_error(this->name(), "supply must be within the L293D's 4.5..36 V");
     }
     en_pins_[0] = add_pin("en12", TerminalRole::Input);
     en_pins_[1] = add_pin("en34", TerminalRole::Input);

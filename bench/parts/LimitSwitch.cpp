@@ -71,7 +71,7 @@ void LimitSwitch::connect_axis(Carriage& axis) {
     const double travel_m = axis_->travel_mm() * 1e-3;
     trip_m_ = position_given_ ? position_m_ : (min_side_ ? 0.0 : travel_m);
     if (trip_m_ < 0 || trip_m_ > travel_m) {
-        throw BadInput("part '" + name() + "': position must lie within the axis' travel (0.." +
+        throw part_error(name(), "position must lie within the axis' travel (0.." +
                        std::to_string(axis_->travel_mm()) + " mm)");
     }
     axis_->on_move([this](double position_m) { on_axis_move(position_m); });

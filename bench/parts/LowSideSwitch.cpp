@@ -34,7 +34,7 @@ LowSideSwitch::LowSideSwitch(std::string name, Mcu& clock, const ParamValues& pa
       r_on_(params.quantity("r_on")),
       v_flyback_(params.quantity("v_flyback")) {
     const long long n = params.integer("channels");
-    if (n < 1 || n > 8) throw BadInput("part '" + this->name() + "': channels must be 1..8");
+    if (n < 1 || n > 8) throw part_error(this->name(), "channels must be 1..8");
     for (long long i = 1; i <= n; ++i) {
         in_pins_.push_back(add_pin("in" + std::to_string(i), TerminalRole::Input));
         sig_on_.push_back(add_signal("on" + std::to_string(i), false));

@@ -109,7 +109,7 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
         if (params.has("soft_min_" + a)) soft_limits_mm_[k][0] = params.quantity("soft_min_" + a) * 1e3;
         if (params.has("soft_max_" + a)) soft_limits_mm_[k][1] = params.quantity("soft_max_" + a) * 1e3;
         if (soft_limits_mm_[k][0] && soft_limits_mm_[k][1] && !(*soft_limits_mm_[k][0] < *soft_limits_mm_[k][1])) {
-            throw BadInput("part '" + this->name() + "': soft_min_" + a + " must be below soft_max_" + a);
+            throw part_error(this->name(), "soft_min_" + a + " must be below soft_max_" + a);
         }
         require_port<Carriage>(a, false, "the " + std::string(1, kAxisLetters[k]) + " axis' carriage",
                                [this, k](Carriage& c) {
@@ -130,14 +130,14 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
 void MotionOracle::start() {
     const bool any_carriage = carriages_[0] != nullptr || carriages_[1] != nullptr || carriages_[2] != nullptr;
     if (effector_ != nullptr && any_carriage) {
-        throw BadInput("part '" + name() + "': join either the effector or the x, y, z carriages, not both");
+        throw part_error(name(), "join either the effector or the x, y, z carriages, not both");
     }
     if (effector_ == nullptr && !any_carriage) {
-        throw BadInput("part '" + name() + "': join at least one of ports x, y, z to a linear axis' carriage, or effector to a mechanism's");
+        throw part_error(name(), "join at least one of ports x, y, z to a linear axis' carriage, or effector to a mechanism's");
     }
     // An effector has no step to be exact to: the board says how close is there.
     if (effector_ != nullptr && !end_tolerance_mm_) {
-        throw BadInput("part '" + name() + "': with an effector, give end_tolerance (how close the mechanism gets to a target)");
+        throw part_error(name(), "with an effector, give end_tolerance (how close the mechanism gets to a target)");
     }
     const Eigen::Vector3d power_up = tool_position();
     for (std::size_t k = 0; k < 3; ++k) {

@@ -127,9 +127,7 @@ std::size_t Part::report(FindingKind kind, std::string detail) {
     f.clock_hz = clock_->frequency_hz();
     f.has_pc = false;
     f.detail = std::move(detail);
-    findings_.push_back(std::move(f));
-    count_finding_recorded();
-    return findings_.size() - 1;
+    return findings_.record(std::move(f));
 }
 
 }  // namespace avrbench

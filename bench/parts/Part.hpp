@@ -22,6 +22,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/Errors.hpp"
 #include "core/Finding.hpp"
 #include "mcu/Mcu.hpp"
 #include "parts/PortType.hpp"
@@ -30,6 +31,11 @@
 namespace avrbench {
 
 class Part;
+
+// A board file's mistake about one part: "part '<name>': <what>".
+inline BadInput part_error(const std::string& part, const std::string& what) {
+    return BadInput("part '" + part + "': " + what);
+}
 
 // One pin of a part. An Input only listens; an Output drives its net
 // push-pull (set_level), through a pull resistor (set_weak), or not at all
@@ -120,7 +126,7 @@ public:
     // After all nets are connected: drive initial outputs, arm timers.
     virtual void start() {}
 
-    const std::vector<Finding>& findings() const { return findings_; }
+    const std::vector<Finding>& findings() const { return findings_.all(); }
     // Findings about what is still under way, as they stand if the run ends
     // now (a move the machine has not left yet): not recorded, asked again
     // at each look (Board::findings()).
@@ -234,7 +240,7 @@ protected:
     std::size_t report(FindingKind kind, std::string detail);
     // A finding recorded when a fault began, told in full once it is over
     // (a path deviation's worst distance): only its text changes.
-    void revise_finding(std::size_t index, std::string detail) { findings_.at(index).detail = std::move(detail); }
+    void revise_finding(std::size_t index, std::string detail) { findings_.revise(index).detail = std::move(detail); }
     void note_activity() {
         for (auto& fn : activity_listeners_) fn();
     }
@@ -250,7 +256,7 @@ private:
     std::vector<void*> offered_;                               // per port; the interface a provider offers
     std::vector<std::function<void(void*, Part&)>> connect_;  // per port; a requirer's callback
     std::vector<std::function<double(Cycle)>> analog_sources_;  // per port; empty but for Analog providers
-    std::vector<Finding> findings_;
+    FindingLog<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;
     std::vector<Readout> readouts_;
     std::vector<double> signal_values_;

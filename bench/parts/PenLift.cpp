@@ -26,7 +26,7 @@ std::vector<ParamSpec> PenLift::param_specs() {
 PenLift::PenLift(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
     down_angle_deg_ = params.quantity("down_angle") * 180.0 / 3.14159265358979323846;
     const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    if (!(interval > 0)) throw part_error(this->name(), "sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     require_port<ServoHorn>("horn", true, "the pen servo's horn", [this](ServoHorn& horn) { servo_ = &horn; });
     require_port<Carriage>("x", true, "the X axis' carriage", [this](Carriage& x) { connect_carriage(x_, x); });

@@ -24,7 +24,7 @@ PullResistor::PullResistor(std::string name, Mcu& clock, const ParamValues& para
     : Part(std::move(name), clock), to_vcc_(params.text("to") == "vcc"), ohms_(params.quantity("resistance")) {
     // 100 Mohm: beyond that a "pull" is leakage, not a resistor anyone fits.
     if (!(ohms_ >= 0 && ohms_ <= 100e6)) {
-        throw BadInput("part '" + this->name() + "': resistance must be from 0 to 100 Mohm");
+        throw part_error(this->name(), "resistance must be from 0 to 100 Mohm");
     }
     pin_ = add_pin("pin", TerminalRole::Output);
 }

@@ -59,15 +59,15 @@ RcServo::RcServo(std::string name, Mcu& clock, const ParamValues& params)
         Point p{};
         char extra = 0;
         if (std::sscanf(item.c_str(), " %lf : %lf %c", &p.deg, &p.us, &extra) != 2) {
-            throw BadInput("part '" + this->name() + "': calibration: '" + item + "' is not degrees:microseconds");
+            throw part_error(this->name(), "calibration: '" + item + "' is not degrees:microseconds");
         }
         if (!table_.empty() && (p.deg <= table_.back().deg || p.us <= table_.back().us)) {
-            throw BadInput("part '" + this->name() + "': calibration: '" + item +
+            throw part_error(this->name(), "calibration: '" + item +
                            "' does not ascend in both degrees and microseconds");
         }
         table_.push_back(p);
     }
-    if (table_.size() < 2) throw BadInput("part '" + this->name() + "': calibration needs at least two points");
+    if (table_.size() < 2) throw part_error(this->name(), "calibration needs at least two points");
     const double initial = params.quantity("initial_angle") * kRadToDeg;
     from_deg_ = target_deg_ = std::clamp(initial, table_.front().deg, table_.back().deg);
     signal_pin_ = add_pin("signal", TerminalRole::Input);

@@ -17,7 +17,7 @@ namespace avrbench {
 
 class RcServo final : public Part, public ServoHorn {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kServoPulseOutOfRange;  // servo-pulse-out-of-range
     static std::vector<ParamSpec> param_specs();
 

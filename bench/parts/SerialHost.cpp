@@ -95,7 +95,7 @@ SerialHost::SerialHost(std::string name, Mcu& clock, const ParamValues& params)
     protocol_.rx_buffer_bytes = static_cast<unsigned>(params.integer("rx_buffer"));
     protocol_.line_timeout_s = params.quantity("line_timeout");
     if (protocol_.line_timeout_s != 0 && protocol_.line_timeout_s < kShortestLineTimeout_s) {
-        throw BadInput("part '" + this->name() + "': line_timeout must be 0 (the family's) or at least 100us: no firmware answers faster");
+        throw part_error(this->name(), "line_timeout must be 0 (the family's) or at least 100us: no firmware answers faster");
     }
     if (params.has("error_pattern")) {
         protocol_.error_pattern = params.text("error_pattern");
@@ -150,7 +150,7 @@ void SerialHost::start() {
 
 SerialLink& SerialHost::link() {
     if (usart_ != nullptr) return *usart_;
-    if (pin_link_ == nullptr) throw BadInput("part '" + name() + "': the board has not started (no link yet)");
+    if (pin_link_ == nullptr) throw part_error(name(), "the board has not started (no link yet)");
     return *pin_link_;
 }
 

@@ -34,7 +34,7 @@ namespace avrbench {
 
 class SerialHost final : public Part, public HostConnector {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kHostLineFraming;  // host-line-framing
     static std::vector<ParamSpec> param_specs();
 

@@ -42,11 +42,11 @@ SerialPeer::SerialPeer(std::string name, Mcu& clock, const ParamValues& params)
              .on_framing_error = [this](Cycle) { report(SerialPeer::kSerialFraming, "stop bit read 0 (framing error)"); },
              .on_edge = [this](double bits) { on_edge(bits); }}) {
     // 50 baud (teleprinters) to 2 Mbaud (the fastest USART setting at 16 MHz, U2X: §20.3.1).
-    if (!(baud_ >= 50 && baud_ <= 2e6)) throw BadInput("part '" + this->name() + "': baud must be from 50 to 2000000");
+    if (!(baud_ >= 50 && baud_ <= 2e6)) throw part_error(this->name(), "baud must be from 50 to 2000000");
     if (!(tolerance_bits_ > 0 && tolerance_bits_ < 0.5)) {
-        throw BadInput("part '" + this->name() + "': tolerance must be more than 0 and less than half a bit");
+        throw part_error(this->name(), "tolerance must be more than 0 and less than half a bit");
     }
-    if (!(send_at_s_ >= 0 && send_at_s_ <= 1e6)) throw BadInput("part '" + this->name() + "': send_at must be from 0 to 1e6 s");
+    if (!(send_at_s_ >= 0 && send_at_s_ <= 1e6)) throw part_error(this->name(), "send_at must be from 0 to 1e6 s");
     rx_pin_ = add_pin("rx", TerminalRole::Input);
     tx_pin_ = add_pin("tx", TerminalRole::Output);
 }

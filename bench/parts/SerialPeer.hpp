@@ -23,7 +23,7 @@ namespace avrbench {
 
 class SerialPeer final : public Part {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kSerialFraming;  // serial-framing
     static std::vector<ParamSpec> param_specs();
 

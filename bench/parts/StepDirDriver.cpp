@@ -141,11 +141,11 @@ StepDirDriver::StepDirDriver(std::string name, Mcu& clock, const ParamValues& pa
     dir_setup_cycles_ = cycles(params.quantity("dir_setup"));
     dir_hold_cycles_ = cycles(params.quantity("dir_hold"));
     max_step_rate_hz_ = params.quantity("max_step_rate");
-    if (max_step_rate_hz_ <= 0) throw BadInput("part '" + this->name() + "': max_step_rate must be positive");
+    if (max_step_rate_hz_ <= 0) throw part_error(this->name(), "max_step_rate must be positive");
     min_step_period_cycles_ = cycles(1.0 / max_step_rate_hz_);
     const long long microsteps = params.integer("microsteps");
     if (microsteps < 1 || microsteps > 256 || (microsteps & (microsteps - 1)) != 0) {
-        throw BadInput("part '" + this->name() + "': microsteps must be a power of two from 1 to 256");
+        throw part_error(this->name(), "microsteps must be a power of two from 1 to 256");
     }
     configured_microsteps_ = static_cast<unsigned>(microsteps);
     current_a_ = params.quantity("current");
@@ -171,7 +171,7 @@ Cycle StepDirDriver::cycles(double seconds) const {
     // A driver's timing minimum is nanoseconds to milliseconds; anything
     // outside 0..1 hour is a typo, and the cast below needs the range.
     if (!(cycles >= 0 && seconds <= 3600)) {
-        throw BadInput("part '" + name() + "': a timing value of " + std::to_string(seconds) + " s is outside 0..1 h");
+        throw part_error(name(), "a timing value of " + std::to_string(seconds) + " s is outside 0..1 h");
     }
     return static_cast<Cycle>(cycles);
 }

@@ -20,7 +20,7 @@ namespace avrbench {
 
 class StepDirDriver final : public Part, public DriveSource, public ShaftMotion {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kStepHighTooShort;  // step-high-too-short
     static const FindingKind kStepLowTooShort;  // step-low-too-short
     static const FindingKind kDirSetupViolation;  // dir-setup-violation

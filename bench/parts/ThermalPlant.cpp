@@ -96,7 +96,7 @@ const std::map<std::string, std::map<std::string, std::string>>& ThermalPlant::p
 ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
     auto need = [&](const char* param) {
         if (!params.has(param)) {
-            throw BadInput("part '" + this->name() + "': a " + params.text("preset") + " plant needs " + param);
+            throw part_error(this->name(), "a " + params.text("preset") + " plant needs " + param);
         }
         return params.quantity(param);
     };
@@ -109,9 +109,9 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     max_degC_ = params.has("max_temperature") ? params.quantity("max_temperature") : 1e9;
     filament_J_per_K_mm_ = params.quantity("filament_J_per_K_per_mm");
     filament_steps_per_mm_ = params.quantity("filament_steps_per_mm");
-    if (!(capacity > 0)) throw BadInput("part '" + this->name() + "': heat_capacity must be positive");
+    if (!(capacity > 0)) throw part_error(this->name(), "heat_capacity must be positive");
     if (g_ambient_ < 0 || g_ambient_fan_ < 0 || tau < 0 || filament_J_per_K_mm_ < 0 || !(filament_steps_per_mm_ > 0)) {
-        throw BadInput("part '" + this->name() + "': conductances, time constants and filament values must not be negative");
+        throw part_error(this->name(), "conductances, time constants and filament values must not be negative");
     }
     network_.set_ambient(ambient);
     block_ = network_.add_mass("block", capacity, initial);
@@ -126,7 +126,7 @@ ThermalPlant::ThermalPlant(std::string name, Mcu& clock, const ParamValues& para
     network_.reset_energy();
 
     const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput("part '" + this->name() + "': sample_interval must be positive");
+    if (!(interval > 0)) throw part_error(this->name(), "sample_interval must be positive");
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     unmonitored_cycles_ = clock.cycles_from_seconds(params.quantity("unmonitored_after"));
     ready_min_degC_ = params.quantity("ready_min");

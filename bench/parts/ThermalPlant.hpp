@@ -29,7 +29,7 @@ namespace avrbench {
 
 class ThermalPlant final : public Part, public ThermalBody {
 public:
-    // What this part finds (docs/FINDINGS.md).
+    // What this part finds (`avrbench findings` lists every kind).
     static const FindingKind kOverheat;  // overheat
     static const FindingKind kHeatingUnmonitored;  // heating-unmonitored
     static const FindingKind kReadyWhileCold;      // ready-while-cold

@@ -280,7 +280,7 @@ bool UartHost::done() const {
 
 std::string UartHost::failure_message() const {
     if (!failure_event_) return "";
-    return events_[*failure_event_].message;
+    return events_.all()[*failure_event_].message;
 }
 
 // --- receiving -----------------------------------------------------------------
@@ -688,10 +688,7 @@ void UartHost::on_line_timeout() {
     fail(std::move(e));
 }
 
-void UartHost::record(HostEvent event) {
-    events_.push_back(std::move(event));
-    count_finding_recorded();
-}
+void UartHost::record(HostEvent event) { events_.record(std::move(event)); }
 
 void UartHost::fail(HostEvent event) {
     if (failed_) {

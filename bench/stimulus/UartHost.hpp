@@ -166,7 +166,7 @@ struct HostEvent {
 
 class UartHost {
 public:
-    // What this one finds (docs/FINDINGS.md).
+    // What this one finds (`avrbench findings` lists every kind).
     static const FindingKind kHostProtocol;  // host-protocol
     using LineListener = std::function<void(const TranscriptEntry& entry)>;
 
@@ -238,7 +238,7 @@ public:
     std::size_t fatals() const { return fatals_; }
     // ok/error answers that arrived with no line outstanding.
     std::size_t unsolicited_acks() const { return unsolicited_acks_; }
-    const std::vector<HostEvent>& events() const { return events_; }
+    const std::vector<HostEvent>& events() const { return events_.all(); }
     // The last time the firmware said it is busy (stimulus/HostFamily.hpp
     // is_busy_report) after its last answer (ok or error: a busy report
     // while a line waited is about that line), with what it said.
@@ -346,7 +346,7 @@ private:
     bool last_was_cr_ = false;
 
     std::size_t oks_ = 0, errors_ = 0, alarms_ = 0, fatals_ = 0, unsolicited_acks_ = 0;
-    std::vector<HostEvent> events_;
+    FindingLog<HostEvent> events_;
     std::optional<std::size_t> failure_event_;
     std::optional<Cycle> last_busy_cycle_;
     std::string last_busy_text_;

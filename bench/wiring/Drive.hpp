@@ -5,7 +5,7 @@
 // sources; pull resistors (the MCU's internal pull-up, board resistors) form
 // a divider whose voltage is read against V_IL max = 0.3 VCC and V_IH min =
 // 0.6 VCC. What the bench decides where the datasheet leaves the level
-// undefined (docs/ELECTRICAL.md):
+// undefined (docs/BOARDS.md, "Electrical model and its limits"):
 //  - two strong drivers at different levels: contention; the net reads 0;
 //  - no driver, or a divider between V_IL and V_IH: floating; reads 0.
 #pragma once

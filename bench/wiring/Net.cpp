@@ -50,9 +50,7 @@ void Net::update() {
             f.clock_hz = clock_->frequency_hz();
             f.has_pc = false;
             f.detail = "net '" + name_ + "': outputs drive opposite levels (" + drivers_text() + ")";
-            findings_.push_back(std::move(f));
-    count_finding_recorded();
-            count_finding_recorded();
+            findings_.record(std::move(f));
         }
         update_pending_ = false;
         deliver();
@@ -103,8 +101,7 @@ void Net::floating_read(Mcu& reader, const std::string& pin_label) {
         std::snprintf(why, sizeof why, "nothing drives it and no pull-up is on");
     }
     f.detail = "the firmware read " + pin_label + " while net '" + name_ + "' floats (" + why + "); the bench reads 0";
-    findings_.push_back(std::move(f));
-    count_finding_recorded();
+    findings_.record(std::move(f));
 }
 
 }  // namespace avrbench

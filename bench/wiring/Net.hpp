@@ -62,7 +62,7 @@ private:
 
 class Net {
 public:
-    // What this one finds (docs/FINDINGS.md).
+    // What this one finds (`avrbench findings` lists every kind).
     static const FindingKind kNetContention;  // net-contention
     static const FindingKind kFloatingInputRead;  // floating-input-read
     explicit Net(std::string name) : name_(std::move(name)) {}
@@ -87,7 +87,7 @@ public:
     // One finding per floating spell, and only when something else on the net
     // could drive it (a net of the MCU's own outputs is not read as a signal).
     void floating_read(Mcu& reader, const std::string& pin_label);
-    const std::vector<Finding>& findings() const { return findings_; }
+    const std::vector<Finding>& findings() const { return findings_.all(); }
 
 private:
     void deliver();
@@ -102,7 +102,7 @@ private:
     bool update_pending_ = false;
     bool floating_read_reported_ = false;
     Mcu* clock_ = nullptr;
-    std::vector<Finding> findings_;
+    FindingLog<Finding> findings_;
 };
 
 }  // namespace avrbench

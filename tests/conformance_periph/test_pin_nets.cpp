@@ -36,6 +36,7 @@ nets:
 }
 
 void expect_nets_resolve(const std::string& mcu_type, const std::string& firmware) {
+    const std::uint64_t counted_before = findings_recorded();
     Board board(parse_board_text(board_text(mcu_type), "pin-nets.yaml"), {{"m", test::firmware(firmware)}});
     board.run_for_seconds(0.001);
     Mcu& m = board.mcu("m");
@@ -73,6 +74,9 @@ void expect_nets_resolve(const std::string& mcu_type, const std::string& firmwar
     // that gives a valid level are not floating, and PB3/PB4's net never floats.
     EXPECT_EQ(floating, 1) << firmware;
     EXPECT_EQ(contention, 1) << firmware;
+    // Each counted once where a debugger's --break-at-finding looks
+    // (wiring/Net.cpp counted a contention twice until 2026-12-02).
+    EXPECT_EQ(findings_recorded() - counted_before, board.findings().size()) << firmware;
     EXPECT_EQ(board.nets()[4]->resolution().state, NetState::Contention);
 }
 
