@@ -1,5 +1,7 @@
 #include "core/SimavrLog.hpp"
 
+#include "core/AvrContext.hpp"
+
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -18,12 +20,14 @@ bool echo_requested() {
 }
 
 void route(avr_t* avr, const int level, const char* format, va_list args) {
-    const bool to_sink = level <= LOG_ERROR && avr != nullptr && avr->custom.data != nullptr;
+    const AvrContext* context = avr != nullptr ? AvrContext::of(avr) : nullptr;
+    SimavrLogSink* sink = context != nullptr ? context->log_sink : nullptr;
+    const bool to_sink = level <= LOG_ERROR && sink != nullptr;
     if (!to_sink && !echo_requested()) return;
     char message[512];
     std::vsnprintf(message, sizeof message, format, args);
     if (echo_requested()) std::fprintf(stderr, "simavr: %s", message);
-    if (to_sink) static_cast<SimavrLogSink*>(avr->custom.data)->on_simavr_error(message);
+    if (to_sink) sink->on_simavr_error(message);
 }
 
 }  // namespace
@@ -33,6 +37,8 @@ void install_simavr_log_router() {
     std::call_once(once, [] { avr_global_logger_set(&route); });
 }
 
-void route_simavr_log(avr_t* avr, SimavrLogSink* sink) { avr->custom.data = sink; }
+void route_simavr_log(avr_t* avr, SimavrLogSink* sink) {
+    if (AvrContext* context = AvrContext::of(avr)) context->log_sink = sink;
+}
 
 }  // namespace avrbench

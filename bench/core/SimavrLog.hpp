@@ -20,7 +20,7 @@ protected:
 // Idempotent; call before any simavr function that may log.
 void install_simavr_log_router();
 
-// Routes `avr`'s messages to `sink` (nullptr detaches). Uses avr->custom.data.
+// Routes `avr`'s messages to `sink` (nullptr detaches). Needs the core's AvrContext (core/AvrContext.hpp).
 void route_simavr_log(avr_t* avr, SimavrLogSink* sink);
 
 }  // namespace avrbench

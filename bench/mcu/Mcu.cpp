@@ -53,7 +53,7 @@ struct ResetHook {
     // watchdog reset apart.
     static void watchdog_reset(avr_io_t* io) {
         avr_t* avr = io->avr;
-        auto* mcu = static_cast<Mcu*>(static_cast<SimavrLogSink*>(avr->custom.data));
+        Mcu* mcu = AvrContext::find_in<Mcu>(avr, avr);
         mcu->original_watchdog_reset_(io);
         mcu->reset_seen_ = true;
         if (avr_regbit_get(avr, avr->reset_flags.wdrf)) mcu->watchdog_reset_seen_ = true;
@@ -120,6 +120,8 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
     avr_init(avr_);
     cycle_ = &avr_->cycle;
     state_ = &avr_->state;
+    AvrContext::attach(avr_, &context_);
+    context_.add<Mcu>(avr_, this);
     route_simavr_log(avr_, this);
     avr_->log = LOG_ERROR;
 

@@ -14,6 +14,7 @@
 
 #include "periph/memory/BootSection.hpp"
 #include "mcu/ElfImage.hpp"
+#include "core/AvrContext.hpp"
 #include "core/Finding.hpp"
 #include "periph/timer/PeriodicOutput.hpp"
 #include "periph/ports/Pin.hpp"
@@ -320,6 +321,8 @@ private:
     ElfImage elf_;
     std::string mcu_type_;
     std::uint32_t frequency_hz_ = 0;
+    // Declared before the fixes: they find their state in it until they are gone.
+    AvrContext context_;
     avr_t* avr_ = nullptr;
     avr_extint_t* extint_ = nullptr;  // simavr's INTn module, for pin_interrupt_enabled
     avr_acomp_t* acomp_ = nullptr;    // simavr's analog comparator

@@ -52,12 +52,6 @@ extern "C" {
 namespace avrbench {
 namespace {
 
-class AdcConversion;
-Registry<avr_io_t, AdcConversion>& adc_registry() {
-    static Registry<avr_io_t, AdcConversion> r;
-    return r;
-}
-
 class AdcConversion final : public Fix {
 public:
     AdcConversion(avr_t* avr, avr_adc_t* adc) : avr_(avr), adc_(adc) {
@@ -76,7 +70,7 @@ public:
         for (int i = 0; i <= ADC_IRQ_TEMP; ++i) avr_irq_register_notify(irq_ + i, &on_input, this);
         original_reset_ = adc->io.reset;
         adc->io.reset = &on_reset;
-        adc_registry().add(&adc->io, this);
+        FixState<AdcConversion>::add(&adc->io, this);
 
         // m32: ADATE is ADCSRA bit 5 and ADTS2:0 are SFIOR bits 7:5; simavr
         // declares neither.
@@ -112,7 +106,7 @@ public:
         adc_->io.reset = original_reset_;
         adc_->io.irq = original_irq_;
         avr_free_irq(irq_, ADC_IRQ_COUNT);
-        adc_registry().remove(&adc_->io);
+        FixState<AdcConversion>::remove(&adc_->io);
     }
 
 private:
@@ -372,7 +366,7 @@ private:
     }
 
     static void on_reset(avr_io_t* io) {
-        AdcConversion* self = adc_registry().find(io);
+        AdcConversion* self = FixState<AdcConversion>::find(io);
         // simavr's reset re-registers its notify on the module's IRQs: let it
         // find its own array, not the bench's.
         self->adc_->io.irq = self->original_irq_;

@@ -35,12 +35,6 @@ extern "C" {
 namespace avrbench {
 namespace {
 
-class ExternalInterrupts;
-Registry<avr_io_t, ExternalInterrupts>& extint_registry() {
-    static Registry<avr_io_t, ExternalInterrupts> r;
-    return r;
-}
-
 class ExternalInterrupts final : public Fix {
 public:
     ExternalInterrupts(avr_t* avr, avr_extint_t* extint) : avr_(avr), extint_(extint), facts_(part_facts(avr)) {
@@ -64,7 +58,7 @@ public:
         disconnect_simavr();
         original_reset_ = extint_->io.reset;
         extint_->io.reset = &on_reset;
-        extint_registry().add(&extint_->io, this);
+        FixState<ExternalInterrupts>::add(&extint_->io, this);
 
         // Registers: enables, sense control, flags (INTn), and PCICR/PCIFR.
         std::vector<avr_io_addr_t> enables, controls, flags;
@@ -110,7 +104,7 @@ public:
                                       &line);
         }
         extint_->io.reset = original_reset_;
-        extint_registry().remove(&extint_->io);
+        FixState<ExternalInterrupts>::remove(&extint_->io);
     }
 
 private:
@@ -218,7 +212,7 @@ private:
     }
 
     static void on_reset(avr_io_t* io) {
-        ExternalInterrupts* self = extint_registry().find(io);
+        ExternalInterrupts* self = FixState<ExternalInterrupts>::find(io);
         self->original_reset_(io);  // re-registers its notify and reconnects the pins
         self->disconnect_simavr();
         for (auto& line : self->lines_) {

@@ -23,7 +23,6 @@
 //  5. SLEEP sleeps with SE = 0 (the datasheet: SE must be one, §10.1).
 // It also replaces the sleep callback of install_virtual_sleep (virtual time:
 // still no wall-clock wait).
-#include <atomic>
 
 extern "C" {
 #include <sim_cycle_timers.h>
@@ -38,20 +37,6 @@ namespace {
 
 constexpr unsigned kSleepOpcode = 0x9588;
 
-class InterruptTiming;
-
-// The sleep callback carries no parameter: find the fix by its core.
-Registry<avr_t, InterruptTiming>& interrupt_timing_registry() {
-    static Registry<avr_t, InterruptTiming> r;
-    return r;
-}
-// Bumped whenever the registry changes, so per-thread caches notice a core
-// freed and another allocated at the same address.
-std::atomic<std::uint64_t>& generation() {
-    static std::atomic<std::uint64_t> g{0};
-    return g;
-}
-
 class InterruptTiming final : public Fix {
 public:
     explicit InterruptTiming(avr_t* avr) : avr_(avr), facts_(part_facts(avr)) {
@@ -60,8 +45,7 @@ public:
         }
         avr_irq_register_notify(avr->interrupts.irq + AVR_INT_IRQ_PENDING, &on_pending, this);
         sreg_hook_ = std::make_unique<IoWriteHook>(avr, R_SREG, &on_sreg_write, this);
-        interrupt_timing_registry().add(avr, this);
-        generation().fetch_add(1);
+        FixState<InterruptTiming>::add(avr, this);
         avr->sleep = &on_sleep;
     }
 
@@ -71,8 +55,7 @@ public:
         }
         avr_irq_unregister_notify(avr_->interrupts.irq + AVR_INT_IRQ_PENDING, &on_pending, this);
         avr_cycle_timer_cancel(avr_, &sei_watch, this);
-        interrupt_timing_registry().remove(avr_);
-        generation().fetch_add(1);
+        FixState<InterruptTiming>::remove(avr_);
     }
 
 private:
@@ -152,20 +135,7 @@ private:
     // Called by simavr's run loop on every step while the core sleeps, just
     // before it adds 1 + how_long to the cycle counter.
     static void on_sleep(avr_t* avr, avr_cycle_count_t how_long) {
-        // One lookup per core and thread, then a compare: this runs on every
-        // sleep jump.
-        thread_local const avr_t* cached_avr = nullptr;
-        thread_local InterruptTiming* cached_self = nullptr;
-        thread_local std::uint64_t cached_generation = 0;
-        InterruptTiming* self = nullptr;
-        if (avr == cached_avr && cached_generation == generation().load(std::memory_order_relaxed)) {
-            self = cached_self;
-        } else {
-            self = interrupt_timing_registry().find(avr);
-            cached_avr = avr;
-            cached_self = self;
-            cached_generation = generation().load(std::memory_order_relaxed);
-        }
+        InterruptTiming* self = FixState<InterruptTiming>::find(avr);
         if (self == nullptr) return;
         const PartFacts& f = self->facts_;
         if (f.sleep_register != 0 && (avr->data[f.sleep_register] & f.se_mask) == 0) {

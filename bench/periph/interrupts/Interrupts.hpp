@@ -1,16 +1,17 @@
 // Helpers shared by the peripheral fixes: simavr's interrupt table, the few
-// per-part facts the fixes need (datasheet values), and a registry to find a
-// fix's state from simavr callbacks that carry no parameter.
+// per-part facts the fixes need (datasheet values), and where a fix's state is
+// found from simavr callbacks that carry no parameter.
 #pragma once
 
 #include <cstdint>
-#include <map>
-#include <mutex>
+#include <stdexcept>
 
 extern "C" {
 #include <sim_avr.h>
 #include <sim_interrupts.h>
 }
+
+#include "core/AvrContext.hpp"
 
 namespace avrbench {
 
@@ -106,29 +107,24 @@ void remove_sleep_entry_listener(avr_t* avr, void* context);
 // armed by a listener, 0 if none.
 avr_cycle_count_t notify_sleep_entry(avr_t* avr, std::uint8_t mode);
 
-// Finds a fix's state from a simavr callback that carries no parameter of
-// its own (a module's reset hook gets only its avr_io_t). Thread-safe: cores
-// may live on several threads.
-template <typename Key, typename Value>
-class Registry {
-public:
-    void add(const Key* key, Value* value) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        map_[key] = value;
-    }
-    void remove(const Key* key) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        map_.erase(key);
-    }
-    Value* find(const Key* key) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        auto it = map_.find(key);
-        return it == map_.end() ? nullptr : it->second;
-    }
+// A fix's state, found from a simavr callback that carries no parameter of
+// its own (a module's reset hook gets only its avr_io_t, avr->sleep only the
+// avr_t): kept in the AvrContext of the core the key belongs to.
+template <typename Value>
+struct FixState {
+    static void add(const avr_io_t* io, Value* value) { context(io->avr).template add<Value>(io, value); }
+    static void add(const avr_t* avr, Value* value) { context(avr).template add<Value>(avr, value); }
+    static void remove(const avr_io_t* io) { context(io->avr).template remove<Value>(io); }
+    static void remove(const avr_t* avr) { context(avr).template remove<Value>(avr); }
+    static Value* find(const avr_io_t* io) { return AvrContext::find_in<Value>(io->avr, io); }
+    static Value* find(const avr_t* avr) { return AvrContext::find_in<Value>(avr, avr); }
 
 private:
-    std::mutex mutex_;
-    std::map<const Key*, Value*> map_;
+    static AvrContext& context(const avr_t* avr) {
+        AvrContext* c = AvrContext::of(avr);
+        if (c == nullptr) throw std::logic_error("a simavr fix on a core without its AvrContext");
+        return *c;
+    }
 };
 
 }  // namespace avrbench

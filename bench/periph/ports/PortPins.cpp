@@ -33,12 +33,6 @@ extern "C" {
 namespace avrbench {
 namespace {
 
-class PortPins;
-Registry<avr_io_t, PortPins>& port_registry() {
-    static Registry<avr_io_t, PortPins> r;
-    return r;
-}
-
 class PortPins final : public Fix {
 public:
     explicit PortPins(avr_t* avr) : facts_(part_facts(avr)) {
@@ -47,7 +41,7 @@ public:
             auto* port = reinterpret_cast<avr_ioport_t*>(io);
             ports_.push_back({port, io->reset});
             io->reset = &on_reset;
-            port_registry().add(io, this);
+            FixState<PortPins>::add(io, this);
             // A write to one port's PIN, PORT or DDR register can change only that port's inputs.
             hook_contexts_.push_back(std::make_unique<PortHook>(PortHook{this, port}));
             PortHook* ctx = hook_contexts_.back().get();
@@ -67,7 +61,7 @@ public:
         pin_hooks_.clear();
         for (auto& p : ports_) {
             p.port->io.reset = p.original_reset;
-            port_registry().remove(&p.port->io);
+            FixState<PortPins>::remove(&p.port->io);
         }
     }
 
@@ -118,7 +112,7 @@ private:
     }
 
     static void on_reset(avr_io_t* io) {
-        PortPins* self = port_registry().find(io);
+        PortPins* self = FixState<PortPins>::find(io);
         auto* port = reinterpret_cast<avr_ioport_t*>(io);
         for (auto& p : self->ports_) {
             if (p.port == port && p.original_reset != nullptr) p.original_reset(io);

@@ -15,10 +15,6 @@ extern "C" {
 namespace avrbench {
 
 namespace {
-Registry<avr_t, CompareOutputPins>& instances() {
-    static Registry<avr_t, CompareOutputPins> r;
-    return r;
-}
 }  // namespace
 
 struct CompareOutputPins::Port {
@@ -42,12 +38,12 @@ struct CompareOutputPins::Port {
 
 CompareOutputPins::CompareOutputPins(avr_t* avr)
     : avr_(avr), pin_write_toggles_(part_facts(avr).pin_write_toggles) {
-    instances().add(avr, this);
+    FixState<CompareOutputPins>::add(avr, this);
 }
 
-CompareOutputPins::~CompareOutputPins() { instances().remove(avr_); }
+CompareOutputPins::~CompareOutputPins() { FixState<CompareOutputPins>::remove(avr_); }
 
-CompareOutputPins* CompareOutputPins::of(const avr_t* avr) { return instances().find(avr); }
+CompareOutputPins* CompareOutputPins::of(const avr_t* avr) { return FixState<CompareOutputPins>::find(avr); }
 
 CompareOutputPins::Port* CompareOutputPins::port_for(avr_ioport_t* io) {
     for (auto& p : ports_) {

@@ -271,15 +271,6 @@ avr_irq_t* pin_irq(avr_t* avr, avr_regbit_t pin) {
 }
 
 
-class TimerModel;
-
-// simavr's io reset callback has no parameter.
-std::mutex timer_model_registry_mutex;
-std::map<const avr_io_t*, TimerModel*>& timer_model_registry() {
-    static std::map<const avr_io_t*, TimerModel*> r;
-    return r;
-}
-
 class TimerModel {
 public:
     TimerModel(avr_t* avr, avr_timer_t* timer, const Shape& shape, Prescaler& prescaler, CompareOutputPins& pins)
@@ -327,15 +318,12 @@ public:
 
         original_reset_ = t_->io.reset;
         t_->io.reset = &on_io_reset;
-        std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
-        timer_model_registry()[&t_->io] = this;
+        // simavr's io reset callback has no parameter.
+        FixState<TimerModel>::add(&t_->io, this);
     }
 
     ~TimerModel() {
-        {
-            std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
-            timer_model_registry().erase(&t_->io);
-        }
+        FixState<TimerModel>::remove(&t_->io);
         t_->io.reset = original_reset_;
         avr_cycle_timer_cancel(avr_, &on_event, this);
         avr_cycle_timer_cancel(avr_, &on_noise_canceler, this);
@@ -1180,12 +1168,7 @@ private:
     }
 
     static void on_io_reset(avr_io_t* io) {
-        TimerModel* self = nullptr;
-        {
-            std::lock_guard<std::mutex> lock(timer_model_registry_mutex);
-            auto it = timer_model_registry().find(io);
-            if (it != timer_model_registry().end()) self = it->second;
-        }
+        TimerModel* self = FixState<TimerModel>::find(io);
         if (self == nullptr) return;
         if (self->original_reset_ != nullptr) self->original_reset_(io);
         self->pins_->after_reset();

@@ -5,8 +5,6 @@
 //    times); the datasheet frame is start + data + parity-if-enabled + stop
 //    (ATmega328P §19.4, 8N1 = 10 bits). simavr also recomputes it only on a
 //    UBRRnL write; here it follows every write to UBRRnL/H, UCSRnA/B/C.
-#include <map>
-#include <mutex>
 #include <string_view>
 #include <vector>
 
@@ -14,6 +12,7 @@ extern "C" {
 #include <avr_uart.h>
 }
 
+#include "core/AvrContext.hpp"
 #include "periph/Fixes.hpp"
 
 namespace avrbench {
@@ -22,32 +21,24 @@ namespace avrbench {
 // 19-5, USBSn table 19-6) and cycles per bit (§19.3.1 table 19-1).
 namespace {
 
-// The UCSRC shadows of USARTs whose UCSRC shares UBRRH's location. Fixes of
-// several MCUs may run on different threads (tests, fuzzing): guarded.
-std::mutex ucsrc_shadows_mutex;
-std::map<const avr_uart_t*, const std::uint8_t*>& ucsrc_shadows() {
-    static std::map<const avr_uart_t*, const std::uint8_t*> shadows;
-    return shadows;
-}
+// The UCSRC shadows of USARTs whose UCSRC shares UBRRH's location, kept in
+// the core's AvrContext by the USART they belong to.
+struct UcsrcShadow {};
 
 }  // namespace
 
 void set_uart_ucsrc_shadow(const avr_uart_t* uart, const std::uint8_t* ucsrc) {
-    const std::lock_guard<std::mutex> lock(ucsrc_shadows_mutex);
+    AvrContext* context = AvrContext::of(uart->io.avr);
+    if (context == nullptr) return;
     if (ucsrc == nullptr) {
-        ucsrc_shadows().erase(uart);
+        context->remove<UcsrcShadow>(uart);
     } else {
-        ucsrc_shadows()[uart] = ucsrc;
+        context->add<UcsrcShadow>(uart, ucsrc);
     }
 }
 
 UartFrame uart_frame(avr_t* avr, const avr_uart_t* p) {
-    const std::uint8_t* shadow = nullptr;
-    {
-        const std::lock_guard<std::mutex> lock(ucsrc_shadows_mutex);
-        const auto it = ucsrc_shadows().find(p);
-        if (it != ucsrc_shadows().end()) shadow = it->second;
-    }
+    const std::uint8_t* shadow = AvrContext::find_in<UcsrcShadow, const std::uint8_t>(avr, p);
     const std::uint32_t ubrr =
         avr_regbit_get(avr, p->ubrrl) | (static_cast<std::uint32_t>(avr_regbit_get(avr, p->ubrrh)) << 8);
     UartFrame f;

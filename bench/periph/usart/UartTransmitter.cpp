@@ -43,12 +43,6 @@ extern "C" {
 namespace avrbench {
 namespace {
 
-class UartTransmitter;
-Registry<avr_io_t, UartTransmitter>& tx_registry() {
-    static Registry<avr_io_t, UartTransmitter> r;
-    return r;
-}
-
 class UartTransmitter final : public Fix {
 public:
     UartTransmitter(avr_t* avr, avr_uart_t* uart) : avr_(avr), uart_(uart) {
@@ -59,7 +53,7 @@ public:
         avr_irq_register_notify(uart->udrc.irq + AVR_INT_IRQ_PENDING, &on_udre_pending, this);
         original_reset_ = uart->io.reset;
         uart->io.reset = &on_reset;
-        tx_registry().add(&uart->io, this);
+        FixState<UartTransmitter>::add(&uart->io, this);
         // simavr's reset sets TXEN ("allow printf without fiddling with enabling
         // the uart"); UCSRnB resets to 0 (328P §20.11.3).
         avr_regbit_clear(avr, uart->txen);
@@ -77,7 +71,7 @@ public:
         avr_cycle_timer_cancel(avr_, &on_frame_end, this);
         avr_cycle_timer_cancel(avr_, &on_line_edge, this);
         uart_->io.reset = original_reset_;
-        tx_registry().remove(&uart_->io);
+        FixState<UartTransmitter>::remove(&uart_->io);
     }
 
 private:
@@ -158,7 +152,7 @@ private:
     }
 
     static void on_reset(avr_io_t* io) {
-        UartTransmitter* self = tx_registry().find(io);
+        UartTransmitter* self = FixState<UartTransmitter>::find(io);
         self->original_reset_(io);
         avr_regbit_clear(self->avr_, self->uart_->txen);
         self->shifting_ = false;

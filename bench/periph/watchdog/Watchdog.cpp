@@ -95,25 +95,19 @@ private:
 // the newer parts' 2K cycles of 128 kHz (16 ms) and re-enables the watchdog at
 // its shortest period after a watchdog reset (the newer parts' WDRF rule), so
 // such a firmware resets again every 16 ms.
-class OldMegaWatchdog;
-Registry<avr_io_t, OldMegaWatchdog>& old_registry() {
-    static Registry<avr_io_t, OldMegaWatchdog> r;
-    return r;
-}
-
 class OldMegaWatchdog final : public Fix {
 public:
     OldMegaWatchdog(avr_t* avr, avr_watchdog_t* wdt) : avr_(avr), wdt_(wdt) {
         hook_ = std::make_unique<IoWriteHook>(avr, static_cast<avr_io_addr_t>(wdt->wde.reg), &on_write, this);
         original_reset_ = wdt->io.reset;
         wdt->io.reset = &on_reset;
-        old_registry().add(&wdt->io, this);
+        FixState<OldMegaWatchdog>::add(&wdt->io, this);
         correct_period();
     }
     ~OldMegaWatchdog() override {
         hook_.reset();
         wdt_->io.reset = original_reset_;
-        old_registry().remove(&wdt_->io);
+        FixState<OldMegaWatchdog>::remove(&wdt_->io);
     }
 
 private:
@@ -145,7 +139,7 @@ private:
     }
 
     static void on_reset(avr_io_t* io) {
-        OldMegaWatchdog* self = old_registry().find(io);
+        OldMegaWatchdog* self = FixState<OldMegaWatchdog>::find(io);
         self->original_reset_(io);
         // WDTCR's reset value is 0: the watchdog is off after any reset.
         if (auto* t = self->pending_timer()) avr_cycle_timer_cancel(self->avr_, t->timer, self->wdt_);
