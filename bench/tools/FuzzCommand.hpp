@@ -1,4 +1,5 @@
-// `avrbench fuzz` (bench/tools/FuzzCommand.cpp).
+// `avrbench fuzz` (bench/tools/FuzzCommand.cpp): the command line; the
+// campaign itself is fuzz/campaign/FuzzCampaign.hpp.
 #pragma once
 
 #include <string>
