@@ -74,28 +74,6 @@ void trace_pins_option(Recorder& recorder, Mcu& mcu, const std::string& spec, co
     }
 }
 
-std::pair<Picoseconds, std::string> parse_realtime_bytes(const std::string& item, const char* option) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos || eq + 1 >= item.size()) {
-        throw BadInput(std::string(option) + " '" + item + "': expected TIME=BYTES, e.g. 2s=! or 1.5s=^X or 3s=0x85");
-    }
-    const Picoseconds at = parse_duration_ps(item.substr(0, eq), option);
-    const std::string text = item.substr(eq + 1);
-    std::string bytes;
-    if (text.size() == 2 && text[0] == '^' && text[1] >= '@' && text[1] <= '_') {
-        bytes.push_back(static_cast<char>(text[1] - '@'));
-    } else if (text.size() == 4 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X') &&
-               std::isxdigit(static_cast<unsigned char>(text[2])) && std::isxdigit(static_cast<unsigned char>(text[3]))) {
-        bytes.push_back(static_cast<char>(std::stoi(text.substr(2), nullptr, 16)));
-    } else {
-        for (char c : text) {
-            if (c < 0x20 || c > 0x7e) throw BadInput(std::string(option) + " '" + item + "': write control bytes as ^X or 0xNN");
-        }
-        bytes = text;
-    }
-    return {at, bytes};
-}
-
 BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
     BoardSpec spec = load_board_file(options_.board);
     // The first MCU's ELF may come as `elf` (the CLI's positional argument) or in `firmware`.

@@ -160,8 +160,5 @@ private:
 // Recorder::trace_pins, its error named after the option that gave the list.
 void trace_pins_option(Recorder& recorder, Mcu& mcu, const std::string& spec, const char* option);
 
-// "2.5s=!" / "1.5s=^X" / "3s=0x85": a time and the bytes to send then
-// (printable characters as they are, ^X a control character, 0xNN any byte).
-std::pair<Picoseconds, std::string> parse_realtime_bytes(const std::string& item, const char* option);
 
 }  // namespace avrbench

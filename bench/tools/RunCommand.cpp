@@ -8,9 +8,7 @@
 #include <memory>
 #include <optional>
 
-#include "cam/Chain.hpp"
-#include "cam/DxfReader.hpp"
-#include "cam/Records.hpp"
+#include "cam/PlotJob.hpp"
 #include "mcu/ElfImage.hpp"
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
@@ -24,6 +22,7 @@
 #include "debug/RunViews.hpp"
 #include "tools/Commands.hpp"
 #include "tools/FirmwareArgs.hpp"
+#include "tools/RealtimeArgs.hpp"
 #include "trace/Recorder.hpp"
 #include "trace/WaveformFiles.hpp"
 #include "run/McuRun.hpp"
@@ -163,15 +162,9 @@ BoardRunOptions::RecordJob plot_job(const RunArgs& args) {
         throw BadInput("--records: '" + args.records + "' is not faithful or improved");
     }
     const double feed = parse_quantity(args.feed, Dimension::Dimensionless, "--feed");
-    if (!(feed > 0 && feed <= 1e5)) throw BadInput("--feed: mm/min above 0 and at most 100000");
-    Drawing drawing = read_dxf(args.dxf).drawing;
-    align_segments(drawing, 0.01);
-    const GcodeProgram gcode = emit_gcode(drawing, 0.01, feed);
-    if (!args.nc.empty()) write_output_file(args.nc, gcode.text, "--nc");
-    RecordOptions options;
-    options.improved = args.records == "improved";
-    const RecordProgram program = records_from_gcode(gcode.text, options, args.dxf);
-    return {args.dxf, args.records, program.messages, program.busy_seconds, gcode.text};
+    PlotJob plot = plot_drawing(args.dxf, feed, args.records == "improved");
+    if (!args.nc.empty()) write_output_file(args.nc, plot.gcode, "--nc");
+    return {args.dxf, args.records, std::move(plot.records.messages), std::move(plot.records.busy_seconds), std::move(plot.gcode)};
 }
 
 // `run --board`'s arguments as the library's run options, checked as far as
