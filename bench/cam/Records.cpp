@@ -1,5 +1,7 @@
 #include "cam/Records.hpp"
 
+#include "core/GcodeLexer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -134,23 +136,16 @@ RecordProgram records_from_gcode(const std::string& gcode, const RecordOptions& 
     while (std::getline(in, line)) {
         ++number;
         const std::string at = where + ":" + std::to_string(number) + ": ";
-        std::istringstream words(line);
-        std::string word;
+        const auto words = lex_strict_gcode(line);
+        if (!words) throw BadInput(at + "'" + line + "' is not G-code words (a capital letter and a number each)");
         int g = -1;
         bool m30 = false;
         double X = c.mm(c.x), Y = c.mm(c.y), I = 0, J = 0;
-        while (words >> word) {
-            if (word.size() < 2) throw BadInput(at + "'" + word + "' is not a G-code word");
-            double v = 0;
-            try {
-                std::size_t used = 0;
-                v = std::stod(word.substr(1), &used);
-                if (used != word.size() - 1) throw std::invalid_argument(word);
-            } catch (const std::exception&) {
-                throw BadInput(at + "'" + word + "' is not a G-code word");
-            }
+        for (const GcodeWord& w : *words) {
+            const double v = w.value;
+            const std::string word = line.substr(w.begin, w.end - w.begin);
             if (!std::isfinite(v)) throw BadInput(at + "'" + word + "' is not a finite number");
-            switch (word[0]) {
+            switch (w.letter) {
                 case 'G':
                     if (v == 21 || v == 90) break;
                     if (v != 0 && v != 1 && v != 2 && v != 3) throw BadInput(at + "G" + word.substr(1) + " is not G00..G03");

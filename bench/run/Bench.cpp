@@ -21,23 +21,6 @@
 
 namespace avrbench {
 
-std::map<char, double> gcode_words(const std::string& line) {
-    std::map<char, double> words;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char c = line[i];
-        if (c == ';' || c == '*' || c == '(') break;  // comment or checksum
-        if (!std::isalpha(static_cast<unsigned char>(c))) continue;
-        const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-        const char* begin = line.c_str() + i + 1;
-        char* end = nullptr;
-        const double value = std::strtod(begin, &end);
-        if (end == begin || !std::isfinite(value)) continue;
-        words.emplace(letter, value);
-        i += static_cast<std::size_t>(end - begin);
-    }
-    return words;
-}
-
 const char* to_string(IdleResult result) {
     switch (result) {
         case IdleResult::Idle: return "idle";

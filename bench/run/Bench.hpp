@@ -43,9 +43,6 @@ enum class IdleResult {
 // "idle", "time-limit", "halted", "host-failed", "interrupted", "recorder-full".
 const char* to_string(IdleResult result);
 
-// The words of one G-code line, letter (upper case) -> number, first of each
-// letter; stops at a ';' or '(' comment or a '*' checksum. "M104 S200 T1".
-std::map<char, double> gcode_words(const std::string& line);
 
 // A serial port of the board: a part where a host attaches
 // (parts/HostConnector.hpp: a serial_host on the firmware's TX/RX nets).

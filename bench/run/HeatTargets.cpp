@@ -1,5 +1,7 @@
 #include "run/HeatTargets.hpp"
 
+#include "core/GcodeLexer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,57 +1,23 @@
 #include "stimulus/CommandedTarget.hpp"
 
-#include <cstdlib>
 #include <map>
 #include <string>
 
+#include "core/GcodeLexer.hpp"
+
 namespace avrbench {
-namespace {
-
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-}  // namespace
 
 std::optional<std::map<char, double>> strict_gcode_words(std::string_view line, std::vector<double>* g_words) {
-    if (const auto star = line.find('*'); star != std::string_view::npos) {
-        const auto checksum = line.substr(star + 1);
-        if (checksum.empty()) return std::nullopt;
-        for (char c : checksum) {
-            if (!is_digit(c)) return std::nullopt;
-        }
-        line = line.substr(0, star);
-    }
+    const auto lexed = lex_strict_gcode(line);
+    if (!lexed) return std::nullopt;
     std::map<char, double> words;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        const char letter = line[i];
-        if (letter == ' ') {
-            ++i;
-            continue;
-        }
-        if (letter < 'A' || letter > 'Z') return std::nullopt;
-        std::size_t j = i + 1;
-        if (j < line.size() && (line[j] == '+' || line[j] == '-')) ++j;
-        const std::size_t digits_from = j;
-        while (j < line.size() && is_digit(line[j])) ++j;
-        bool any_digit = j > digits_from;
-        if (j < line.size() && line[j] == '.') {
-            ++j;
-            const std::size_t fraction_from = j;
-            while (j < line.size() && is_digit(line[j])) ++j;
-            any_digit = any_digit || j > fraction_from;
-        }
-        if (!any_digit) return std::nullopt;
-        // A number must end at a space, the line's end or another word's
-        // letter - never E (an exponent to atof/strtod) or anything else.
-        if (j < line.size() && line[j] != ' ' && (line[j] < 'A' || line[j] > 'Z' || line[j] == 'E')) return std::nullopt;
-        const double value = std::strtod(std::string(line.substr(i + 1, j - i - 1)).c_str(), nullptr);
-        if (letter == 'G' && g_words != nullptr) {
-            g_words->push_back(value);
+    for (const GcodeWord& w : *lexed) {
+        if (w.letter == 'G' && g_words != nullptr) {
+            g_words->push_back(w.value);
         } else {
-            if (words.count(letter) != 0) return std::nullopt;
-            words[letter] = value;
+            if (words.count(w.letter) != 0) return std::nullopt;
+            words[w.letter] = w.value;
         }
-        i = j;
     }
     return words;
 }

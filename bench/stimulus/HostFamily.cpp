@@ -1,5 +1,7 @@
 #include "stimulus/HostFamily.hpp"
 
+#include "core/GcodeLexer.hpp"
+
 #include <cctype>
 #include <cstring>
 
@@ -220,9 +222,21 @@ std::string command_named(std::string_view error_line) {
 }
 
 std::string command_word(std::string_view gcode_line) {
-    // Past a line number "N12 " and before a checksum or comment.
-    const std::size_t end = gcode_line.find_first_of("*;(");
-    return first_command(gcode_line.substr(0, end), false);
+    // Past a line number "N12 " and before a checksum or comment: the first
+    // G, M, T or D word, its whole digits without leading zeros.
+    for (const GcodeWord& w : lex_lenient_gcode(gcode_line)) {
+        if (w.letter != 'G' && w.letter != 'M' && w.letter != 'T' && w.letter != 'D') continue;
+        // A word starts a token: not the 'd' of "Bad".
+        if (w.begin > 0 && std::isalnum(static_cast<unsigned char>(gcode_line[w.begin - 1]))) continue;
+        std::size_t j = w.begin + 1;
+        while (j < w.end && gcode_line[j] == ' ') ++j;
+        std::size_t k = j;
+        while (k < w.end && std::isdigit(static_cast<unsigned char>(gcode_line[k]))) ++k;
+        if (k == j) continue;
+        while (j + 1 < k && gcode_line[j] == '0') ++j;
+        return std::string(1, w.letter) + std::string(gcode_line.substr(j, k - j));
+    }
+    return "";
 }
 
 }  // namespace avrbench

@@ -1,5 +1,7 @@
 #include "stimulus/UartHost.hpp"
 
+#include "core/GcodeLexer.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -634,32 +636,25 @@ double UartHost::timeout_for_oldest_s() const {
     const double line_timeout = line_timeout_s();
     if (outstanding_.empty()) return line_timeout;
     const GcodeLine& line = lines_[outstanding_.front().index];
-    std::string upper;
-    for (char c : line.text) upper.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    auto has_word = [&upper](const char* word) {
-        const std::size_t n = std::strlen(word);
-        for (std::size_t at = upper.find(word); at != std::string::npos; at = upper.find(word, at + 1)) {
-            const bool start_ok = at == 0 || !std::isalnum(static_cast<unsigned char>(upper[at - 1]));
-            const bool end_ok = at + n >= upper.size() || !std::isdigit(static_cast<unsigned char>(upper[at + n]));
-            if (start_ok && end_ok) return true;
-        }
-        return false;
+    const std::vector<GcodeWord> words = lex_lenient_gcode(line.text);
+    const auto has_word = [&words](char letter, double code) {
+        return std::any_of(words.begin(), words.end(), [&](const GcodeWord& w) { return w.letter == letter && w.value == code; });
     };
-    if (has_word("G4")) {
+    if (has_word('G', 4)) {
         // Dwell: P in seconds on grbl (its G-code reference follows
         // LinuxCNC), in milliseconds on Marlin and Teacup (S in seconds).
         // grbl and Marlin first wait for every queued move to finish, so G4
         // is a long command whatever its dwell.
         double dwell_s = 0;
-        const auto p = upper.find('P'), sec = upper.find('S');
         const double p_unit_s = options_.family == FirmwareFamily::Grbl ? 1.0 : 1e-3;
-        if (p != std::string::npos) dwell_s = std::strtod(upper.c_str() + p + 1, nullptr) * p_unit_s;
-        else if (sec != std::string::npos) dwell_s = std::strtod(upper.c_str() + sec + 1, nullptr);
+        if (const GcodeWord* p = find_word(words, 'P')) dwell_s = p->value * p_unit_s;
+        else if (const GcodeWord* sec = find_word(words, 'S')) dwell_s = sec->value;
         if (!std::isfinite(dwell_s) || dwell_s < 0) dwell_s = 0;
         return std::max(options_.long_command_timeout_s, std::min(dwell_s, 1e6) + line_timeout);
     }
-    for (const char* long_one : {"M109", "M190", "M116", "G28", "G29", "$H"}) {
-        if (has_word(long_one)) return std::max(options_.long_command_timeout_s, line_timeout);
+    const bool homing_cycle = line.text.size() >= 2 && line.text[0] == '$' && (line.text[1] == 'H' || line.text[1] == 'h');  // grbl's $H
+    if (homing_cycle || has_word('M', 109) || has_word('M', 190) || has_word('M', 116) || has_word('G', 28) || has_word('G', 29)) {
+        return std::max(options_.long_command_timeout_s, line_timeout);
     }
     return line_timeout;
 }
