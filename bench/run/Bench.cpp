@@ -589,95 +589,16 @@ std::vector<Finding> Bench::findings() const {
     return out;
 }
 
-RunReport Bench::make_report(const std::string& title) const {
-    RunReport r;
-    r.title = title;
-    r.timeline = &timeline_;
-    report_facts(r);
-    Mcu& first = *board_->mcus().front();
-    r.end_cycle = first.cycle();
-    r.end_clock_hz = first.frequency_hz();
-    report_plots(r);
-    report_faults(r);
-    report_transcripts(r);
-    report_timing(r);
-    r.findings = findings();
-    return r;
-}
+RunReport Bench::make_report(const std::string& title) const { return make_run_report(*this, title); }
 
-std::vector<bool> Bench::report_signal_mask() const {
-    std::vector<bool> keep(timeline_.signals().size(), false);
-    const auto mark = [&keep](long id) {
-        if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = true;
-    };
-    for (Part* p : board_->parts()) {
-        for (const PartSignalInfo& info : p->signals()) {
-            if (!info.role.empty()) mark(timeline_.find(p->name(), info.name));
-        }
-    }
-    for (Mcu* m : board_->mcus()) mark(timeline_.find(m->name(), "twi"));
-    return keep;
-}
+std::vector<bool> Bench::report_signal_mask() const { return avrbench::report_signal_mask(*this); }
 
-// The MCUs, the board, the simulated time and each MCU's I2C traffic.
-void Bench::report_facts(RunReport& r) const {
-    for (Mcu* m : board_->mcus()) {
-        r.facts.push_back("MCU " + m->name() + ": " + m->mcu_type() + " at " +
-                          std::to_string(m->frequency_hz() / 1000000.0).substr(0, 5) + " MHz, firmware " +
-                          m->elf().path());
-    }
-    r.facts.push_back("board: " + board_->spec().path);
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "simulated: %.6f s", now_seconds());
-    r.facts.push_back(buf);
-    // The I2C traffic each MCU's TWI took part in (its `twi` byte signal).
-    for (Mcu* m : board_->mcus()) {
-        const long twi = timeline_.find(m->name(), "twi");
-        if (twi < 0) continue;
-        std::size_t bytes = 0;
-        Cycle first_cycle = 0;
-        for (const TimelineEvent& e : timeline_.events()) {
-            if (e.signal != static_cast<SignalId>(twi)) continue;
-            if (bytes++ == 0) first_cycle = e.cycle;
-        }
-        if (bytes == 0) continue;
-        char text[160];
-        std::snprintf(text, sizeof text, "%zu bytes (addresses and data), the first at %.6f s", bytes,
-                      static_cast<double>(first_cycle) / m->frequency_hz());
-        r.facts.push_back("I2C " + m->name() + ".twi: " + text);
-    }
-}
+std::vector<Mcu*> Bench::mcus() const { return board_->mcus(); }
+std::vector<Part*> Bench::parts() const { return board_->parts(); }
+std::string Bench::board_path() const { return board_->spec().path; }
 
-void Bench::report_plots(RunReport& r) const {
-    // The report's plots come from what the parts' signals declare they are
-    // (PartSignalInfo::role), not from part types.
-    struct Declared {
-        Part* part;
-        const PartSignalInfo* info;
-        SignalId id;
-        std::size_t index;
-    };
-    std::vector<Declared> declared;
-    for (Part* p : board_->parts()) {
-        for (std::size_t i = 0; i < p->signals().size(); ++i) {
-            const PartSignalInfo& info = p->signals()[i];
-            if (info.role.empty()) continue;
-            const long id = timeline_.find(p->name(), info.name);
-            if (id >= 0) declared.push_back({p, &info, static_cast<SignalId>(id), i});
-        }
-    }
-    std::vector<Part*> plants;  // parts with a temperature, in board order
-    for (const Declared& d : declared) {
-        if (d.info->role == "position") {
-            // A position that never changed has nothing to plot.
-            if (d.part->signal_changes(d.index) > 0) r.axes.push_back({d.part->name(), d.id, d.info->unit == "deg"});
-        } else if (d.info->role == "temperature") {
-            plants.push_back(d.part);
-        } else if (d.info->role == "servo-angle") {
-            r.servos.push_back({d.part->name(), d.id});
-        }
-    }
-    // Temperature targets from the G-code the hosts sent (run/HeatTargets.hpp).
+std::map<const Part*, std::vector<std::pair<double, double>>> Bench::temperature_targets(const std::vector<Part*>& plants) const {
+    // From the G-code the hosts sent (run/HeatTargets.hpp).
     std::map<const Part*, std::vector<std::pair<double, double>>> targets;
     for (const auto& [name, host] : hosts_) {
         const std::uint32_t hz = port_of(name).mcu->frequency_hz();
@@ -689,38 +610,18 @@ void Bench::report_plots(RunReport& r) const {
             }
         }
     }
-    for (Part* plant : plants) {
-        TemperatureSeries series;
-        series.name = plant->name();
-        for (const Declared& d : declared) {
-            if (d.part == plant && d.info->role == "temperature") series.temperature_degC = d.id;
-            if (d.part == plant && d.info->role == "sensor-temperature") series.sensor_degC = d.id;
-            if (d.info->concerns != plant->name()) continue;
-            if (d.info->role == "heater-on") series.heater_on = d.id;
-            if (d.info->role == "heater-duty") series.duty = d.id;
-        }
-        series.target_steps = targets[plant];
-        r.temperatures.push_back(series);
-    }
-}
-
-void Bench::report_faults(RunReport& r) const {
-    for (Part* p : board_->parts()) {
-        for (const auto& f : p->fault_history()) {
-            r.faults.push_back({static_cast<double>(f.cycle) / p->clock().frequency_hz(), f.cycle,
-                                p->name() + ": " + (f.fault == "none" ? std::string("repaired") : f.fault)});
-        }
-    }
+    return targets;
 }
 
 // Each serial port's lines: the host's transcript, or the firmware's output.
-void Bench::report_transcripts(RunReport& r) const {
+std::vector<TranscriptLine> Bench::transcript() const {
+    std::vector<TranscriptLine> lines;
     for (const auto& port : serial_ports_) {
         const std::uint32_t hz = port.mcu->frequency_hz();
         auto host = hosts_.find(port.name);
         if (host != hosts_.end()) {
             for (const auto& e : host->second->transcript()) {
-                r.transcript.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
+                lines.push_back({e.cycle, hz, e.direction == Direction::Sent, e.text});
             }
             continue;
         }
@@ -731,33 +632,15 @@ void Bench::report_transcripts(RunReport& r) const {
         for (const auto& b : port.link().transmitted()) {
             if (line.empty()) line_start = b.cycle;
             if (b.value == '\n') {
-                r.transcript.push_back({line_start, hz, false, line});
+                lines.push_back({line_start, hz, false, line});
                 line.clear();
             } else if (b.value != '\r') {
                 line.push_back(static_cast<char>(b.value));
             }
         }
-        if (!line.empty()) r.transcript.push_back({line_start, hz, false, line});
+        if (!line.empty()) lines.push_back({line_start, hz, false, line});
     }
-}
-
-// The profiled MCUs' timing (mcu/TimingProfile.hpp).
-void Bench::report_timing(RunReport& r) const {
-    for (Mcu* m : board_->mcus()) {
-        const TimingProfiler* p = m->profile();
-        if (p == nullptr) continue;
-        TimingTable t;
-        t.mcu = m->name();
-        t.facts = p->summary_lines();
-        for (const auto& [vector, v] : p->vectors()) {
-            auto stats = [](const CycleStats& s) { return std::array<Cycle, 4>{s.min(), s.median(), s.p99(), s.max()}; };
-            t.rows.push_back({vector, v.runs, v.max_depth, stats(v.inclusive_cycles), stats(v.exclusive_cycles),
-                              stats(v.latency_cycles)});
-        }
-        // The per-vector lines are the table; the facts are the rest.
-        t.facts.resize(t.facts.size() - std::min(t.facts.size(), p->vectors().size()));
-        r.timing.push_back(std::move(t));
-    }
+    return lines;
 }
 
 }  // namespace avrbench

@@ -23,6 +23,7 @@
 #include "parts/HostConnector.hpp"
 #include "stimulus/UartHost.hpp"
 #include "trace/Recorder.hpp"
+#include "trace/ReportOfRun.hpp"
 #include "trace/RunReport.hpp"
 #include "trace/Timeline.hpp"
 
@@ -58,7 +59,7 @@ struct SerialPort {
 // A host's options as the board file's serial port declares them.
 UartHostOptions default_host_options(const SerialPort& port);
 
-class Bench {
+class Bench final : public RunView {
 public:
     // The ELF runs on the board's first MCU.
     Bench(const std::string& board_file, const std::string& elf);
@@ -130,7 +131,7 @@ public:
     };
     IdleResult run_to_ps(Picoseconds end_ps, const RunSlices& how);
     Picoseconds now_ps() const { return board_->now_ps(); }
-    double now_seconds() const { return board_->now_seconds(); }
+    double now_seconds() const override { return board_->now_seconds(); }
     // Simulated time of the last STEP edge any driver counted, or -1.
     double last_step_seconds() const { return last_step_ps_ ? seconds_from_ps(*last_step_ps_) : -1.0; }
 
@@ -146,7 +147,7 @@ public:
 
     // Board findings plus one HostProtocol finding per host error, alarm,
     // fatal answer or timeout.
-    std::vector<Finding> findings() const;
+    std::vector<Finding> findings() const override;
 
     // What the HTML report needs about this run (the timeline must be traced).
     RunReport make_report(const std::string& title) const;
@@ -156,13 +157,16 @@ public:
     // these in memory (Timeline::keep_when_taken) and still reports the same.
     std::vector<bool> report_signal_mask() const;
 
+    // What a report reads of the run (trace/ReportOfRun.hpp).
+    const Timeline& timeline() const override { return timeline_; }
+    std::vector<Mcu*> mcus() const override;
+    std::vector<Part*> parts() const override;
+    std::string board_path() const override;
+    std::vector<TranscriptLine> transcript() const override;
+    std::map<const Part*, std::vector<std::pair<double, double>>> temperature_targets(
+        const std::vector<Part*>& plants) const override;
+
 private:
-    // make_report's parts.
-    void report_facts(RunReport& r) const;
-    void report_plots(RunReport& r) const;
-    void report_faults(RunReport& r) const;
-    void report_transcripts(RunReport& r) const;
-    void report_timing(RunReport& r) const;
     void watch_motion();
     // G0/G1 targets the firmware answers ok to, checked against the board's
     // machines that can judge them (parts/DeltaRobot: target-out-of-reach);
