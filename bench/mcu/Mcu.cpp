@@ -226,6 +226,7 @@ std::string Mcu::describe_pc(std::uint32_t pc_bytes) const {
 Mcu::~Mcu() {
     profiler_.reset();  // unhooks from the core's IRQs
     uarts_.clear();
+    spi_.reset();
     pins_.clear();
     adc_.reset();
     twi_.reset();
@@ -452,6 +453,14 @@ Pin& Mcu::pin(std::string_view name) {
         slot = std::make_unique<Pin>(avr_, canonical, irq, ioport, bit);
     }
     return *slot;
+}
+
+Spi* Mcu::spi() {
+    if (!spi_looked_for_) {
+        spi_looked_for_ = true;
+        spi_ = Spi::install(avr_);
+    }
+    return spi_.get();
 }
 
 Uart& Mcu::uart(int index) {

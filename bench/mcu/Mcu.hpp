@@ -21,6 +21,7 @@
 #include "core/Scheduler.hpp"
 #include "periph/SimavrFixes.hpp"
 #include "core/SimavrLog.hpp"
+#include "periph/spi/Spi.hpp"
 #include "periph/usart/Uart.hpp"
 #include "core/Time.hpp"
 
@@ -210,6 +211,9 @@ public:
     Scheduler& scheduler() { return *scheduler_; }
     // The TWI (I2C) module, or nullptr when the bench does not model the MCU's.
     Twi* twi() { return twi_.get(); }
+    // The SPI master as the bench's SPI slave parts see it (periph/spi/Spi.hpp),
+    // made on first use; nullptr when the part has no SPI.
+    Spi* spi();
     // The ADC: analog sources per channel, pin -> channel (periph/adc/Adc.hpp).
     Adc& adc() { return *adc_; }
 
@@ -350,6 +354,8 @@ private:
     PeerSync* peer_sync_ = nullptr;
     std::map<std::string, std::unique_ptr<Pin>, std::less<>> pins_;
     std::map<int, std::unique_ptr<Uart>> uarts_;
+    std::unique_ptr<Spi> spi_;
+    bool spi_looked_for_ = false;
     FindingLog<Finding> findings_;
 
     // Oracle thresholds, precomputed so the hot loop only compares.

@@ -15,7 +15,7 @@ namespace avrbench {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kCli = ::avrbench::test::cli();
+const std::string kWorkflowCli = ::avrbench::test::cli();
 const std::string kFw = std::string(" --firmware-dir ") + ::avrbench::test::firmware_dir();
 
 fs::path write(const fs::path& path, const std::string& text) {
@@ -35,7 +35,7 @@ TEST(CheckBatch, ABrokenScenarioIsOneErrorResultAndTheOthersStillRun) {
                                                  "expect:\n  - steps: {axis: w, count: 3}\n");
     const fs::path also_good = write(dir / "also_good.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\n");
     const fs::path junit = dir / "j.xml";
-    const auto r = test::run_command(kCli + " check " + good.string() + " " + bad.string() + " " + also_good.string() +
+    const auto r = test::run_command(kWorkflowCli + " check " + good.string() + " " + bad.string() + " " + also_good.string() +
                                          kFw + " --junit " + junit.string(), dir);
     EXPECT_EQ(r.exit_code, 2) << r.out << r.err;  // an input error in the batch
     EXPECT_NE(r.out.find("PASS good"), std::string::npos) << r.out;
@@ -56,7 +56,7 @@ TEST(CheckBatch, ABrokenScenarioIsOneErrorResultAndTheOthersStillRun) {
 TEST(CheckBatch, VcdDirHoldsEachScenariosWaveforms) {
     const auto dir = test::scratch_dir("vcd-dir");
     const fs::path blink = write(dir / "blink.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 20ms\n");
-    const auto r = test::run_command(kCli + " check " + blink.string() + kFw + " --vcd-dir " + (dir / "waves").string(), dir);
+    const auto r = test::run_command(kWorkflowCli + " check " + blink.string() + kFw + " --vcd-dir " + (dir / "waves").string(), dir);
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("  waveforms: " + (dir / "waves/blink.vcd").string() + " (gtkwave " + (dir / "waves/blink.gtkw").string() + ")"),
               std::string::npos)
@@ -95,7 +95,7 @@ TEST(CheckBatch, ScenarioIsValidatedBeforeAnySimulation) {
     for (const auto& c : cases) {
         const fs::path path = write(dir / ("s" + std::to_string(n++) + ".yaml"),
                                     "board: " + (c.cnc_board ? cnc() : uno()) + "\nfirmware: {uno: blink_timer1}\nsteps:\n" + c.body);
-        const auto r = test::run_command(kCli + " check " + path.string() + kFw, dir, 30);
+        const auto r = test::run_command(kWorkflowCli + " check " + path.string() + kFw, dir, 30);
         EXPECT_EQ(r.exit_code, 2) << c.body << r.out << r.err;
         EXPECT_NE(r.err.find(path.string() + c.message), std::string::npos) << c.message << "\n" << r.err;
     }
@@ -105,7 +105,7 @@ TEST(BoardSerial, UartInAndOutWorkOnABoardWithAndWithoutGcode) {
     const auto dir = test::scratch_dir("board-serial");
     const fs::path in = write(dir / "in.txt", "hello\n");
     const fs::path out = dir / "out.txt";
-    const auto r = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") + " --for 20ms" +
+    const auto r = test::run_command(kWorkflowCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") + " --for 20ms" +
                                          " --uart-in " + in.string() + " --uart-out host=" + out.string(), dir);
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     // The firmware's banner, then its echo of what it was sent (firmware/uart_echo).
@@ -113,7 +113,7 @@ TEST(BoardSerial, UartInAndOutWorkOnABoardWithAndWithoutGcode) {
     // The summary shows the port's traffic and last lines without --gcode.
     EXPECT_NE(r.out.find("serial host 26 bytes from firmware, 6 bytes to firmware; last lines:\n    avrbench uart_echo\n    hello\n"),
               std::string::npos) << r.out;
-    const auto bad_port = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") +
+    const auto bad_port = test::run_command(kWorkflowCli + " run -q --board " + uno() + " " + test::firmware("uart_echo") +
                                                 " --for 1ms --uart-out debug=" + out.string(), dir);
     EXPECT_EQ(bad_port.exit_code, 2);
     EXPECT_NE(bad_port.err.find("no serial port 'debug' (ports: host)"), std::string::npos) << bad_port.err;
@@ -122,7 +122,7 @@ TEST(BoardSerial, UartInAndOutWorkOnABoardWithAndWithoutGcode) {
 TEST(OutputPaths, BadPathsFailBeforeTheRunWithOneLine) {
     const auto dir = test::scratch_dir("out-paths");
     write(dir / "a_file", "x");
-    const std::string run = kCli + " run -q --board " + uno() + " " + test::firmware("busy_poll") + " --for 1000s ";
+    const std::string run = kWorkflowCli + " run -q --board " + uno() + " " + test::firmware("busy_poll") + " --for 1000s ";
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"--vcd /nonexistent/x.vcd", "avrbench: error: --vcd: /nonexistent/x.vcd: the folder /nonexistent does not exist\n"},
         {"--report /nonexistent/r.html", "avrbench: error: --report: /nonexistent/r.html: the folder /nonexistent does not exist\n"},
@@ -144,14 +144,14 @@ TEST(OutputPaths, ADeviceOrFifoTargetIsRefusedAndLeftInPlace) {
     const auto dir = test::scratch_dir("out-device");
     const fs::path fifo = dir / "fifo";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
-    const auto r = test::run_command(kCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + fifo.string(), dir, 20);
+    const auto r = test::run_command(kWorkflowCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + fifo.string(), dir, 20);
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_TRUE(fs::is_fifo(fifo)) << "the bench removed a file it did not create";
     // As root a character device can be made (mknod c 1 7 is /dev/full);
     // as another user mknod is refused and the FIFO above stands for it.
     const fs::path device = dir / "fd";
     if (::mknod(device.c_str(), S_IFCHR | 0644, makedev(1, 7)) == 0) {
-        const auto d = test::run_command(kCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + device.string(), dir, 20);
+        const auto d = test::run_command(kWorkflowCli + " run -q " + test::firmware("blink_timer1") + " --for 1ms --vcd " + device.string(), dir, 20);
         EXPECT_EQ(d.exit_code, 2) << d.err;
         EXPECT_TRUE(fs::is_character_file(device)) << "the bench removed a device node";
     }
@@ -159,7 +159,7 @@ TEST(OutputPaths, ADeviceOrFifoTargetIsRefusedAndLeftInPlace) {
 
 TEST(OutputPaths, SummaryToAFullDiskIsAnError) {
     const auto dir = test::scratch_dir("stdout-full");
-    const auto r = test::run_command(kCli + " run " + test::firmware("blink_timer1") + " --for 1ms > /dev/full", dir, 20);
+    const auto r = test::run_command(kWorkflowCli + " run " + test::firmware("blink_timer1") + " --for 1ms > /dev/full", dir, 20);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, "avrbench: error: cannot write to standard output\n");
 }
@@ -173,7 +173,7 @@ TEST(Interrupt, SigintEndsALongRunWritingWhatWasRecorded) {
         std::filesystem::remove(vcd);
         // 1000 s of simulation would take many minutes; SIGINT comes after 2 s.
         // busy_poll never idles (blink_timer1's idle loop is skipped: 1000 s in 0.6 s).
-        const auto r = test::run_command("timeout --preserve-status -s INT 2 " + kCli + " run -q" + board + " " +
+        const auto r = test::run_command("timeout --preserve-status -s INT 2 " + kWorkflowCli + " run -q" + board + " " +
                                              test::firmware("busy_poll") + " --for 1000s --vcd " + vcd, dir, 60);
         EXPECT_EQ(r.exit_code, 130) << board << r.err;
         EXPECT_NE(r.err.find("avrbench: interrupted at "), std::string::npos) << r.err;
@@ -188,7 +188,7 @@ TEST(Interrupt, SigintEndsALongRunWritingWhatWasRecorded) {
 // the dump (the demo's job: moves, UART traffic, part signals).
 TEST(BoardRun, AReportDoesNotChangeTheStreamedVcd) {
     const auto dir = test::scratch_dir("vcd-streamed");
-    const std::string base = kCli + " run -q --board arduino-uno-cnc-shield-v3 " + test::firmware("stepdir_test") + " --gcode " +
+    const std::string base = kWorkflowCli + " run -q --board arduino-uno-cnc-shield-v3 " + test::firmware("stepdir_test") + " --gcode " +
                              test::source_path("tests/scenarios/jobs/demo_square.gcode") + " --family generic --vcd ";
     const auto streamed = test::run_command(base + (dir / "streamed.vcd").string(), dir, 120);
     const auto whole = test::run_command(base + (dir / "whole.vcd").string() + " --report " + (dir / "r.html").string(), dir, 120);
@@ -202,7 +202,7 @@ TEST(BoardRun, AReportDoesNotChangeTheStreamedVcd) {
 // A board whose only MCU halted says when it halted, not "0 s".
 TEST(BoardRun, AHaltedBoardReportsTheTimeItHalted) {
     const auto dir = test::scratch_dir("halted-board");
-    const auto r = test::run_command(kCli + " run -q --board " + uno() + " " + test::firmware("crash_bad_opcode") + " --for 10ms", dir);
+    const auto r = test::run_command(kWorkflowCli + " run -q --board " + uno() + " " + test::firmware("crash_bad_opcode") + " --for 10ms", dir);
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_EQ(r.out.find("simulated  0.000000 s"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("simulated  0.0000"), std::string::npos) << r.out;  // microseconds after reset
@@ -213,12 +213,12 @@ TEST(GoldenUpdate, RefusesAFailingRunUnlessForced) {
     // blink_timer1 has no serial output and no findings: expecting one fails.
     const fs::path scenario = write(dir / "s.yaml", "board: " + uno() + "\nfirmware: {uno: blink_timer1}\nsteps:\n  - delay: 5ms\n"
                                                     "expect:\n  - findings: 1\ngolden: s.timeline\n");
-    const auto r = test::run_command(kCli + " golden update " + scenario.string() + kFw, dir);
+    const auto r = test::run_command(kWorkflowCli + " golden update " + scenario.string() + kFw, dir);
     EXPECT_EQ(r.exit_code, 1) << r.out;
     EXPECT_NE(r.out.find("expect findings (" + scenario.string() + ":6): 0 findings, expected 1"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("golden: not updated"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(dir / "s.timeline"));
-    const auto forced = test::run_command(kCli + " golden update --force " + scenario.string() + kFw, dir);
+    const auto forced = test::run_command(kWorkflowCli + " golden update --force " + scenario.string() + kFw, dir);
     EXPECT_EQ(forced.exit_code, 1) << forced.out;  // still a failing run, but written
     EXPECT_TRUE(fs::exists(dir / "s.timeline"));
 }
@@ -233,7 +233,7 @@ TEST(GoldenUpdate, GoldenIsTheSameWhereverTheCommandRuns) {
                                     "golden: s.timeline\n");
     const fs::path golden = dir / "project" / "tests" / "s.timeline";
     auto update_from = [&](const fs::path& cwd, const std::string& scenario_arg) {
-        const auto r = test::run_command("cd " + cwd.string() + " && " + kCli + " golden update " + scenario_arg + kFw, dir);
+        const auto r = test::run_command("cd " + cwd.string() + " && " + kWorkflowCli + " golden update " + scenario_arg + kFw, dir);
         EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
         return test::slurp(golden);
     };
@@ -248,7 +248,7 @@ TEST(GoldenUpdate, GoldenIsTheSameWhereverTheCommandRuns) {
 TEST(Gtkw, SaveFileNamesTheDumpRelativeToItself) {
     const auto dir = test::scratch_dir("gtkw-path");
     fs::create_directories(dir / "traces");
-    const auto r = test::run_command("cd " + dir.string() + " && " + kCli + " run -q " + test::firmware("blink_timer1") +
+    const auto r = test::run_command("cd " + dir.string() + " && " + kWorkflowCli + " run -q " + test::firmware("blink_timer1") +
                                          " --for 2ms --vcd traces/demo.vcd", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::string gtkw = test::slurp(dir / "traces" / "demo.gtkw");

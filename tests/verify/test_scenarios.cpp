@@ -19,7 +19,7 @@ namespace avrbench {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kCli = ::avrbench::test::cli();
+const std::string kScenarioCli = ::avrbench::test::cli();
 
 // A blink scenario in `dir` running `firmware`, with its golden in `dir`.
 fs::path write_blink_scenario(const fs::path& dir, const std::string& name, const std::string& firmware) {
@@ -34,7 +34,7 @@ fs::path write_blink_scenario(const fs::path& dir, const std::string& name, cons
 }
 
 std::string check(const fs::path& scenario, const fs::path& dir, int* exit_code, const std::string& extra = "") {
-    const auto r = test::run_command(kCli + " check " + scenario.string() + " --firmware-dir " + ::avrbench::test::firmware_dir() +
+    const auto r = test::run_command(kScenarioCli + " check " + scenario.string() + " --firmware-dir " + ::avrbench::test::firmware_dir() +
                                          " --report-dir " + (dir / "reports").string() + extra, dir);
     *exit_code = r.exit_code;
     return r.out + r.err;
@@ -74,7 +74,7 @@ TEST(Scenarios, ShiftedTimerFailsNamingTheChannelAndFirstEdgeThenGoldenUpdateAcc
     EXPECT_NE(junit.find("<failure message=\"golden: uno.PB1 diverges"), std::string::npos) << junit;
 
     // Accept the change explicitly; the check passes afterwards.
-    const auto update = test::run_command(kCli + " golden update " + scenario.string() + " --firmware-dir " +
+    const auto update = test::run_command(kScenarioCli + " golden update " + scenario.string() + " --firmware-dir " +
                                               ::avrbench::test::firmware_dir(), dir);
     ASSERT_EQ(update.exit_code, 0) << update.out << update.err;
     // The new golden toggles every (250 + 1) * 64 = 16064 cycles.
@@ -163,11 +163,11 @@ TEST(Scenarios, ShardingSplitsTheScenarioList) {
     const fs::path a = write_blink_scenario(dir, "first", "blink_timer1");
     const fs::path b = write_blink_scenario(dir, "second", "blink_timer1");
     for (const auto& s : {a, b}) {
-        ASSERT_EQ(test::run_command(kCli + " golden update " + s.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir)
+        ASSERT_EQ(test::run_command(kScenarioCli + " golden update " + s.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir)
                       .exit_code,
                   0);
     }
-    const auto shard1 = test::run_command("GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=1 " + kCli + " check " + a.string() +
+    const auto shard1 = test::run_command("GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=1 " + kScenarioCli + " check " + a.string() +
                                               " " + b.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
     EXPECT_EQ(shard1.exit_code, 0) << shard1.out;
     EXPECT_EQ(shard1.out.find("first"), std::string::npos) << shard1.out;
@@ -181,7 +181,7 @@ TEST(Scenarios, MalformedScenarioIsOneLineWithExitCode2) {
     std::ofstream(path) << "board: " << test::source_path("bench/boards/arduino-uno.yaml") << "\n"
                         << "firmware: {uno: blink_timer1}\n"
                         << "steps:\n  - dance: 3\n";
-    const auto r = test::run_command(kCli + " check " + path.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
+    const auto r = test::run_command(kScenarioCli + " check " + path.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, "avrbench: error: " + path.string() +
                          ":4: unknown step 'dance' (known: delay, inject_fault, release_input, send, send_file, set_input, "

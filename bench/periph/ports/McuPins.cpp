@@ -59,6 +59,24 @@ std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index) {
     return it->second[static_cast<std::size_t>(index)];
 }
 
+std::optional<SpiPins> spi_pins(const std::string& mcu_type) {
+    static const std::map<std::string, SpiPins> table = [] {
+        const SpiPins mega48_328 = {"PB5", "PB3", "PB4", "PB2"};
+        const SpiPins mega2560 = {"PB1", "PB2", "PB3", "PB0"};
+        const SpiPins mega16_1284 = {"PB7", "PB5", "PB6", "PB4"};
+        return std::map<std::string, SpiPins>{
+            {"atmega48", mega48_328},    {"atmega88", mega48_328},   {"atmega168", mega48_328},
+            {"atmega168p", mega48_328},  {"atmega328", mega48_328},  {"atmega328p", mega48_328},
+            {"atmega1280", mega2560},    {"atmega2560", mega2560},
+            {"atmega16", mega16_1284},   {"atmega32", mega16_1284},  {"atmega164", mega16_1284},
+            {"atmega324", mega16_1284},  {"atmega644", mega16_1284}, {"atmega1284", mega16_1284},
+        };
+    }();
+    auto it = table.find(mcu_type);
+    if (it == table.end()) return std::nullopt;
+    return it->second;
+}
+
 bool pin_may_feed_an_interrupt(const std::string& mcu_type, char port, int bit) {
     struct PortBit {
         char port;

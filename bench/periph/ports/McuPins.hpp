@@ -27,6 +27,16 @@ struct UsartPins {
 // std::nullopt for a USART or MCU type the table does not know.
 std::optional<UsartPins> usart_pins(const std::string& mcu_type, int index);
 
+// The SPI pins: SCK, MOSI, MISO and SS (each as "PB5").
+struct SpiPins {
+    std::string sck, mosi, miso, ss;
+};
+// From the datasheets' alternate port functions (ATmega328P Table 14-3: SS
+// PB2, MOSI PB3, MISO PB4, SCK PB5; ATmega2560 Table 13-6: SS PB0, SCK PB1,
+// MOSI PB2, MISO PB3; ATmega16/32/164..1284: SS PB4, MOSI PB5, MISO PB6,
+// SCK PB7). std::nullopt for an MCU type the table does not know.
+std::optional<SpiPins> spi_pins(const std::string& mcu_type);
+
 // True when a level change on P<port><bit> can start an interrupt through a
 // peripheral other than INTn, PCINTn and the analog comparator's multiplexer
 // (which Mcu::pin_change_may_interrupt reads from the MCU's registers): an
