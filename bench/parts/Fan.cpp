@@ -24,6 +24,12 @@ std::vector<ParamSpec> Fan::param_specs() {
          .help = "first-order lag of the speed behind the drive"},
         {.name = "sample_interval", .type = PT::Quantity, .dimension = D::Time, .default_value = "50ms",
          .source = "assumed", .help = "how often the plant gets the current speed"},
+        {.name = "full_speed_rpm", .type = PT::Integer, .default_value = "5000",
+         .source = "assumed: a 40 mm fan at full speed (Noctua NF-A4x10 5V: 5000 rpm)",
+         .help = "revolutions per minute at full drive (the tachometer's rate)", .min = 1, .max = 100000},
+        {.name = "pulses_per_rev", .type = PT::Integer, .default_value = "2",
+         .source = "Intel 4-Wire PWM Fan Specification rev. 1.3: two tachometer pulses per revolution",
+         .help = "tachometer periods per revolution", .min = 1, .max = 16},
     };
 }
 
@@ -36,8 +42,12 @@ Fan::Fan(std::string name, Mcu& clock, const ParamValues& params) : Part(std::mo
     }
     sample_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     pwm_pin_ = add_pin("pwm", TerminalRole::Input);
+    tach_pin_ = add_pin("tach", TerminalRole::Output);
+    full_speed_rpm_ = static_cast<double>(params.integer("full_speed_rpm"));
+    pulses_per_rev_ = static_cast<unsigned>(params.integer("pulses_per_rev"));
+    add_readout("rpm", [this] { return rpm(); });
     sig_speed_ = add_signal("speed", true, 0);
-    require_port<ThermalBody>("body", true, "the thermal_plant it cools",
+    require_port<ThermalBody>("body", false, "the thermal_plant it cools (none: a fan that cools nothing modelled, a heat sink's)",
                               [this](ThermalBody& body) { connect_body(body); });
 }
 
@@ -48,6 +58,36 @@ void Fan::start() {
     last_cycle_ = clock().cycle();
     update();
     clock().scheduler().at(last_cycle_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
+    if (connected(tach_pin_)) release_output(tach_pin_);
+}
+
+// Below this fraction of full speed the tachometer gives no edges (a fan
+// that is not turning; its next check is the next sample).
+constexpr double kSlowestTachSpeed = 0.01;
+
+// The next tachometer edge: half a period at the present speed, the speed
+// taken as constant for that half period (it changes over the spin time
+// constant, hundreds of half periods).
+void Fan::schedule_tach(Cycle from) {
+    const double revs_per_s = speed() * full_speed_rpm_ / 60.0;
+    if (speed() < kSlowestTachSpeed || revs_per_s <= 0) {
+        tach_running_ = false;
+        return;
+    }
+    const double half_period_s = 1.0 / (2.0 * revs_per_s * pulses_per_rev_);
+    tach_running_ = true;
+    clock().scheduler().at(from + std::max<Cycle>(1, clock().cycles_from_seconds(half_period_s)), [this](Cycle c) { on_tach(c); });
+}
+
+void Fan::on_tach(Cycle scheduled) {
+    tach_low_ = !tach_low_;
+    ++tach_edges_;
+    if (tach_low_) {
+        drive_output(tach_pin_, false);
+    } else {
+        release_output(tach_pin_);
+    }
+    schedule_tach(scheduled);
 }
 
 // Exact solution of tau ds/dt = drive - s over the time since the last event.
@@ -91,10 +131,11 @@ void Fan::on_sample(Cycle scheduled) {
     // Within 1e-4 of its target the speed counts as there.
     const double target = driven_ ? 1.0 : 0.0;
     const double s = std::abs(speed_ - target) < 1e-4 ? target : speed_;
-    if (std::abs(s - plant_->fan_speed()) >= 1e-4 || (s == target && plant_->fan_speed() != target)) {
+    if (plant_ != nullptr && (std::abs(s - plant_->fan_speed()) >= 1e-4 || (s == target && plant_->fan_speed() != target))) {
         plant_->set_fan_speed(s);
     }
     publish(sig_speed_, speed_);
+    if (!tach_running_ && connected(tach_pin_)) schedule_tach(scheduled);
     clock().scheduler().at(scheduled + sample_cycles_, [this](Cycle c) { on_sample(c); });
 }
 

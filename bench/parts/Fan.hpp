@@ -5,6 +5,7 @@
 // (ThermalPlant). Fault "stopped": a seized or unplugged fan, which spins down.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -28,6 +29,8 @@ public:
     void start() override;
 
     double speed() const;   // 0..1 of full speed, now
+    double rpm() const { return speed() * full_speed_rpm_; }
+    std::uint64_t tach_edges() const { return tach_edges_; }
     bool driven() const { return driven_; }
     void inject(Fault fault, Cycle at_cycle);
     std::vector<std::string> fault_names() const override { return {"stopped"}; }
@@ -39,6 +42,8 @@ private:
     void update();
     void settle_speed();
     void on_sample(Cycle scheduled);
+    void on_tach(Cycle scheduled);
+    void schedule_tach(Cycle from);
 
     ThermalBody* plant_ = nullptr;
     std::size_t pwm_pin_;
@@ -50,6 +55,12 @@ private:
     Cycle last_cycle_ = 0;
     Cycle sample_cycles_;
     std::size_t sig_speed_;
+    std::size_t tach_pin_;
+    double full_speed_rpm_;
+    unsigned pulses_per_rev_;
+    bool tach_low_ = false;
+    bool tach_running_ = false;
+    std::uint64_t tach_edges_ = 0;
 };
 
 }  // namespace avrbench
