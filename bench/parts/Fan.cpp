@@ -27,6 +27,9 @@ std::vector<ParamSpec> Fan::param_specs() {
         {.name = "full_speed_rpm", .type = PT::Integer, .default_value = "5000",
          .source = "assumed: a 40 mm fan at full speed (Noctua NF-A4x10 5V: 5000 rpm)",
          .help = "revolutions per minute at full drive (the tachometer's rate)", .min = 1, .max = 100000},
+        {.name = "tach_pullup", .type = PT::Quantity, .dimension = D::Resistance, .default_value = "0ohm",
+         .source = "the board's pull-up on the tachometer line (0: none, the MCU's own if the firmware enables it)",
+         .help = "pull-up resistor on the open-collector tachometer output", .min = 0, .max = 1e7},
         {.name = "pulses_per_rev", .type = PT::Integer, .default_value = "2",
          .source = "Intel 4-Wire PWM Fan Specification rev. 1.3: two tachometer pulses per revolution",
          .help = "tachometer periods per revolution", .min = 1, .max = 16},
@@ -45,6 +48,7 @@ Fan::Fan(std::string name, Mcu& clock, const ParamValues& params) : Part(std::mo
     tach_pin_ = add_pin("tach", TerminalRole::Output);
     full_speed_rpm_ = static_cast<double>(params.integer("full_speed_rpm"));
     pulses_per_rev_ = static_cast<unsigned>(params.integer("pulses_per_rev"));
+    tach_pullup_ohm_ = params.quantity("tach_pullup");
     add_readout("rpm", [this] { return rpm(); });
     sig_speed_ = add_signal("speed", true, 0);
     require_port<ThermalBody>("body", false, "the thermal_plant it cools (none: a fan that cools nothing modelled, a heat sink's)",
@@ -58,7 +62,16 @@ void Fan::start() {
     last_cycle_ = clock().cycle();
     update();
     clock().scheduler().at(last_cycle_ + sample_cycles_, [this](Cycle c) { on_sample(c); });
-    if (connected(tach_pin_)) release_output(tach_pin_);
+    if (connected(tach_pin_)) release_tach();
+}
+
+// The open collector off: the line is what its pull-up (or nothing) makes it.
+void Fan::release_tach() {
+    if (tach_pullup_ohm_ > 0) {
+        pull_output(tach_pin_, true, tach_pullup_ohm_);
+    } else {
+        release_output(tach_pin_);
+    }
 }
 
 // Below this fraction of full speed the tachometer gives no edges (a fan
@@ -85,7 +98,7 @@ void Fan::on_tach(Cycle scheduled) {
     if (tach_low_) {
         drive_output(tach_pin_, false);
     } else {
-        release_output(tach_pin_);
+        release_tach();
     }
     schedule_tach(scheduled);
 }

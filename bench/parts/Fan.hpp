@@ -44,6 +44,7 @@ private:
     void on_sample(Cycle scheduled);
     void on_tach(Cycle scheduled);
     void schedule_tach(Cycle from);
+    void release_tach();
 
     ThermalBody* plant_ = nullptr;
     std::size_t pwm_pin_;
@@ -58,6 +59,7 @@ private:
     std::size_t tach_pin_;
     double full_speed_rpm_;
     unsigned pulses_per_rev_;
+    double tach_pullup_ohm_;
     bool tach_low_ = false;
     bool tach_running_ = false;
     std::uint64_t tach_edges_ = 0;

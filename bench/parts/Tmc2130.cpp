@@ -85,7 +85,10 @@ Tmc2130::Tmc2130(std::string name, Mcu& clock, const ParamValues& params) : Part
     cs_pin_ = add_pin("cs", TerminalRole::Input);
     sck_pin_ = add_pin("sck", TerminalRole::Input);
     mosi_pin_ = add_pin("mosi", TerminalRole::Input);
-    miso_pin_ = add_pin("miso", TerminalRole::Output);
+    // SDO: the bytes travel at byte level through the MCU's SPI
+    // (periph/spi/Spi.hpp), so the pin only marks the bus; as an output it
+    // would fight every other slave's on the shared MISO net.
+    miso_pin_ = add_pin("miso", TerminalRole::Input);
     diag0_pin_ = add_pin("diag0", TerminalRole::Output);
     diag1_pin_ = add_pin("diag1", TerminalRole::Output);
     const long long microsteps = params.integer("microsteps");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "boards/Board.hpp"
+#include "boards/BoardFile.hpp"
 #include "parts/Axis.hpp"
 #include "parts/SpiBus.hpp"
 #include "parts/Tmc2130.hpp"
@@ -141,6 +142,27 @@ TEST(Tmc2130, AnSpiPinOnTheWrongNetIsABoardError) {
     } catch (const BadInput& e) {
         EXPECT_NE(std::string(e.what()).find("must share a net with PB1"), std::string::npos) << e.what();
     }
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(PrusaMk3sBoard, HomesXSensorlessAgainstTheEndOfItsTravel) {
+    // The standard board: X starts mid-travel at 127.5 mm, 100 steps/mm at
+    // 1/16; the stall-homing firmware drives it to 0 (12750 microsteps) and the
+    // 12751st finds it blocked: stallGuard2 on DIAG1, the firmware stops.
+    Board board(load_board_file("prusa-mk3s"), {{"mega", test::firmware("tmc2130_stall_home")}});
+    board.run_for_seconds(2);
+    ASSERT_EQ(board.mcu().read_ram_u8("done"), 1);
+    auto& x = dynamic_cast<Tmc2130&>(board.part("x_driver"));
+    EXPECT_EQ(x.steps_taken(), 12751u);
+    EXPECT_TRUE(x.stalled());
+    EXPECT_NEAR(dynamic_cast<Axis&>(board.part("x")).position_mm(), 0.0, 1e-9);
+    // 12750 = 796 * 16 + 14: the stall comes in the 797th full-step loop.
+    EXPECT_EQ(board.mcu().read_ram_u16("steps_to_stall"), 797);
 }
 
 }  // namespace
