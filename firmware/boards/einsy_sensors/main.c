@@ -12,6 +12,10 @@
 #include <stdint.h>
 #include <util/delay.h>
 
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
 volatile uint16_t tach_falls;
 volatile uint16_t probe_steps;
 volatile uint8_t done;

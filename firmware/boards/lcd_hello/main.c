@@ -13,6 +13,10 @@
 #include <stdint.h>
 #include <util/delay.h>
 
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
 volatile uint8_t done;
 
 static void pin(volatile uint8_t* port, uint8_t bit, uint8_t on) {

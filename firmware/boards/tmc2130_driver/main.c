@@ -23,6 +23,10 @@
 #include <stdint.h>
 #include <util/delay.h>
 
+#include "avrbench_mcu.h"
+
+AVRBENCH_MCU_SECTION();
+
 #ifndef SGT_VALUE
 #define SGT_VALUE 0
 #endif

@@ -56,4 +56,22 @@ static __attribute__((noinline, unused)) uint8_t read_pin_b(uint8_t bit)
 #define IO_PORTB _SFR_IO_ADDR(PORTB)
 #define IO_PINB _SFR_IO_ADDR(PINB)
 
+// SPI pins (ATmega328P Table 14-3, ATmega2560 Table 13-6, ATmega32 PB4..PB7).
+#if defined(__AVR_ATmega2560__) || defined(__AVR_ATmega1280__)
+#define SPI_DDR DDRB
+#define SPI_SS PB0
+#define SPI_SCK PB1
+#define SPI_MOSI PB2
+#elif defined(__AVR_ATmega32__) || defined(__AVR_ATmega16__)
+#define SPI_DDR DDRB
+#define SPI_SS PB4
+#define SPI_SCK PB7
+#define SPI_MOSI PB5
+#else
+#define SPI_DDR DDRB
+#define SPI_SS PB2
+#define SPI_SCK PB5
+#define SPI_MOSI PB3
+#endif
+
 #endif

@@ -1,0 +1,45 @@
+// SPI master timing and write collision (firmware/conformance/peripherals/
+// spi_timing): a byte takes 8 SCK periods, SCK = f_osc/4, 16, 64, 128 by
+// SPR1:0 and twice as fast with SPI2X (ATmega328P §19.5 Table 19-5,
+// ATmega2560 §21.2 Table 21-5); SPDR written during a transfer sets WCOL
+// (328P §19.5.2, 2560 §21.2.2).
+#include "conformance_periph/PeriphSupport.hpp"
+
+namespace avrbench {
+namespace {
+
+using test::Part;
+
+class SpiTiming : public ::testing::TestWithParam<const Part*> {};
+
+TEST_P(SpiTiming, AByteTakesEightSckPeriods) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("spi_timing", part);
+    mcu.run_for(200000);
+    ASSERT_EQ(mcu.read_ram_u8("done"), 1) << part.name;
+    const auto c = mcu.read_ram("cycles", 10);
+    const auto at = [&](int i) { return static_cast<int>(c[2 * i] | (c[2 * i + 1] << 8)); };
+    // The poll loop's own cycles are the same in each measurement: the
+    // differences are 8 SCK periods: 8 * (16 - 4), 8 * (64 - 16), 8 * (128 - 64),
+    // and SPI2X at f/4 gives f/2: 8 * (2 - 4).
+    EXPECT_EQ(at(1) - at(0), 96) << part.name;
+    EXPECT_EQ(at(2) - at(1), 384) << part.name;
+    EXPECT_EQ(at(3) - at(2), 512) << part.name;
+    EXPECT_EQ(at(4) - at(0), -16) << part.name;
+    // f/4: 32 cycles of transfer, plus the loop (a few cycles at most).
+    EXPECT_GE(at(0), 32) << part.name;
+    EXPECT_LE(at(0), 32 + 12) << part.name;
+}
+
+TEST_P(SpiTiming, WritingSpdrDuringATransferSetsWcol) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("spi_timing", part);
+    mcu.run_for(200000);
+    ASSERT_EQ(mcu.read_ram_u8("done"), 1) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("wcol_spsr") & 0x40, 0x40) << part.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Parts, SpiTiming, ::testing::Values(&test::kAtmega328p, &test::kAtmega2560), test::part_name);
+
+}  // namespace
+}  // namespace avrbench
