@@ -260,4 +260,10 @@ std::string SpiFlash::summary() {
     return text;
 }
 
+void SpiFlash::on_bus_contention(const std::string& others, Cycle) {
+    if (contention_reported_) return;  // once: the bus stays wrong until the firmware fixes its chip selects
+    contention_reported_ = true;
+    report(kSpiBusContention, "selected together with " + others + ": their outputs fought on MISO (a chip select left floating or low?)");
+}
+
 }  // namespace avrbench

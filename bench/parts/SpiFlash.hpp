@@ -41,6 +41,7 @@ public:
 
     std::optional<std::uint8_t> exchange(const SpiTransfer& transfer) override;
     const std::string& spi_name() const override { return name(); }
+    void on_bus_contention(const std::string& others, Cycle cycle) override;
 
 private:
     void on_input(std::size_t pin, bool level) override;
@@ -65,6 +66,7 @@ private:
     std::vector<std::uint8_t> page_;  // page program data
     bool ignore_ = false;           // a refused command: the rest of it too
     std::uint64_t programs_ = 0, erases_ = 0;
+    bool contention_reported_ = false;
     bool mode_reported_ = false;
 };
 

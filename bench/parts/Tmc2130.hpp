@@ -73,6 +73,7 @@ public:
     // SpiSlave.
     std::optional<std::uint8_t> exchange(const SpiTransfer& transfer) override;
     const std::string& spi_name() const override { return name(); }
+    void on_bus_contention(const std::string& others, Cycle cycle) override;
 
 private:
     void on_input(std::size_t pin, bool level) override;
@@ -100,6 +101,7 @@ private:
     std::uint32_t reply_data_ = 0;  // the data the next datagram returns
     std::uint64_t datagrams_ = 0;
     bool selected_ = false;
+    bool contention_reported_ = false;
     bool mode_reported_ = false, clock_reported_ = false;
 
     std::int64_t position_256_ = 0;

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "boards/Board.hpp"
+#include "boards/BoardFile.hpp"
+#include "parts/SpiBus.hpp"
 #include "parts/SpiFlash.hpp"
 #include "support/Paths.hpp"
 
@@ -60,6 +62,29 @@ TEST(SpiFlash, ASectorEraseIsBusyForItsTimeAndAPageProgramReadsBack) {
     auto& flash = dynamic_cast<SpiFlash&>(board.part("xflash"));
     EXPECT_EQ(flash.programs(), 1u);
     EXPECT_EQ(flash.erases(), 1u);
+}
+
+}  // namespace
+}  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(SpiBus, SlavesSelectedTogetherAreContention) {
+    // On the Einsy RAMBo this firmware drives only the XFLASH's chip select:
+    // the four TMC2130s' CS lines float, which the bench reads low (the
+    // drivers take themselves as selected), so every byte has five answers.
+    Board board(load_board_file("einsy-rambo"), {{"mega", test::firmware("xflash_probe")}});
+    board.run_for_seconds(0.2);
+    std::size_t contention = 0;
+    std::string flash_detail;
+    for (const auto& f : board.findings()) {
+        if (f.kind != kSpiBusContention) continue;
+        ++contention;
+        if (f.source == "xflash") flash_detail = f.detail;
+    }
+    EXPECT_EQ(contention, 5u);  // once per slave that answered with others
+    EXPECT_NE(flash_detail.find("x_driver, y_driver, z_driver, e0_driver"), std::string::npos) << flash_detail;
 }
 
 }  // namespace

@@ -63,14 +63,22 @@ void Spi::on_output(avr_irq_t*, std::uint32_t value, void* param) {
     const SpiTransfer t = self->transfer_of(static_cast<std::uint8_t>(value));
     ++self->bytes_;
     std::optional<std::uint8_t> miso;
-    std::vector<const SpiSlave*> answered;
+    std::vector<SpiSlave*> answered;
     for (SpiSlave* s : self->slaves_) {
         if (auto reply = s->exchange(t)) {
             if (!miso) miso = reply;
             answered.push_back(s);
         }
     }
-    if (answered.size() > 1 && self->on_contention_) self->on_contention_(answered, t.cycle);
+    if (answered.size() > 1) {
+        for (SpiSlave* s : answered) {
+            std::string others;
+            for (const SpiSlave* o : answered) {
+                if (o != s) others += (others.empty() ? "" : ", ") + o->spi_name();
+            }
+            s->on_bus_contention(others, t.cycle);
+        }
+    }
     if (miso) avr_raise_irq(self->module_->irq + SPI_IRQ_INPUT, *miso);
 }
 

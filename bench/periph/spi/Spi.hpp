@@ -45,6 +45,9 @@ public:
     virtual std::optional<std::uint8_t> exchange(const SpiTransfer& transfer) = 0;
     // For findings about the bus: "x_driver".
     virtual const std::string& spi_name() const = 0;
+    // Another slave answered the same byte (both were selected): their MISO
+    // outputs fought. `others` names them.
+    virtual void on_bus_contention(const std::string& others, Cycle cycle) = 0;
 
 protected:
     ~SpiSlave() = default;
@@ -60,11 +63,6 @@ public:
     Spi& operator=(const Spi&) = delete;
 
     void attach(SpiSlave& slave) { slaves_.push_back(&slave); }
-    // Called with the names of every slave that answered one byte when more
-    // than one did (their MISO outputs fight): a board finding.
-    void on_contention(std::function<void(const std::vector<const SpiSlave*>&, Cycle)> fn) {
-        on_contention_ = std::move(fn);
-    }
     std::uint64_t bytes_exchanged() const { return bytes_; }
 
 private:
@@ -74,7 +72,6 @@ private:
     avr_t* avr_;
     avr_io_t* module_;
     std::vector<SpiSlave*> slaves_;
-    std::function<void(const std::vector<const SpiSlave*>&, Cycle)> on_contention_;
     std::uint64_t bytes_ = 0;
 };
 
