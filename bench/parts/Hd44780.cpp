@@ -53,6 +53,7 @@ Hd44780::Hd44780(std::string name, Mcu& clock, const ParamValues& params) : Part
     for (std::size_t i = 0; i < 8; ++i) d_pins_[i] = add_pin("d" + std::to_string(i), TerminalRole::Input);
     ddram_.fill(0x20);
     add_readout("writes", [this] { return static_cast<double>(writes_); });
+    add_text_readout("lines", [this] { return lines(); });
 }
 
 void Hd44780::start() {

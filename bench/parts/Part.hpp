@@ -168,6 +168,18 @@ public:
         std::function<double()> value;
     };
     const std::vector<Readout>& readouts() const { return readouts_; }
+    // Text a part shows (an LCD's lines): one string per line.
+    struct TextReadout {
+        std::string name;
+        std::function<std::vector<std::string>()> lines;
+    };
+    const std::vector<TextReadout>& text_readouts() const { return text_readouts_; }
+    const TextReadout* find_text_readout(std::string_view name) const {
+        for (const auto& t : text_readouts_) {
+            if (t.name == name) return &t;
+        }
+        return nullptr;
+    }
 
     // One line about the part's state for the run summary ("" for none);
     // not const: a model may first catch up with the clock.
@@ -206,6 +218,9 @@ protected:
     std::size_t add_signal(std::string name, bool real, double initial = 0);
     std::size_t add_signal(PartSignalInfo info, double initial);
     void add_readout(std::string name, std::function<double()> value) { readouts_.push_back({std::move(name), std::move(value)}); }
+    void add_text_readout(std::string name, std::function<std::vector<std::string>()> lines) {
+        text_readouts_.push_back({std::move(name), std::move(lines)});
+    }
     void publish(std::size_t signal, double value);
 
     // Called when an injected fault takes effect ("none": repaired).
@@ -259,6 +274,7 @@ private:
     FindingLog<Finding> findings_;
     std::vector<PartSignalInfo> signal_infos_;
     std::vector<Readout> readouts_;
+    std::vector<TextReadout> text_readouts_;
     std::vector<double> signal_values_;
     std::vector<std::uint64_t> signal_changes_;
     std::vector<SignalListener> signal_listeners_;

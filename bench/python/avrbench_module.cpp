@@ -464,9 +464,19 @@ void bind_part(py::module_& m) {
             for (const auto& r : p.readouts()) {
                 if (r.name == name) return readout_value(r.value());
             }
+            // Text (an LCD's): `lines` as a list of str, `text` the lines joined with newlines.
+            if (const auto* t = p.find_text_readout(name)) return py::object(py::cast(t->lines()));
+            if (name == "text") {
+                if (const auto* t = p.find_text_readout("lines")) {
+                    std::string joined;
+                    for (const auto& l : t->lines()) joined += (joined.empty() ? "" : "\n") + l;
+                    return py::object(py::str(joined));
+                }
+            }
             std::string names;
             for (const auto& s : p.signals()) names += (names.empty() ? "" : ", ") + s.name;
             for (const auto& r : p.readouts()) names += (names.empty() ? "" : ", ") + r.name;
+            for (const auto& t : p.text_readouts()) names += (names.empty() ? "" : ", ") + t.name + (t.name == "lines" ? ", text" : "");
             throw BadInput("part " + p.name() + " has no signal '" + name + "' (it has " + (names.empty() ? "none" : names) + ")");
         });
 }

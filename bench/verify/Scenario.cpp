@@ -155,6 +155,19 @@ public:
         }
     }
 
+    // `name`, or (empty) the board's first part of `type`; BadInput naming what there is.
+    std::string part_of_type(const std::string& name, const std::string& type, const std::string& location) const {
+        if (!name.empty()) {
+            check_part(name, location);
+            if (board_.find_part(name)->type != type) throw BadInput(location + ": part '" + name + "' is not an " + type);
+            return name;
+        }
+        for (const auto& p : board_.parts) {
+            if (p.type == type) return p.name;
+        }
+        throw BadInput(location + ": the board has no " + type + " part");
+    }
+
     void check_serial(const std::string& kind, const std::string& location) const {
         if (board_.has_serial_port()) return;
         throw BadInput(location + ": '" + kind + "' needs a serial port (a serial_host part), and " + board_.path +
@@ -300,6 +313,19 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
     } else if (k == "text") {
         names.check_serial(k, item.location);
         e.action = ExpectText{item.scalar_value()};
+    } else if (k == "lcd_shows") {
+        ExpectLcdShows shows;
+        if (item.value.IsMap()) {
+            item.expect_keys({"pattern"}, {"part", "line"});
+            shows.pattern = item.get("pattern");
+            if (item.has("line")) shows.line = static_cast<int>(parse_integer(item.get("line"), item.at("line") + ": line", 1, 4));
+            shows.part = names.part_of_type(item.has("part") ? item.get("part") : "", "hd44780", item.location);
+        } else {
+            shows.pattern = item.scalar_value();
+            shows.part = names.part_of_type("", "hd44780", item.location);
+        }
+        TextPattern(shows.pattern, item.location + ": lcd_shows");  // a bad pattern fails when the file loads
+        e.action = shows;
     } else if (k == "isr" || k == "stack" || k == "interrupts_off" || k == "cpu") {
         e.action = parse_timing_expectation(item, names);
     } else if (k == "findings") {
@@ -501,7 +527,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
     if (const YAML::Node steps = sequence("steps")) {
         for (const auto& node : steps) spec.steps.push_back(parse_step(read_item(node, path, kSteps, "step"), path, names));
     }
-    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "findings", "isr", "stack", "interrupts_off", "cpu"};
+    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "lcd_shows", "findings", "isr", "stack", "interrupts_off", "cpu"};
     if (const YAML::Node expect = sequence("expect")) {
         for (const auto& node : expect) spec.expectations.push_back(parse_expectation(read_item(node, path, kExpect, "expectation"), names));
     }

@@ -48,6 +48,9 @@ struct ExpectSteps { std::string axis; std::uint64_t count = 0; };
 struct ExpectPosition { std::string axis; double value = 0; double within = 1e-6; };  // mm, or deg on a rotary axis
 struct ExpectPin { std::string pin; bool level = false; };
 struct ExpectText { std::string text; };
+// A display part's text (an hd44780's lines) matches `pattern` (RE2): on line
+// `line` (1-based), or anywhere in the lines joined with newlines (line 0).
+struct ExpectLcdShows { std::string part; int line = 0; std::string pattern; };
 struct ExpectFindingCount { std::uint64_t count = 0; };
 struct ExpectFindingKinds { std::vector<std::string> kinds; };  // as a multiset
 
@@ -61,8 +64,8 @@ struct ExpectIsr {
 struct ExpectStack { std::string mcu; std::int64_t min_headroom_bytes = 0; };
 struct ExpectInterruptsOff { std::string mcu; std::uint64_t max_cycles = 0; };
 struct ExpectCpu { std::string mcu; double max_busy_percent = 100; };  // executing / (executing + asleep + idle loop)
-using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectFindingCount, ExpectFindingKinds,
-                                  ExpectIsr, ExpectStack, ExpectInterruptsOff, ExpectCpu>;
+using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectLcdShows, ExpectFindingCount,
+                                  ExpectFindingKinds, ExpectIsr, ExpectStack, ExpectInterruptsOff, ExpectCpu>;
 
 struct ScenarioExpectation {
     ExpectAction action;

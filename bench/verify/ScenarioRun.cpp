@@ -19,6 +19,7 @@
 #include "core/OutputFile.hpp"
 #include "trace/TimelineText.hpp"
 #include "run/Bench.hpp"
+#include "core/TextPattern.hpp"
 #include "verify/Scenario.hpp"
 
 namespace fs = std::filesystem;
@@ -299,6 +300,23 @@ private:
     std::string operator()(const ExpectText& e) {
         if (bench_.host().received_text().find(e.text) != std::string::npos) return "";
         return "the firmware never sent '" + e.text + "'";
+    }
+    std::string operator()(const ExpectLcdShows& e) {
+        const Part::TextReadout* shown = bench_.board().part(e.part).find_text_readout("lines");
+        if (shown == nullptr) return "part " + e.part + " shows no text";
+        const std::vector<std::string> lines = shown->lines();
+        const TextPattern pattern(e.pattern, "lcd_shows");
+        std::string text;
+        if (e.line > 0) {
+            text = static_cast<std::size_t>(e.line) <= lines.size() ? lines[static_cast<std::size_t>(e.line - 1)] : "";
+        } else {
+            for (const auto& l : lines) text += (text.empty() ? "" : "\n") + l;
+        }
+        if (pattern.found_in(text)) return "";
+        std::string screen;
+        for (const auto& l : lines) screen += "|" + l + "|";
+        return e.part + (e.line > 0 ? " line " + std::to_string(e.line) : std::string()) + " does not show /" + e.pattern +
+               "/; it shows " + screen;
     }
     const TimingProfiler& profile(const std::string& mcu) {
         return *(mcu.empty() ? bench_.mcu() : bench_.mcu(mcu)).profile();

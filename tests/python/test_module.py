@@ -240,3 +240,14 @@ def test_a_deprecated_serial_section_is_a_deprecation_warning(elf, tmp_path):
         bench = avrbench.Bench(str(board), elf("uart_echo"))
     bench.run_for("5ms")
     assert bench.serial("host").received.startswith("avrbench uart_echo")
+
+
+def test_an_lcd_shows_its_text_and_lines(elf):
+    # firmware/boards/lcd_hello on the Einsy RAMBo's 20x4 HD44780: line 1
+    # "Hello, Einsy", line 4 "Temp 215" with the ROM's degree sign (0xDF).
+    bench = avrbench.Bench("einsy-rambo", elf("lcd_hello"))
+    bench.run_for("100ms")
+    lcd = bench.part("lcd")
+    assert lcd.lines == ["Hello, Einsy".ljust(20), " " * 20, " " * 20, "Temp 215\u00b0C".ljust(20)]
+    assert lcd.text == "\n".join(lcd.lines)
+    assert lcd.writes > 0
