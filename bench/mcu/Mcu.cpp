@@ -458,7 +458,12 @@ Pin& Mcu::pin(std::string_view name) {
 Spi* Mcu::spi() {
     if (!spi_looked_for_) {
         spi_looked_for_ = true;
-        spi_ = Spi::install(avr_);
+        std::function<bool()> miso_level;
+        if (const auto pins = spi_pins(mcu_type_)) {
+            Pin* miso = &pin(pins->miso);
+            miso_level = [miso] { return miso->level(); };
+        }
+        spi_ = Spi::install(avr_, std::move(miso_level));
     }
     return spi_.get();
 }

@@ -28,13 +28,14 @@ avr_io_t* spi_module(avr_t* avr) {
 
 }  // namespace
 
-std::unique_ptr<Spi> Spi::install(avr_t* avr) {
+std::unique_ptr<Spi> Spi::install(avr_t* avr, std::function<bool()> miso_level) {
     avr_io_t* module = spi_module(avr);
     if (module == nullptr) return nullptr;
-    return std::make_unique<Spi>(avr, module);
+    return std::make_unique<Spi>(avr, module, std::move(miso_level));
 }
 
-Spi::Spi(avr_t* avr, avr_io_t* module) : avr_(avr), module_(module) {
+Spi::Spi(avr_t* avr, avr_io_t* module, std::function<bool()> miso_level)
+    : avr_(avr), module_(module), miso_level_(std::move(miso_level)) {
     avr_irq_register_notify(module_->irq + SPI_IRQ_OUTPUT, &on_output, this);
 }
 
@@ -79,6 +80,7 @@ void Spi::on_output(avr_irq_t*, std::uint32_t value, void* param) {
             s->on_bus_contention(others, t.cycle);
         }
     }
+    if (!miso && self->miso_level_) miso = self->miso_level_() ? 0xFF : 0x00;  // nobody drives MISO
     if (miso) avr_raise_irq(self->module_->irq + SPI_IRQ_INPUT, *miso);
 }
 

@@ -7,8 +7,10 @@
 // SPIF (and SPI_IRQ_OUTPUT with the byte) 8 SCK periods later, f_osc/4..128,
 // /2 with SPI2X (ATmega328P §19.5 Table 19-5, ATmega2560 §21.2.1 Table 21-5);
 // a byte raised on SPI_IRQ_INPUT then becomes SPDR. This class answers that
-// IRQ from the slaves, at the cycle the transfer ends. Without slaves on the
-// bus it does nothing, and SPDR keeps what simavr leaves there.
+// IRQ from the slaves, at the cycle the transfer ends. A byte no slave
+// answers reads the MISO line's level on every bit (a pull-up: 0xFF; a
+// floating line, the bench's low: 0x00). Without slaves on the bus it does
+// nothing, and SPDR keeps what simavr leaves there (its input register).
 #pragma once
 
 #include <cstdint>
@@ -55,9 +57,10 @@ protected:
 
 class Spi {
 public:
-    // nullptr when the core has no SPI module.
-    static std::unique_ptr<Spi> install(avr_t* avr);
-    explicit Spi(avr_t* avr, avr_io_t* module);
+    // nullptr when the core has no SPI module. `miso_level`: the level of the
+    // MCU's MISO pin as its net has it.
+    static std::unique_ptr<Spi> install(avr_t* avr, std::function<bool()> miso_level);
+    Spi(avr_t* avr, avr_io_t* module, std::function<bool()> miso_level);
     ~Spi();
     Spi(const Spi&) = delete;
     Spi& operator=(const Spi&) = delete;
@@ -72,6 +75,7 @@ private:
     avr_t* avr_;
     avr_io_t* module_;
     std::vector<SpiSlave*> slaves_;
+    std::function<bool()> miso_level_;
     std::uint64_t bytes_ = 0;
 };
 
