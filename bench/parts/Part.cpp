@@ -130,4 +130,11 @@ std::size_t Part::report(FindingKind kind, std::string detail) {
     return findings_.record(std::move(f));
 }
 
+void Part::act(const std::string& action, const std::vector<double>& arguments) {
+    (void)arguments;
+    std::string list;
+    for (const auto& a : actions()) list += (list.empty() ? "" : ", ") + a.name;
+    throw part_error(name(), "has no action '" + action + "' (actions: " + (list.empty() ? "none" : list) + ")");
+}
+
 }  // namespace avrbench

@@ -161,6 +161,17 @@ public:
     // How many times the signal was published since the start (0: never changed).
     std::uint64_t signal_changes(std::size_t signal) const { return signal_changes_[signal]; }
 
+    // What a user can do to the part from a scenario or Python (press a
+    // button, turn a knob): `arguments` numbers each. act() throws BadInput
+    // for an action the part does not have or a wrong argument count.
+    struct Action {
+        std::string name;
+        std::size_t arguments;
+        std::string help;
+    };
+    virtual std::vector<Action> actions() const { return {}; }
+    virtual void act(const std::string& action, const std::vector<double>& arguments);
+
     // Values a front end may read at any time that are not traced signals
     // (an axis's step count): Python's part attributes, beside the signals.
     struct Readout {

@@ -452,6 +452,13 @@ void bind_part(py::module_& m) {
         .def_property_readonly("faults", &Part::fault_names)
         .def_property_readonly("fault", &Part::fault)
         .def("inject_fault", [](Part& p, const std::string& fault) { p.inject_fault(fault, p.clock().cycle()); })
+        .def_property_readonly("actions", [](Part& p) {
+            std::vector<std::string> names;
+            for (const auto& a : p.actions()) names.push_back(a.name);
+            return names;
+        })
+        .def("act", [](Part& p, const std::string& action, const std::vector<double>& arguments) { p.act(action, arguments); },
+             py::arg("action"), py::arg("arguments"))
         .def_property_readonly("readouts", [](Part& p) {
             py::dict d;
             for (const auto& r : p.readouts()) d[py::str(r.name)] = readout_value(r.value());

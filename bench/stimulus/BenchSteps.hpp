@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 #include <variant>
 
 #include "core/Time.hpp"
@@ -19,8 +20,9 @@ struct WaitPinStep { std::string pin; bool level = false; };
 struct SetInputStep { std::string pin; bool level = false; };
 struct ReleaseInputStep { std::string pin; };
 struct InjectFaultStep { std::string part; std::string fault; };
+struct PartActionStep { std::string part; std::string action; std::vector<double> arguments; };  // press a knob, turn it
 
 using StepAction = std::variant<SendStep, SendFileStep, DelayStep, WaitIdleStep, WaitForTextStep, WaitPinStep,
-                                SetInputStep, ReleaseInputStep, InjectFaultStep>;
+                                SetInputStep, ReleaseInputStep, InjectFaultStep, PartActionStep>;
 
 }  // namespace avrbench

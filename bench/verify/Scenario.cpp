@@ -217,6 +217,15 @@ ScenarioStep parse_step(const Item& item, const std::string& path, const BoardNa
         item.expect_keys({"part", "fault"});
         names.check_part(item.get("part"), item.at("part"));
         step.action = InjectFaultStep{item.get("part"), item.get("fault")};
+    } else if (k == "press" || k == "release") {
+        const std::string part = item.scalar_value();
+        names.check_part(part, item.location);
+        step.action = PartActionStep{part, k, {}};
+    } else if (k == "turn") {
+        item.expect_keys({"part", "detents"});
+        names.check_part(item.get("part"), item.at("part"));
+        const double detents = static_cast<double>(parse_integer(item.get("detents"), item.at("detents") + ": detents", -100000, 100000));
+        step.action = PartActionStep{item.get("part"), "turn", {detents}};
     }
     return step;
 }
@@ -523,7 +532,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
         return node;
     };
     static const std::set<std::string> kSteps = {"wait_for_text", "send", "send_file", "wait_idle", "wait_pin",
-                                                 "delay", "set_input", "release_input", "inject_fault"};
+                                                 "delay", "set_input", "release_input", "inject_fault", "press", "release", "turn"};
     if (const YAML::Node steps = sequence("steps")) {
         for (const auto& node : steps) spec.steps.push_back(parse_step(read_item(node, path, kSteps, "step"), path, names));
     }

@@ -262,6 +262,10 @@ private:
         part.inject_fault(s.fault, part.clock().cycle());
         return "";
     }
+    std::string operator()(const PartActionStep& s) {
+        bench_.board().part(s.part).act(s.action, s.arguments);
+        return "";
+    }
 
     // Waits wake on their event; slices only bound how long a SIGINT or a
     // full recorder goes unnoticed.
@@ -395,6 +399,17 @@ private:
 // Checks what only the built board can say (fault names), before anything runs.
 void bind(const ScenarioSpec& spec, Bench& bench) {
     for (const auto& step : spec.steps) {
+        if (const auto* a = std::get_if<PartActionStep>(&step.action)) {
+            const Part& part = bench.board().part(a->part);
+            const auto actions = part.actions();
+            const bool known = std::any_of(actions.begin(), actions.end(), [&](const Part::Action& x) { return x.name == a->action; });
+            if (!known) {
+                std::string list;
+                for (const auto& x : actions) list += (list.empty() ? "" : ", ") + x.name;
+                throw BadInput(step.location + ": part '" + a->part + "' (" + std::string(part.type()) + ") cannot " + a->action +
+                               " (actions: " + (list.empty() ? "none" : list) + ")");
+            }
+        }
         if (const auto* f = std::get_if<InjectFaultStep>(&step.action)) {
             const Part& part = bench.board().part(f->part);
             const auto names = part.fault_names();

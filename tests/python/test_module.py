@@ -251,3 +251,21 @@ def test_an_lcd_shows_its_text_and_lines(elf):
     assert lcd.lines == ["Hello, Einsy".ljust(20), " " * 20, " " * 20, "Temp 215\u00b0C".ljust(20)]
     assert lcd.text == "\n".join(lcd.lines)
     assert lcd.writes > 0
+
+
+def test_a_knob_is_turned_and_pressed_from_python(elf):
+    # firmware/boards/knob_menu counts detents (4 transitions each) and clicks.
+    bench = avrbench.Bench("einsy-rambo", elf("knob_menu"))
+    bench.run_for("100ms")
+    knob = bench.part("knob")
+    assert set(knob.actions) == {"press", "release", "turn"}
+    knob.turn(2)            # 8 transitions, 25 ms apart at 10 detents/s
+    bench.run_for("300ms")
+    knob.press()
+    bench.run_for("50ms")
+    knob.release()
+    bench.run_for("50ms")
+    mcu = bench.mcu()
+    assert mcu.symbol("detents", size=2) == 2
+    assert mcu.symbol("clicks", size=2) == 1
+    assert bench.part("lcd").lines[0].rstrip() == "Item 2"

@@ -184,8 +184,8 @@ TEST(Scenarios, MalformedScenarioIsOneLineWithExitCode2) {
     const auto r = test::run_command(kScenarioCli + " check " + path.string() + " --firmware-dir " + ::avrbench::test::firmware_dir(), dir);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, "avrbench: error: " + path.string() +
-                         ":4: unknown step 'dance' (known: delay, inject_fault, release_input, send, send_file, set_input, "
-                         "wait_for_text, wait_idle, wait_pin)\n");
+                         ":4: unknown step 'dance' (known: delay, inject_fault, press, release, release_input, send, send_file, "
+                         "set_input, turn, wait_for_text, wait_idle, wait_pin)\n");
 }
 
 }  // namespace

@@ -104,6 +104,11 @@ class Part:
     def fault(self):
         return self._native.fault
 
+    @property
+    def actions(self):
+        """What can be done to the part (a knob's "press", "release", "turn"), each a method."""
+        return self._native.actions
+
     def inject_fault(self, fault):
         """Applies one of `faults` now ("none" repairs)."""
         self._native.inject_fault(fault)
@@ -120,6 +125,13 @@ class Part:
             raise AttributeError(name)
         if self._bench is not None:
             _check_open(self._bench)
+        if name in self._native.actions:
+            # An action (a knob's press(), release(), turn(3)): done now, in simulated time.
+            def action(*arguments):
+                if self._bench is not None:
+                    _check_open(self._bench)
+                self._native.act(name, [float(a) for a in arguments])
+            return action
         return self._native.signal(name)
 
     def __repr__(self):
