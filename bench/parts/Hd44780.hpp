@@ -43,6 +43,11 @@ public:
         std::vector<std::string> lines;
     };
     std::vector<Screen> screens();
+    std::vector<TextScreen> text_screens() override {
+        std::vector<TextScreen> out;
+        for (auto& s : screens()) out.push_back({s.cycle, std::move(s.lines)});
+        return out;
+    }
     std::uint64_t writes() const { return writes_; }
 
 private:

@@ -185,6 +185,13 @@ public:
         std::function<std::vector<std::string>()> lines;
     };
     const std::vector<TextReadout>& text_readouts() const { return text_readouts_; }
+    // What the part showed over time (an LCD's screens), oldest first: the
+    // cycle of each and its lines. Empty for parts that show nothing.
+    struct TextScreen {
+        Cycle cycle;
+        std::vector<std::string> lines;
+    };
+    virtual std::vector<TextScreen> text_screens() { return {}; }
     const TextReadout* find_text_readout(std::string_view name) const {
         for (const auto& t : text_readouts_) {
             if (t.name == name) return &t;

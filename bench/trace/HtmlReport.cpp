@@ -49,6 +49,10 @@ header.report li { break-inside: avoid; }
 nav { font-size: 13px; margin-top: 6px; }
 nav a { color: #9ecbff; margin-right: 14px; text-decoration: none; }
 main { max-width: 1100px; margin: 0 auto; padding: 8px 20px 40px; }
+.screens { display: flex; flex-wrap: wrap; gap: 10px; }
+figure.screen { margin: 0; }
+figure.screen pre { background: #2b4a1e; color: #d8f5c0; padding: 6px 8px; margin: 2px 0 0; font-size: 12px; line-height: 1.25; }
+figure.screen figcaption { font-size: 11px; color: #5b6472; }
 section { background: #fff; border: 1px solid #d9dde3; border-radius: 6px; padding: 10px 18px 14px; margin: 14px 0; }
 h2 { font-size: 17px; margin: 2px 0 8px; }
 figure.plot-block { margin: 6px 0 10px; }
@@ -154,6 +158,7 @@ std::string format_html_report(const RunReport& report) {
     if (report.timeline != nullptr && !report.temperatures.empty()) out += "<a href=\"#thermal-section\">temperatures</a>";
     if (report.timeline != nullptr && !report.servos.empty()) out += "<a href=\"#servo-section\">servos</a>";
     if (!report.timing.empty()) out += "<a href=\"#timing-section\">timing</a>";
+    if (!report.displays.empty()) out += "<a href=\"#display-section\">displays</a>";
     out += "<a href=\"#transcript-section\">UART</a></nav>\n</div></header>\n<main>\n";
 
     append_findings(out, report);
@@ -162,6 +167,7 @@ std::string format_html_report(const RunReport& report) {
     append_thermal(out, ctx);
     append_servos(out, ctx);
     append_timing(out, report);
+    append_displays(out, report);
     append_transcript(out, report);
     out += "</main>\n<footer>avrbench " AVRBENCH_VERSION " \xc2\xb7 self-contained report, no network</footer>\n</body>\n</html>\n";
     return out;

@@ -128,6 +128,13 @@ RunReport make_run_report(const RunView& run, const std::string& title) {
     r.transcript = run.transcript();
     report_timing(run, r);
     r.findings = run.findings();
+    for (Part* p : run.parts()) {
+        auto screens = p->text_screens();
+        if (screens.empty()) continue;
+        DisplayScreens d{p->name(), p->clock().frequency_hz(), {}};
+        for (auto& s : screens) d.screens.emplace_back(s.cycle, std::move(s.lines));
+        r.displays.push_back(std::move(d));
+    }
     return r;
 }
 

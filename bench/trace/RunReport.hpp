@@ -82,6 +82,13 @@ struct TimingTable {
     std::vector<Row> rows;
 };
 
+// A display's screens over time (an LCD's: each burst of writes one screen).
+struct DisplayScreens {
+    std::string part;  // "lcd"
+    std::uint32_t clock_hz = 16000000;
+    std::vector<std::pair<Cycle, std::vector<std::string>>> screens;  // the cycle of each screen's last write
+};
+
 struct RunReport {
     std::string title;               // "stepdir_test on arduino-uno-cnc-shield-v3"
     std::vector<std::string> facts;  // "firmware: build/firmware/x.elf (sha256 ...)", "simulated: 1.2 s", ...
@@ -96,6 +103,7 @@ struct RunReport {
     std::vector<Finding> findings;
     std::optional<ComparisonView> comparison;
     std::vector<TimingTable> timing;  // the profiled MCUs (run --profile); none: no section
+    std::vector<DisplayScreens> displays;  // parts that show text; none: no section
 };
 
 }  // namespace avrbench

@@ -69,3 +69,29 @@ TEST(Hd44780, WritingBeforeAClearHasFinishedLosesTheWrites) {
 
 }  // namespace
 }  // namespace avrbench
+
+#include <fstream>
+
+#include "support/RunCommand.hpp"
+
+namespace avrbench {
+namespace {
+
+TEST(Hd44780, TheHtmlReportShowsTheScreensWithTheirTimes) {
+    const auto dir = test::scratch_dir("lcd-report");
+    const auto report = dir / "lcd.html";
+    const auto r = test::run_command(std::string(test::cli()) + " run " + std::string(test::firmware("lcd_hello")) + " --board einsy-rambo --for 0.2s --report " +
+                                         report.string(),
+                                     dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(report);
+    const std::string html((std::istreambuf_iterator<char>(in)), {});
+    // One screen (a single burst of writes), its lines as the LCD shows them.
+    EXPECT_NE(html.find("<section id=\"display-section\">"), std::string::npos);
+    EXPECT_NE(html.find("id=\"display-lcd\""), std::string::npos);
+    EXPECT_NE(html.find("<pre>Hello, Einsy        \n"), std::string::npos);
+    EXPECT_NE(html.find("Temp 215\u00B0C"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace avrbench

@@ -257,5 +257,7 @@ void append_transcript(std::string& out, const RunReport& report);
 // <section id="timing-section">: per profiled MCU its facts and a
 // <table class="timing" id="timing-<mcu>"> of vectors; left out when no MCU was profiled.
 void append_timing(std::string& out, const RunReport& report);
+// Each display's screens with their times (at most kMaxScreens per display, the last ones).
+void append_displays(std::string& out, const RunReport& report);
 
 }  // namespace avrbench::html_report
