@@ -40,27 +40,71 @@ void append_text_tail(std::vector<std::string>& out, const std::string& text, st
 }
 
 // PB5, PORTB or all name pins of every MCU; MCU.PB5, MCU.PORTB or MCU.all
-// those of one MCU.
-void trace_board_pins(Recorder& recorder, Board& board, const std::string& spec, const char* option) {
+// those of one MCU; PART.SIGNAL a part's signal (hotend.block_degC) and a
+// net's or label's name its MCU pin, as the summary and the VCD name them.
+// `parts_traced`: every part signal is recorded already (the defaults).
+void trace_board_pins(Bench& bench, const std::string& spec, const char* option, bool parts_traced) {
     if (spec.empty()) return;
+    Recorder& recorder = bench.recorder();
+    Board& board = bench.board();
     std::string every_mcu;
     std::map<std::string, std::string> per_mcu;
+    std::map<std::string, std::vector<std::string>> per_part;
     std::stringstream items(spec);
     std::string item;
     while (std::getline(items, item, ',')) {
         const auto dot = item.find('.');
         if (dot == std::string::npos) {
+            // A net or label by its board-file name: its MCU pin, shown under that name too.
+            const Endpoint* endpoint = nullptr;
+            std::string scope;
+            for (const auto& net : board.spec().nets) {
+                if (net.name != item) continue;
+                for (const auto& e : net.endpoints) {
+                    if (board.spec().find_mcu(e.owner) != nullptr) {
+                        endpoint = &e;
+                        break;
+                    }
+                }
+                scope = "nets";
+            }
+            for (const auto& label : board.spec().labels) {
+                if (label.name == item) endpoint = &label.endpoint, scope = "labels";
+            }
+            if (endpoint != nullptr) {
+                Mcu& m = board.mcu(endpoint->owner);
+                bench.timeline().add_alias(recorder.trace_pin(m, m.pin(endpoint->pin)), scope, item);
+                continue;
+            }
             every_mcu += item + ",";
             continue;
         }
-        const std::string mcu = item.substr(0, dot);
-        if (board.spec().find_mcu(mcu) == nullptr)
-            throw BadInput(std::string(option) + ": '" + item + "': the board has no MCU '" + mcu + "'");
-        per_mcu[mcu] += item.substr(dot + 1) + ",";
+        const std::string owner = item.substr(0, dot);
+        if (board.spec().find_mcu(owner) != nullptr) {
+            per_mcu[owner] += item.substr(dot + 1) + ",";
+        } else if (board.spec().find_part(owner) != nullptr) {
+            per_part[owner].push_back(item.substr(dot + 1));
+        } else {
+            throw BadInput(std::string(option) + ": '" + item + "': the board has no MCU or part '" + owner + "'");
+        }
     }
     for (Mcu* m : board.mcus()) {
         if (!every_mcu.empty()) trace_pins_option(recorder, *m, every_mcu, option);
         if (const auto it = per_mcu.find(m->name()); it != per_mcu.end()) trace_pins_option(recorder, *m, it->second, option);
+    }
+    for (const auto& [part, signals] : per_part) {
+        try {
+            if (parts_traced) {
+                Part& p = board.part(part);
+                for (const auto& name : signals) {
+                    if (bench.timeline().find(part, name) < 0) recorder.trace_part(p, {name});  // checks the name
+                }
+            } else {
+                recorder.trace_part(board.part(part), signals);
+            }
+        } catch (const BadInput& e) {
+            throw BadInput(std::string(option) + ": " + e.what());
+        }
     }
 }
 
@@ -232,8 +276,7 @@ void BoardRun::count_i2c() {
 void BoardRun::trace() {
     const bool defaults = options_.trace_only.empty();
     if (defaults) bench_->trace_board();
-    trace_board_pins(bench_->recorder(), bench_->board(), defaults ? options_.trace : options_.trace_only,
-                     defaults ? "--trace" : "--trace-only");
+    trace_board_pins(*bench_, defaults ? options_.trace : options_.trace_only, defaults ? "--trace" : "--trace-only", defaults);
 }
 
 void BoardRun::after_slice(std::chrono::steady_clock::time_point wall_start) {

@@ -1,5 +1,9 @@
 #include "trace/Recorder.hpp"
 
+#include <optional>
+
+#include <algorithm>
+
 #include <cctype>
 #include <sstream>
 
@@ -89,31 +93,52 @@ SignalId Recorder::trace_twi(Mcu& mcu, Twi& twi) {
     return id;
 }
 
-std::vector<SignalId> Recorder::trace_part(Part& part) {
+std::vector<SignalId> Recorder::trace_part(Part& part) { return trace_part(part, {}); }
+
+std::vector<SignalId> Recorder::trace_part(Part& part, const std::vector<std::string>& only) {
+    for (const auto& name : only) {
+        bool known = false;
+        std::string names;
+        for (const auto& s : part.signals()) {
+            known = known || s.name == name;
+            names += (names.empty() ? "" : ", ") + s.name;
+        }
+        if (!known) throw BadInput("part '" + part.name() + "' has no signal '" + name + "' (signals: " + (names.empty() ? "none" : names) + ")");
+    }
+    const auto wanted = [&](const std::string& name) { return only.empty() || std::find(only.begin(), only.end(), name) != only.end(); };
     part.clock().settle_periodic_outputs();  // a heater following a wave publishes no edges
+    // Per part signal: its timeline signal, or none when not traced.
+    std::vector<std::optional<SignalId>> by_signal;
     std::vector<SignalId> ids;
     for (const auto& s : part.signals()) {
+        if (!wanted(s.name)) {
+            by_signal.emplace_back();
+            continue;
+        }
         ids.push_back(timeline_.add_signal({part.name(), s.name, s.real ? SignalKind::Real : SignalKind::Wire, 1,
                                             part.clock().frequency_hz()}));
+        by_signal.emplace_back(ids.back());
     }
     if (ids.empty()) return ids;
     Timeline* timeline = &timeline_;
     std::vector<bool> real;
     for (const auto& s : part.signals()) real.push_back(s.real);
     // The values at the moment tracing starts, so the trace has no unknowns.
-    for (std::size_t i = 0; i < ids.size(); ++i) {
+    for (std::size_t i = 0; i < by_signal.size(); ++i) {
+        if (!by_signal[i]) continue;
         const double v = part.signal_value(i);
         if (real[i]) {
-            timeline_.record_real(ids[i], part.clock().cycle(), v);
+            timeline_.record_real(*by_signal[i], part.clock().cycle(), v);
         } else {
-            timeline_.record(ids[i], part.clock().cycle(), v != 0 ? 1 : 0);
+            timeline_.record(*by_signal[i], part.clock().cycle(), v != 0 ? 1 : 0);
         }
     }
-    part.watch_signals([timeline, ids, real](std::size_t signal, Cycle cycle, double value) {
+    part.watch_signals([timeline, by_signal, real](std::size_t signal, Cycle cycle, double value) {
+        if (!by_signal[signal]) return;
         if (real[signal]) {
-            timeline->record_real(ids[signal], cycle, value);
+            timeline->record_real(*by_signal[signal], cycle, value);
         } else {
-            timeline->record(ids[signal], cycle, value != 0 ? 1 : 0);
+            timeline->record(*by_signal[signal], cycle, value != 0 ? 1 : 0);
         }
     });
     return ids;

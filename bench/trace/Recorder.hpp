@@ -35,6 +35,9 @@ public:
     // Every signal the part publishes (positions, levels, temperatures), in a
     // scope named after the part, stamped with the part's clock.
     std::vector<SignalId> trace_part(Part& part);
+    // Only the part's signals named in `only` (BadInput naming the part's
+    // signals for one it does not have).
+    std::vector<SignalId> trace_part(Part& part, const std::vector<std::string>& only);
 
     // Pins named in `spec`: "PB5,PD2", "PORTB" (its 8 pins) or "all" (every
     // pin of every port the MCU has). Throws BadInput on an unknown name.

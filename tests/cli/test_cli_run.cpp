@@ -265,3 +265,28 @@ TEST(CliRunPeriodicWaves, ADutyZeroBedHeatsWithItsMeanPowerUnlessWavesAreOff) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(CliRun, TraceOnlyTakesPartSignalsAndNetNamesAsTheVcdNamesThem) {
+    const auto dir = test::scratch_dir("cli-trace-part");
+    const auto vcd = (dir / "t.vcd").string();
+    // arduino-uno-cnc-shield-v3: net x_step joins uno.PD2 (grbl's X_STEP); the
+    // linear axis x declares the signal position_mm.
+    const auto r = test::run_command(kCli + " run -q --board arduino-uno-cnc-shield-v3 " + quoted(test::firmware("stepdir_test")) +
+                                         " --for 20ms --trace-only x.position_mm,x_step --vcd " + quoted(vcd), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const VcdDump parsed = read_vcd(vcd);
+    std::vector<std::string> names;
+    for (const auto& v : parsed.variables) names.push_back(v.full_name());
+    EXPECT_EQ(names, (std::vector<std::string>{"uno.PD2", "x.position_mm", "nets.x_step"}));
+
+    const auto bad = test::run_command(kCli + " run -q --board arduino-uno-cnc-shield-v3 " + quoted(test::firmware("stepdir_test")) +
+                                           " --for 20ms --trace-only x.speed --vcd " + quoted(vcd), dir);
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_EQ(bad.err, "avrbench: error: --trace-only: part 'x' has no signal 'speed' (signals: position_mm)\n");
+}
+
+}  // namespace
+}  // namespace avrbench
