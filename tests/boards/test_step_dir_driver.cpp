@@ -130,3 +130,25 @@ TEST(StepDirDriver, NoFindingsForGoodSteps) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(StepDirDriver, EachMinimumIsPinnedOnBothSides) {
+    // firmware/boards/step_boundaries: each A4988 minimum met exactly (16
+    // cycles STEP high, 16 low, 4 of DIR setup, 4 of hold: no finding) and
+    // missed by one cycle (15, 15, 3, 3: one finding each).
+    std::unique_ptr<Board> board = uno_with("step_boundaries");
+    board->run_for_seconds(0.01);
+    ASSERT_EQ(board->mcu().read_ram_u8("done"), 1);
+    std::vector<std::string> details;
+    for (const auto& f : board->findings()) details.push_back(f.kind.name() + ": " + f.detail);
+    EXPECT_EQ(details, (std::vector<std::string>{
+                           "step-high-too-short: STEP active for 15 cycles (0.938 us); a4988 needs 16 cycles",
+                           "step-low-too-short: STEP inactive for 15 cycles before this edge; a4988 needs 16 cycles",
+                           "dir-setup-violation: DIR changed 3 cycles before the STEP edge; a4988 needs 4 cycles of setup",
+                           "dir-hold-violation: DIR changed 3 cycles after the STEP edge; a4988 needs 4 cycles of hold"}));
+}
+
+}  // namespace
+}  // namespace avrbench
