@@ -111,7 +111,8 @@ std::vector<std::uint8_t> mmcu_section(Elf_Scn* scn, const GElf_Shdr& shdr, cons
 
 // Every named symbol, and the flash ones that can name a PC (functions and labels).
 void read_symbol_table(Elf* elf, Elf_Scn* scn, const GElf_Shdr& shdr, const std::string& path,
-                       std::map<std::string, std::uint32_t>& symbols, std::map<std::uint32_t, std::string>& functions) {
+                       std::map<std::string, std::uint32_t>& symbols, std::map<std::uint32_t, std::string>& functions,
+                       std::map<std::string, std::uint32_t>& object_sizes) {
     // A symbol table, and the string table it names, are read whole: bounded.
     GElf_Shdr strings{};
     Elf_Scn* string_section = elf_getscn(elf, shdr.sh_link);
@@ -138,6 +139,7 @@ void read_symbol_table(Elf* elf, Elf_Scn* scn, const GElf_Shdr& shdr, const std:
         const auto value = static_cast<std::uint32_t>(sym.st_value);
         symbols.emplace(sname, value);
         const int type = GELF_ST_TYPE(sym.st_info);
+        if (type == STT_OBJECT && sym.st_size > 0) object_sizes.emplace(sname, static_cast<std::uint32_t>(sym.st_size));
         const bool in_flash = value < kDataSpaceBase && sym.st_shndx != SHN_ABS && sym.st_shndx != SHN_UNDEF;
         if (in_flash && (type == STT_FUNC || type == STT_NOTYPE)) {
             auto [it, inserted] = functions.emplace(value, sname);
@@ -195,7 +197,7 @@ ElfImage ElfImage::load(const std::string& path_given) {
             mmcu_bytes = mmcu_section(scn, shdr, path);
             mmcu = &mmcu_bytes;
         }
-        if (shdr.sh_type == SHT_SYMTAB) read_symbol_table(h.elf, scn, shdr, path, image.symbols_, image.flash_functions_);
+        if (shdr.sh_type == SHT_SYMTAB) read_symbol_table(h.elf, scn, shdr, path, image.symbols_, image.flash_functions_, image.object_sizes_);
     }
     if (!has_text) throw BadInput(path + ": AVR ELF without a .text section (nothing to run)");
 

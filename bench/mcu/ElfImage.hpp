@@ -36,6 +36,12 @@ public:
     std::uint32_t embedded_frequency_hz() const { return embedded_frequency_hz_; }
 
     std::optional<std::uint32_t> symbol_address(const std::string& name) const;
+    // A data object's size in bytes as the symbol table gives it (st_size of
+    // an STT_OBJECT), nothing for other symbols.
+    std::optional<std::uint32_t> object_size(const std::string& name) const {
+        const auto it = object_sizes_.find(name);
+        return it == object_sizes_.end() ? std::nullopt : std::optional<std::uint32_t>(it->second);
+    }
 
     // "name+0x12" for a flash byte address, or "0x1234" when no symbol covers it.
     std::string describe_flash_address(std::uint32_t pc_bytes) const;
@@ -73,6 +79,7 @@ private:
     std::string embedded_mcu_;
     std::uint32_t embedded_frequency_hz_ = 0;
     std::map<std::string, std::uint32_t> symbols_;         // all named symbols
+    std::map<std::string, std::uint32_t> object_sizes_;    // data objects' sizes
     std::map<std::uint32_t, std::string> flash_functions_;  // code symbols by byte address
     std::uint32_t ram_static_end_ = 0;
 };

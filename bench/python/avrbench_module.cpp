@@ -428,13 +428,27 @@ void bind_mcu(py::module_& m) {
                  const auto bytes = mcu.read_ram(symbol, size);
                  return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
              }, py::arg("symbol"), py::arg("size"))
-        .def("symbol", [](const Mcu& mcu, const std::string& symbol, std::size_t size) {
-                 if (size != 1 && size != 2 && size != 4) throw BadInput("symbol: size 1, 2 or 4 bytes");
+        .def("symbol", [](const Mcu& mcu, const std::string& symbol, std::optional<std::size_t> size_given, bool is_signed) {
+                 // The ELF's own size of the object by default; a size past it would read its neighbour.
+                 const auto elf_size = mcu.elf().object_size(symbol);
+                 std::size_t size = size_given.value_or(elf_size.value_or(1));
+                 if (size != 1 && size != 2 && size != 4) {
+                     throw BadInput("symbol: " + symbol + " is " + std::to_string(size) + " bytes; give size=1, 2 or 4 (or read() its bytes)");
+                 }
+                 if (elf_size && size > *elf_size) {
+                     throw BadInput("symbol: " + symbol + " is " + std::to_string(*elf_size) + " byte" + (*elf_size == 1 ? "" : "s") +
+                                    " in the ELF; size=" + std::to_string(size) + " would read past it");
+                 }
                  const auto bytes = mcu.read_ram(symbol, size);
                  std::uint32_t v = 0;
                  for (std::size_t i = size; i-- > 0;) v = (v << 8) | bytes[i];
-                 return v;
-             }, py::arg("name"), py::arg("size") = 1, "an unsigned little-endian variable of 1, 2 or 4 bytes")
+                 if (!is_signed) return static_cast<std::int64_t>(v);
+                 const std::uint32_t sign = 1u << (8 * size - 1);
+                 return static_cast<std::int64_t>(v & sign ? static_cast<std::int64_t>(v) - (static_cast<std::int64_t>(sign) << 1)
+                                                           : static_cast<std::int64_t>(v));
+             }, py::arg("name"), py::arg("size") = py::none(), py::arg("signed") = false,
+             "a little-endian variable: its size from the ELF's symbol table (or size=1, 2, 4), unsigned unless signed=True "
+             "(the symbol table has no type; the sign is the caller's)")
         .def("write", [](Mcu& mcu, const std::string& symbol, const py::bytes& data) {
                  const std::string bytes = data;
                  mcu.read_ram(symbol, bytes.size());  // BadInput past RAM or for an unknown symbol

@@ -269,3 +269,17 @@ def test_a_knob_is_turned_and_pressed_from_python(elf):
     assert mcu.symbol("detents", size=2) == 2
     assert mcu.symbol("clicks", size=2) == 1
     assert bench.part("lcd").lines[0].rstrip() == "Item 2"
+
+
+def test_symbols_take_their_size_from_the_elf_and_a_sign_when_asked(elf):
+    # knob_menu: `int16_t detents`, `uint16_t clicks` (2 bytes each in the
+    # symbol table, avr-nm -S).
+    bench = avrbench.Bench("einsy-rambo", elf("knob_menu"))
+    bench.run_for("100ms")
+    bench.part("knob").turn(-2)
+    bench.run_for("300ms")
+    mcu = bench.mcu()
+    assert mcu.symbol("detents", signed=True) == -2
+    assert mcu.symbol("detents") == 0x10000 - 2        # the same two bytes, unsigned
+    with pytest.raises(avrbench.BadInput, match="is 2 bytes in the ELF; size=4 would read past it"):
+        mcu.symbol("clicks", size=4)
