@@ -21,8 +21,7 @@ std::unique_ptr<BoardRun> run_board_debugged(const BoardRunOptions& options, Deb
         debugger.attach(run->bench().board().mcus(), board_debug_view(run->bench(), run->host(), !options.pty.has_value()));
         run->run();
     });
-    debugger.detach();
-    debugger.run_ended();
+    debugger.detach();  // the front end tells the debugger the exit code (Debugger::run_ended)
     return run;
 }
 
@@ -40,8 +39,7 @@ std::unique_ptr<McuRun> run_mcu_debugged(const McuRunOptions& options, Debugger&
         debugger.attach({&run->mcu()}, mcu_debug_view(*run));
         run->run();
     });
-    debugger.detach();
-    debugger.run_ended();
+    debugger.detach();  // the front end tells the debugger the exit code (Debugger::run_ended)
     return run;
 }
 

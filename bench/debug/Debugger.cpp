@@ -195,11 +195,13 @@ void Debugger::detach() {
     mcus_.clear();
 }
 
-void Debugger::run_ended() {
+void Debugger::run_ended(int exit_code) {
+    char exited[8];
+    std::snprintf(exited, sizeof exited, "W%02x", static_cast<unsigned>(exit_code) & 0xFF);
     for (auto& t : targets_) {
         if (!t->conn || !t->conn->open()) continue;
-        // W: exited (its time is up); X0b: killed by SIGSEGV (it crashed).
-        if (t->waiting) t->conn->send_packet(t->halted ? "X0b" : "W00");
+        // W: exited with the front end's exit code; X0b: killed by SIGSEGV (it crashed).
+        if (t->waiting) t->conn->send_packet(t->halted ? "X0b" : exited);
         t->conn->close();
     }
 }

@@ -78,8 +78,10 @@ public:
     // The run's objects are gone or about to go (its MCUs are not touched).
     void detach();
     // The run ended (its time was up, the MCU halted or the user stopped it):
-    // every debugger waiting for a stop hears that the program exited.
-    void run_ended();
+    // every debugger waiting for a stop hears that the program exited, with
+    // the exit code the front end returns (RSP 'W', so gdb prints
+    // "exited with code 03"), or was killed by SIGSEGV if its MCU crashed.
+    void run_ended(int exit_code);
     // True once a debugger killed the program ('k'): the front end reports an interrupted run.
     bool killed() const { return killed_; }
 

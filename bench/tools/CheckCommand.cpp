@@ -67,13 +67,15 @@ int check_debugged(const CheckArgs& args, DebugOptions debug, const std::string&
     ScenarioResult result;
     debugger.run_replays([&] { result = run_scenario(spec, options); });
     debugger.detach();
-    debugger.run_ended();
     std::fputs(result.text().c_str(), stdout);
     if (debugger.killed()) {
         std::fprintf(stderr, "avrbench: the debugger killed the program\n");
+        debugger.run_ended(kExitInterrupted);
         return kExitInterrupted;
     }
-    return result.passed ? kExitOk : kExitFinding;
+    const int code = result.passed ? kExitOk : kExitFinding;
+    debugger.run_ended(code);
+    return code;
 }
 
 // GoogleTest's sharding variables, so a CI matrix splits scenario lists the

@@ -86,7 +86,9 @@ int replay_command(const FuzzArgs& args) {
         Debugger debugger(*debug);
         const auto run = run_board_debugged(o, debugger);
         for (const std::string& line : run->summary()) std::printf("%s\n", line.c_str());
-        return exit_code(debugged_verdict(debugger, run->verdict(true)));
+        const int code = exit_code(debugged_verdict(debugger, run->verdict(true)));
+        debugger.run_ended(code);
+        return code;
     }
     BoardRun run(o);
     run.run();

@@ -236,7 +236,9 @@ int run_board_command(const RunArgs& args) {
         const auto run = run_board_debugged(options, debugger);
         progress.finish();
         for (const std::string& line : run->summary()) std::printf("%s\n", line.c_str());
-        return exit_code(debugged_verdict(debugger, run->verdict(args.strict)));
+        const int code = exit_code(debugged_verdict(debugger, run->verdict(args.strict)));
+        debugger.run_ended(code);
+        return code;
     }
     BoardRun run(std::move(options));
     run.run();
@@ -286,7 +288,9 @@ int run_command(const RunArgs& args) {
         const auto run = run_mcu_debugged(o, debugger);
         progress.finish();
         for (const std::string& text : run->summary()) std::printf("%s\n", text.c_str());
-        return exit_code(debugged_verdict(debugger, run->verdict()));
+        const int code = exit_code(debugged_verdict(debugger, run->verdict()));
+        debugger.run_ended(code);
+        return code;
     }
     McuRun run(std::move(o));
     run.run();

@@ -368,6 +368,21 @@ class GdbTests(unittest.TestCase):
         rc, _, err = s.finish()
         self.assertEqual(rc, 0, err)
 
+    def test_gdb_sees_the_runs_exit_code(self):
+        # blink_timer1 never answers a G-code line: the job is unfinished when
+        # --for ends, a timeout (exit 3, README "Exit codes"), which gdb hears
+        # in the RSP 'W' packet and prints as the inferior's exit code.
+        target = elf("blink_timer1")
+        job = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"gdb-exit-{os.getpid()}.gcode")
+        with open(job, "w") as f:
+            f.write("G1 X1\n")
+        s = Session([target, "--board", "arduino-uno", "--gcode", job, "--for", "0.5s"])
+        out = gdb(s.port(), target, ["continue"])
+        rc, _, err = s.finish()
+        os.remove(job)
+        self.assertEqual(rc, 3, err)
+        self.assertIn("exited with code 03]", out)
+
     def test_bad_gdb_option_is_one_line_with_the_bad_input_exit_code(self):
         r = subprocess.run([CLI, "run", elf("gdb_target"), "--gdb", "x=notaport"], capture_output=True, text=True,
                            timeout=GUARD_S)
