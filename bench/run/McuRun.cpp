@@ -100,7 +100,11 @@ std::vector<std::string> McuRun::summary() const {
                            static_cast<unsigned long long>(mcu.idle_jumps()),
                            static_cast<double>(mcu.idle_cycles_skipped()) / mcu.frequency_hz()));
     }
-    if (options_.until_sleep) out.push_back(format_text("  stopped    %s", slept_ ? "firmware executed SLEEP" : "time limit"));
+    if (options_.until_sleep) {
+        // A SLEEP with interrupts off halts the core: the run stopped there, not at the time limit.
+        const char* why = slept_ ? "firmware executed SLEEP" : mcu.halted() ? "the core halted (below)" : "time limit";
+        out.push_back(format_text("  stopped    %s", why));
+    }
     if (mcu.halted()) out.push_back("  halted     " + mcu.halt_reason());
     if (uart0_ != nullptr) {
         out.push_back(format_text("  uart0      %zu bytes from firmware, %llu bytes to firmware", uart0_->transmitted().size(),

@@ -290,3 +290,20 @@ TEST(CliRun, TraceOnlyTakesPartSignalsAndNetNamesAsTheVcdNamesThem) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(CliRun, UntilSleepOnASleepWithInterruptsOffSaysTheCoreHaltedNotTheTimeLimit) {
+    // firmware/boards/tmc2130_driver ends in sleep_mode() with interrupts
+    // never enabled: the core halts at that SLEEP, long before --for's 1 s.
+    const auto dir = test::scratch_dir("cli-until-sleep-halt");
+    const auto r = test::run_command(kCli + " run " + quoted(test::firmware("tmc2130_driver")) +
+                                         " --mcu atmega2560 --freq 16MHz --until-sleep --for 1s", dir);
+    EXPECT_NE(r.out.find("  stopped    the core halted (below)\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  halted     SLEEP with interrupts disabled"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("time limit"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace avrbench
