@@ -260,19 +260,10 @@ void SdCard::command(const std::array<std::uint8_t, 6>& c) {
         case 8:  // SEND_IF_COND: R7 echoes the voltage and the check pattern
             respond({ncr, r1(), 0x00, 0x00, static_cast<std::uint8_t>((arg >> 8) & 0x0F), static_cast<std::uint8_t>(arg)});
             return;
-        case 9: {  // SEND_CSD
+        case 9:   // SEND_CSD
+        case 10: {  // SEND_CID: R1, then the register as a data block (token, 16 bytes, CRC16)
+            const auto reg = index == 9 ? csd() : cid();
             std::vector<std::uint8_t> b = {ncr, r1(), 0xFF, kStartBlock};
-            const auto reg = csd();
-            b.insert(b.end(), reg.begin(), reg.end());
-            const std::uint16_t crc = crc16(reg.data(), reg.size());
-            b.push_back(static_cast<std::uint8_t>(crc >> 8));
-            b.push_back(static_cast<std::uint8_t>(crc));
-            respond(b);
-            return;
-        }
-        case 10: {  // SEND_CID
-            std::vector<std::uint8_t> b = {ncr, r1(), 0xFF, kStartBlock};
-            const auto reg = cid();
             b.insert(b.end(), reg.begin(), reg.end());
             const std::uint16_t crc = crc16(reg.data(), reg.size());
             b.push_back(static_cast<std::uint8_t>(crc >> 8));
