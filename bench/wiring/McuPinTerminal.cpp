@@ -117,17 +117,51 @@ void McuPortWatch::on_pud_write(IoWriteHook& hook, avr_t* avr, avr_io_addr_t add
     static_cast<McuPortWatch*>(hook.context())->refresh_all();
 }
 
+namespace {
+
+unsigned word_at(const avr_t* avr, std::uint32_t pc) {
+    return pc + 1 <= avr->flashend ? avr->flash[pc] | (avr->flash[pc + 1] << 8) : 0xFFFF;
+}
+
+}  // namespace
+
+// Which PINx bits the instruction at `pc` uses (AVR Instruction Set Manual
+// encodings). SBI/CBI (1001 10x0 AAAA Abbb) read PINx only to write one bit
+// back (a toggle); SBIC/SBIS (1001 10x1 AAAA Abbb) test bit b. IN (1011 0AAd
+// dddd AAAA) and LDS (1001 000d dddd 0000, k) load the byte into Rd: when the
+// next instruction (after a COM Rd, 1001 010d dddd 0000) masks Rd with ANDI
+// (0111 KKKK dddd KKKK) or tests one bit with SBRC/SBRS (1111 11xd dddd 0bbb),
+// only those bits are used - a whole-port read for one pin (Prusa-Firmware's
+// `lds r24, PINK; com r24; andi r24, 1`) does not read the port's other pins.
+// Anything else takes the whole byte.
+std::uint8_t pin_bits_used(const avr_t* avr, std::uint32_t pc) {
+    const unsigned opcode = word_at(avr, pc);
+    if ((opcode & 0xFD00) == 0x9800) return 0;
+    if ((opcode & 0xFD00) == 0x9900) return static_cast<std::uint8_t>(1u << (opcode & 0x7));
+    unsigned rd = 0;
+    std::uint32_t next = 0;
+    if ((opcode & 0xF800) == 0xB000) {
+        rd = (opcode >> 4) & 0x1F;
+        next = pc + 2;
+    } else if ((opcode & 0xFE0F) == 0x9000) {
+        rd = (opcode >> 4) & 0x1F;
+        next = pc + 4;
+    } else {
+        return 0xFF;
+    }
+    unsigned op = word_at(avr, next);
+    if ((op & 0xFE0F) == 0x9400 && ((op >> 4) & 0x1F) == rd) op = word_at(avr, next + 2);  // COM Rd
+    if ((op & 0xF000) == 0x7000 && 16 + ((op >> 4) & 0xF) == rd) {                        // ANDI Rd, K
+        return static_cast<std::uint8_t>(((op >> 4) & 0xF0) | (op & 0x0F));
+    }
+    if ((op & 0xFC08) == 0xFC00 && ((op >> 4) & 0x1F) == rd) return static_cast<std::uint8_t>(1u << (op & 0x7));  // SBRC/SBRS
+    return 0xFF;
+}
+
 std::uint8_t McuPortWatch::on_pin_read(IoReadHook& hook, avr_t* avr, avr_io_addr_t addr) {
     auto* watch = static_cast<PortWatch*>(hook.context());
-    // Which PINx bits the instruction uses (AVR Instruction Set Manual
-    // encodings; avr->pc is still the reading instruction's address):
-    // SBI/CBI (1001 10x0 AAAA Abbb) read PINx only to write one bit back (a
-    // toggle), SBIC/SBIS (1001 10x1 AAAA Abbb) test bit b; anything else (IN,
-    // LDS, LD) takes the whole byte.
-    const unsigned opcode = avr->flash[avr->pc] | (avr->flash[avr->pc + 1] << 8);
-    std::uint8_t used = 0xFF;
-    if ((opcode & 0xFD00) == 0x9800) used = 0;
-    if ((opcode & 0xFD00) == 0x9900) used = static_cast<std::uint8_t>(1u << (opcode & 0x7));
+    // avr->pc is still the reading instruction's address.
+    const std::uint8_t used = pin_bits_used(avr, avr->pc);
     for (McuPinTerminal* t : watch->terminals) {
         if ((used & t->pin().mask()) != 0 && t->net()->resolution().state == NetState::Floating && !t->pin().is_output()) {
             t->net()->floating_read(watch->owner->mcu_, t->label());

@@ -98,4 +98,8 @@ private:
     std::vector<std::unique_ptr<IoReadHook>> read_hooks_;
 };
 
+// Which bits of a PINx byte the instruction at byte address `pc` uses (an
+// SBIS tests one; an IN masked at once by ANDI uses the mask; 0xFF: all).
+std::uint8_t pin_bits_used(const avr_t* avr, std::uint32_t pc);
+
 }  // namespace avrbench
