@@ -367,7 +367,7 @@ std::vector<std::uint8_t> SdCard::cid() const {
 void SdCard::on_bus_contention(const std::string& others, Cycle) {
     if (contention_reported_) return;
     contention_reported_ = true;
-    report(kSpiBusContention, "selected together with " + others + ": their outputs fought on MISO (a chip select left floating or low?)");
+    report(kSpiBusContention, spi_contention_detail(others));
 }
 
 std::string SdCard::summary() {

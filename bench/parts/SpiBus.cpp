@@ -52,6 +52,10 @@ void attach_spi_slave(Part& part, std::size_t sck, std::size_t mosi, std::size_t
     spi->attach(slave);
 }
 
+std::string spi_contention_detail(const std::string& others) {
+    return "selected together with " + others + ": their outputs fought on MISO (a chip select left floating or low?)";
+}
+
 std::string spi_mode_problem(const SpiTransfer& t, const SpiLimits& limits) {
     if (t.mode() == limits.mode && t.lsb_first == limits.lsb_first) return "";
     char text[200];

@@ -32,6 +32,11 @@ extern const FindingKind kSpiBusContention;  // spi-bus-contention
 // (one line, naming the pin) otherwise.
 void attach_spi_slave(Part& part, std::size_t sck, std::size_t mosi, std::size_t miso, SpiSlave& slave);
 
+// The spi-bus-contention finding's text for a slave selected together with
+// `others` (each slave reports it once: the bus stays wrong until the
+// firmware fixes its chip selects).
+std::string spi_contention_detail(const std::string& others);
+
 // "" when `t` was shifted in the mode and bit order `limits` gives, else why
 // not (a kSpiModeMismatch finding's text).
 std::string spi_mode_problem(const SpiTransfer& t, const SpiLimits& limits);

@@ -414,9 +414,9 @@ std::string Tmc2130::summary() {
 }
 
 void Tmc2130::on_bus_contention(const std::string& others, Cycle) {
-    if (contention_reported_) return;  // once: the bus stays wrong until the firmware fixes its chip selects
+    if (contention_reported_) return;
     contention_reported_ = true;
-    report(kSpiBusContention, "selected together with " + others + ": their outputs fought on MISO (a chip select left floating or low?)");
+    report(kSpiBusContention, spi_contention_detail(others));
 }
 
 }  // namespace avrbench

@@ -71,6 +71,8 @@ std::unique_ptr<Fix> install_uart_ursel(avr_t* avr);
 // EEPROM: EEPE stays set for the programming time (EEPM modes), CPU halts
 // after EEPE/EERE, EE_READY is a level interrupt.
 std::unique_ptr<Fix> install_eeprom_timing(avr_t* avr);
+// SPI master: a byte takes 8 SCK periods at the SPR/SPI2X clock (simavr:
+// 100 us whatever the clock); SPDR written during a transfer sets WCOL.
 std::unique_ptr<Fix> install_spi_timing(avr_t* avr);
 // SPM only from the boot loader section (BOOTSZ fuses); elsewhere a no-op.
 std::unique_ptr<Fix> install_self_programming(avr_t* avr);
