@@ -43,6 +43,13 @@ std::vector<ParamSpec> Axis::param_specs() {
          .help = "a reversal of the carriage up to this far is not traced in position_mm (linear); switches and "
                  "judges still follow every 1/256 step",
          .min = 0, .max = 1e-3},
+        {.name = "stall_allowance", .type = PT::Quantity, .dimension = Dimension::Length, .default_value = "0mm",
+         .source = "0: any step past an end is a crash; an axis homed sensorless against its frame sets what its "
+                   "motor may slip there, e.g. 4 full steps (a stalled two-phase motor slips by whole electrical "
+                   "periods of 4 full steps)",
+         .help = "how far the driver may push the carriage into an end of travel (the motor stalling against the "
+                 "frame) before it is an axis-out-of-travel finding (linear)",
+         .min = 0, .max = 0.1},
     };
 }
 
@@ -72,6 +79,7 @@ Axis::Axis(std::string name, Mcu& clock, const ParamValues& params)
         travel_m_ = params.quantity("travel");
         start_m_ = params.quantity("start_position");
         trace_deadband_m_ = params.quantity("trace_deadband");
+        stall_allowance_m_ = params.quantity("stall_allowance");
         if (start_m_ < 0 || start_m_ > travel_m_) {
             throw part_error(this->name(), "start_position outside 0..travel");
         }
@@ -93,6 +101,7 @@ void Axis::connect_drive(ShaftMotion& driver) {
         carriage_256_ = std::llround(start_m_ / metres_per_256_);
         traced_256_ = carriage_256_;
         deadband_256_ = static_cast<std::int64_t>(std::floor(trace_deadband_m_ / metres_per_256_ + 1e-9));
+        stall_allowance_256_ = static_cast<std::int64_t>(std::floor(stall_allowance_m_ / metres_per_256_ + 1e-9));
     }
     // STEP pulses the driver took, and the net position in steps (signed).
     add_readout("steps", [this] { return driver_ != nullptr ? static_cast<double>(driver_->steps_taken()) : 0.0; });
@@ -129,18 +138,30 @@ void Axis::on_step(int delta_256) {
     }
     const std::int64_t wanted = carriage_256_ + delta_256;
     if (wanted < 0 || wanted > travel_256_) {
-        if (!in_crash_) {
+        // The steps a stalled motor loses against the frame add up; within
+        // the allowance they are sensorless homing, past it a crash.
+        pushed_256_ += wanted < 0 ? -wanted : wanted - travel_256_;
+        if (!in_crash_ && pushed_256_ > stall_allowance_256_) {
             in_crash_ = true;
             ++crashes_;
-            char detail[160];
-            std::snprintf(detail, sizeof detail, "carriage driven past the %s end of travel (%.4f mm of 0..%.3f mm)",
-                          wanted < 0 ? "lower" : "upper", static_cast<double>(wanted) * metres_per_256_ * 1e3,
-                          travel_m_ * 1e3);
+            char detail[200];
+            const double end_mm = wanted < 0 ? 0.0 : travel_m_ * 1e3;
+            const double pushed_mm = static_cast<double>(pushed_256_) * metres_per_256_ * 1e3;
+            if (stall_allowance_256_ == 0) {
+                std::snprintf(detail, sizeof detail, "carriage driven past the %s end of travel (%.4f mm of 0..%.3f mm)",
+                              wanted < 0 ? "lower" : "upper", wanted < 0 ? -pushed_mm : end_mm + pushed_mm,
+                              travel_m_ * 1e3);
+            } else {
+                std::snprintf(detail, sizeof detail,
+                              "carriage driven %.4f mm into the %s end of travel (stall allowance %.4f mm)", pushed_mm,
+                              wanted < 0 ? "lower" : "upper", stall_allowance_m_ * 1e3);
+            }
             report(Axis::kAxisOutOfTravel, detail);
         }
         carriage_256_ = wanted < 0 ? 0 : travel_256_;  // the carriage stays at the end it hit
     } else {
         in_crash_ = false;
+        pushed_256_ = 0;
         carriage_256_ = wanted;
     }
     trace_position();

@@ -62,6 +62,9 @@ private:
     std::int64_t traced_256_ = 0;
     int traced_direction_ = 0;
     double angle_rad_ = 0;
+    double stall_allowance_m_ = 0;
+    std::int64_t stall_allowance_256_ = 0;
+    std::int64_t pushed_256_ = 0;  // driven into the end since the carriage last moved freely
     bool in_crash_ = false;
     unsigned crashes_ = 0;
     std::size_t sig_position_ = 0;

@@ -75,6 +75,11 @@ std::vector<ParamSpec> Tmc2130::param_specs() {
         {.name = "sg_free", .type = PT::Integer, .default_value = "500",
          .source = "assumed: SG_RESULT of a motor turning freely at SGT 0 (datasheet §8: 0..1023, higher = less load)",
          .help = "stallGuard2 reading without load", .min = 0, .max = 1023},
+        {.name = "stall_sgt", .type = PT::Integer, .default_value = "0",
+         .source = "the motor's tuning: the SGT its maker found to read 0 with the motor blocked at homing speed "
+                   "(Prusa MK3S: TMC2130_SG_THRS_X/Y 3, Z 4)",
+         .help = "COOLCONF.SGT at which a blocked motor reads SG_RESULT 0; each SGT step away moves the reading by 16",
+         .min = -64, .max = 63},
     };
 }
 
@@ -99,6 +104,7 @@ Tmc2130::Tmc2130(std::string name, Mcu& clock, const ParamValues& params) : Part
     clock_hz_ = params.quantity("clock");
     motor_supply_v_ = params.quantity("motor_supply");
     sg_free_ = static_cast<int>(params.integer("sg_free"));
+    stall_sgt_ = static_cast<int>(params.integer("stall_sgt"));
 
     sig_position_ = add_signal("position_steps", true);
     sig_enabled_ = add_signal("enabled", false, 0);
@@ -319,13 +325,13 @@ void Tmc2130::on_step_edge() {
 
 // stallGuard2 (§8): SG_RESULT falls with the load, 0 at a stall; SGT
 // (COOLCONF bits 22:16, signed) shifts it, a higher SGT needing more load for
-// 0. The load here is all or nothing: a carriage that did not move on a
+// 0 (at the motor's tuned `stall_sgt`). The load here is all or nothing: a carriage that did not move on a
 // step is blocked (its axis at an end of travel). A stall counts while
 // stallGuard is active: THIGH <= TSTEP <= TCOOLTHRS (§8.2 TCOOLTHRS).
 void Tmc2130::update_stallguard(bool blocked) {
     int sgt = static_cast<int>((regs_[kCoolconf] >> 16) & 0x7F);
     if (sgt >= 64) sgt -= 128;
-    const int raw = (blocked ? 0 : sg_free_) + kSgPerSgtStep * sgt;
+    const int raw = (blocked ? 0 : sg_free_) + kSgPerSgtStep * (sgt - stall_sgt_);
     sg_result_ = std::clamp(raw, 0, 1023);
     const std::uint32_t t = tstep();
     const bool active = regs_[kTcoolthrs] != 0 && t <= regs_[kTcoolthrs] && t >= regs_[kThigh];

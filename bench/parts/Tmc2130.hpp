@@ -92,6 +92,7 @@ private:
     bool forward_dir_level_;
     double rsense_ohm_, clock_hz_, motor_supply_v_;
     int sg_free_;
+    int stall_sgt_;
 
     std::array<std::uint32_t, 128> regs_{};
     bool reset_flag_ = true;  // GSTAT.reset: set at power-up, cleared by reading GSTAT

@@ -41,8 +41,8 @@ nets:
 
 struct TmcRun {
     Board board;
-    explicit TmcRun(const std::string& firmware, double seconds = 3)
-        : board(parse_board_text(kBoard, "tmc2130-x.yaml"), {{"mega", test::firmware(firmware)}}) {
+    explicit TmcRun(const std::string& firmware, double seconds = 3, const std::string& board_text = kBoard)
+        : board(parse_board_text(board_text, "tmc2130-x.yaml"), {{"mega", test::firmware(firmware)}}) {
         board.run_for_seconds(seconds);
         EXPECT_EQ(board.mcu().read_ram_u8("done"), 1);
     }
@@ -116,6 +116,34 @@ TEST(Tmc2130, StallGuardHomingStopsAtTheEndOfTravel) {
     EXPECT_EQ(r.finding_kinds(), std::vector<std::string>{"axis-out-of-travel"});
 }
 
+// The same X axis homed sensorless against its frame: it may slip 4 full
+// steps there (one electrical period), 4 * 16 microsteps / 100 steps/mm =
+// 0.64 mm (the prusa-mk3s board's setting).
+std::string board_with_stall_allowance() {
+    std::string text = kBoard;
+    const std::string axis = "start_position: 5mm}";
+    text.replace(text.find(axis), axis.size(), "start_position: 5mm, stall_allowance: 0.64mm}");
+    return text;
+}
+
+TEST(Tmc2130, AStallWithinTheAxisStallAllowanceIsNoCrash) {
+    TmcRun r("tmc2130_stall_home", 3, board_with_stall_allowance());
+    // As above: the 501st microstep pushes 0.01 mm into the end, within 0.64 mm.
+    EXPECT_EQ(r.driver().steps_taken(), 501u);
+    EXPECT_TRUE(r.driver().stalled());
+    EXPECT_TRUE(r.board.findings().empty());
+}
+
+TEST(Tmc2130, AStallTheFirmwareMissesIsACrashPastTheStallAllowance) {
+    TmcRun r("tmc2130_stall_home_sgt2", 4, board_with_stall_allowance());
+    // 2000 full steps from 5 mm: 500 microsteps to the end, then 31 500 into
+    // it; the 65th passes the 64 allowed (0.64 mm): 0.65 mm, reported once.
+    EXPECT_EQ(r.driver().steps_taken(), 2000u * 16u);
+    ASSERT_EQ(r.finding_kinds(), std::vector<std::string>{"axis-out-of-travel"});
+    EXPECT_EQ(r.board.findings()[0].detail,
+              "carriage driven 0.6500 mm into the lower end of travel (stall allowance 0.6400 mm)");
+}
+
 TEST(Tmc2130, AHigherSgtNeedsMoreLoadThanABlockedMotorGives) {
     TmcRun r("tmc2130_stall_home_sgt2", 4);
     // SGT +2 lifts the reading by 2 * 16 (the model's assumed step): a blocked
@@ -125,6 +153,19 @@ TEST(Tmc2130, AHigherSgtNeedsMoreLoadThanABlockedMotorGives) {
     EXPECT_FALSE(r.driver().stalled());
     EXPECT_EQ(r.board.mcu().read_ram_u16("steps_to_stall"), 2000);
     EXPECT_EQ(r.driver().steps_taken(), 2000u * 16u);
+}
+
+TEST(Tmc2130, AMotorTunedToSgtTwoStallsAtSgtTwo) {
+    // The motor reads 0 blocked at SGT +2 (its stall_sgt): the SGT +2
+    // firmware now stops as the SGT 0 one did at stall_sgt 0 (501 steps, 32 loops).
+    std::string text = kBoard;
+    const std::string driver = "microsteps: 16}";
+    text.replace(text.find(driver), driver.size(), "microsteps: 16, stall_sgt: 2}");
+    TmcRun r("tmc2130_stall_home_sgt2", 3, text);
+    EXPECT_EQ(r.driver().sg_result(), 0);
+    EXPECT_TRUE(r.driver().stalled());
+    EXPECT_EQ(r.board.mcu().read_ram_u16("steps_to_stall"), 32);
+    EXPECT_EQ(r.driver().steps_taken(), 501u);
 }
 
 TEST(Tmc2130, TheWrongSpiModeAndAFastClockAreFindings) {

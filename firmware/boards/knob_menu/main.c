@@ -1,7 +1,7 @@
 // A two-line "menu" on the Einsy RAMBo's 20x4 LCD driven by its knob, for the
 // rotary_knob part's tests (tests/boards/test_rotary_knob.cpp and the
-// scenario einsy_knob_menu): the knob's contacts BTN_EN1 72 = PJ2 and BTN_EN2
-// 14 = PJ1 and its button BTN_ENC 9 = PH6 (Prusa-Firmware pins_Einsy_1_0.h
+// scenario einsy_knob_menu): the knob's contacts BTN_EN2 14 = PJ1 (A, leading
+// clockwise, see bench/boards/einsy-rambo.yaml) and BTN_EN1 72 = PJ2 (B) and its button BTN_ENC 9 = PH6 (Prusa-Firmware pins_Einsy_1_0.h
 // with fastio.h) close to GND and are read with the pull-ups on, every
 // 100 us, as quadrature: 4 transitions a detent (Prusa's
 // ENCODER_PULSES_PER_STEP). Line 1 shows "Item <detents>", line 2
@@ -69,7 +69,7 @@ static void lcd_init(void) {
 
 // The knob's state as a position in the cycle 00 -> A -> A+B -> B (closed = 1).
 static uint8_t knob_phase(void) {
-    const uint8_t a = !(PINJ & (1 << PJ2)), b = !(PINJ & (1 << PJ1));
+    const uint8_t a = !(PINJ & (1 << PJ1)), b = !(PINJ & (1 << PJ2));
     static const uint8_t phase_of[4] = {0, 1, 3, 2};  // index: a | b << 1
     return phase_of[a | (b << 1)];
 }
