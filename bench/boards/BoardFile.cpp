@@ -384,7 +384,8 @@ void parse_parts(const YAML::Node& root, const std::string& path, BoardSpec& spe
                 if (key == "type") {
                     p.type = yaml_scalar(field.second, path, "type");
                 } else {
-                    p.params.push_back({key, yaml_scalar(field.second, path, "parameter " + key), yaml_where(path, field.first)});
+                    p.params.push_back({key, yaml_scalar(field.second, path, "parameter " + key), yaml_where(path, field.first),
+                                        std::filesystem::path(path).parent_path().string()});
                 }
             }
             if (p.type.empty()) throw BadInput(p.location + ": part '" + p.name + "': missing 'type'");

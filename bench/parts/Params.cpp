@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "core/Errors.hpp"
 
@@ -78,6 +79,7 @@ void parse_into(const ParamSpec& spec, const std::string& value, const std::stri
             throw BadInput(what + ": '" + value + "' is not one of " + list);
         }
         case ParamType::Text:
+        case ParamType::Path:
             out.set_text(spec.name, value);
             return;
     }
@@ -163,7 +165,11 @@ ParamValues resolve_params(const std::vector<ParamSpec>& specs, const std::map<s
             throw BadInput(raw.location + ": part '" + part_name + "': unknown parameter '" + raw.name +
                            "' (known: " + known + ")");
         }
-        parse_into(*spec, raw.value, raw.location + ": part '" + part_name + "': " + raw.name, values);
+        std::string value = raw.value;
+        if (spec->type == ParamType::Path && !raw.directory.empty() && std::filesystem::path(value).is_relative()) {
+            value = (std::filesystem::path(raw.directory) / value).string();
+        }
+        parse_into(*spec, value, raw.location + ": part '" + part_name + "': " + raw.name, values);
     }
     for (const auto& spec : specs) {
         if (spec.required && !values.has(spec.name)) {

@@ -16,7 +16,8 @@ enum class ParamType {
     Quantity,  // a number with a unit of `dimension` (or a bare number for Dimensionless)
     Integer,   // a whole number
     Choice,    // one of `choices`
-    Text,      // free text (file names, references to other parts)
+    Text,      // free text (references to other parts)
+    Path,      // a file or folder name, relative to the board file that gives it
 };
 
 struct ParamSpec {
@@ -50,6 +51,7 @@ struct RawParam {
     std::string name;
     std::string value;
     std::string location;  // "file:line" for messages
+    std::string directory;  // the folder of the board file it is written in (Path parameters start there)
 };
 
 class ParamValues {

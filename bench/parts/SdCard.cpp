@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include "core/Errors.hpp"
 #include "core/InputFile.hpp"
@@ -67,14 +69,36 @@ void set_bits(std::vector<std::uint8_t>& reg, int hi, int lo, std::uint32_t valu
 
 void finish_register(std::vector<std::uint8_t>& reg) { reg[15] = static_cast<std::uint8_t>(crc7(reg.data(), 15) << 1 | 1); }
 
+// A folder's files by name (so the card is the same wherever the folder is
+// checked out), each read as an input file.
+std::vector<FatFile> folder_files(const std::string& folder, const std::string& part) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec)) throw part_error(part, "folder " + folder + ": no such folder");
+    std::vector<std::filesystem::path> paths;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+        if (entry.is_directory()) throw part_error(part, "folder " + folder + ": '" + entry.path().filename().string() +
+                                                             "' is a folder (the card gets only the top level's files)");
+        paths.push_back(entry.path());
+    }
+    if (ec) throw part_error(part, "folder " + folder + ": " + ec.message());
+    std::sort(paths.begin(), paths.end());
+    std::vector<FatFile> files;
+    for (const auto& p : paths) files.push_back({p.filename().string(), read_input_file(p.string(), "sd_card file", 32u << 20)});
+    return files;
+}
+
 }  // namespace
 
 std::vector<ParamSpec> SdCard::param_specs() {
     using PT = ParamType;
     using D = Dimension;
     return {
-        {.name = "image", .type = PT::Text,
-         .help = "a disk image (a multiple of 512 bytes, at most 1 GiB), read once and never written; none: an empty card of `size`"},
+        {.name = "image", .type = PT::Path,
+         .help = "a disk image (a multiple of 512 bytes, at most 1 GiB), read once; written only with write_back: yes"},
+        {.name = "folder", .type = PT::Path,
+         .help = "instead of an image: a folder whose files (8.3 names, no subfolders) go on a 32 MiB FAT16 card"},
+        {.name = "write_back", .type = PT::Choice, .default_value = "no", .choices = {"no", "yes"},
+         .help = "yes: each block the firmware writes goes to `image` too (the file changes); no: the card's copy only"},
         {.name = "size", .type = PT::Integer, .default_value = "8388608", .source = "assumed: an 8 MiB card when no image is given",
          .help = "bytes without an image (a multiple of 512 KiB)", .min = 524288, .max = 1073741824},
         {.name = "card", .type = PT::Choice, .default_value = "sdhc", .choices = {"sdhc", "sdsc"},
@@ -95,6 +119,7 @@ SdCard::SdCard(std::string name, Mcu& clock, const ParamValues& params) : Part(s
     sdhc_ = params.text("card") == "sdhc";
     init_time_s_ = params.quantity("init_time");
     write_latency_s_ = params.quantity("write_latency");
+    if (params.has("image") && params.has("folder")) throw part_error(this->name(), "give an image or a folder, not both");
     if (params.has("image")) {
         const std::string bytes = read_input_file(params.text("image"), "sd_card image", 1u << 30);
         if (bytes.empty() || bytes.size() % kBlock != 0) {
@@ -102,7 +127,12 @@ SdCard::SdCard(std::string name, Mcu& clock, const ParamValues& params) : Part(s
                                                " bytes, not a whole number of 512-byte blocks");
         }
         memory_.assign(bytes.begin(), bytes.end());
+        if (params.text("write_back") == "yes") write_back_path_ = params.text("image");
+    } else if (params.has("folder")) {
+        if (params.text("write_back") == "yes") throw part_error(this->name(), "write_back needs an image (a folder's card is made in memory)");
+        memory_ = make_fat16_volume(folder_files(params.text("folder"), this->name()), "part '" + this->name() + "': folder " + params.text("folder"));
     } else {
+        if (params.text("write_back") == "yes") throw part_error(this->name(), "write_back needs an image");
         const long long size = params.integer("size");
         if (size % (512 * 1024) != 0) throw part_error(this->name(), "size must be a multiple of 512 KiB");
         memory_.assign(static_cast<std::size_t>(size), 0);
@@ -130,6 +160,19 @@ void SdCard::start() {
 
 void SdCard::on_input(std::size_t pin, bool level) {
     if (pin == cs_pin_) selected_ = !level;
+}
+
+std::optional<std::vector<FatFile>> SdCard::stored_files() const {
+    if (!inserted_) return std::nullopt;
+    return read_fat_root_files(memory_);
+}
+
+void SdCard::write_back(std::uint64_t offset, const std::uint8_t* block) const {
+    std::fstream file(write_back_path_, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(offset));
+    file.write(reinterpret_cast<const char*>(block), kBlock);
+    file.flush();
+    if (!file) throw part_error(name(), "write_back: cannot write block " + std::to_string(offset / kBlock) + " of " + write_back_path_);
 }
 
 std::uint8_t SdCard::r1() const { return idle_ ? kIdle : 0; }
@@ -202,6 +245,7 @@ std::uint8_t SdCard::byte(std::uint8_t in) {
         response = kDataCrcError;
     } else {
         std::copy(data, data + kBlock, memory_.begin() + static_cast<std::ptrdiff_t>(write_offset_));
+        if (!write_back_path_.empty()) write_back(write_offset_, data);
         ++blocks_written_;
         write_offset_ += kBlock;
         if (write_offset_ + kBlock > memory_.size()) writing_multiple_ = false;

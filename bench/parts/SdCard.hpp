@@ -4,8 +4,9 @@
 // data tokens, CRC7 on commands (always for CMD0 and CMD8, for all once CMD59
 // turns it on) and CRC16 on data, busy after writes for `write_latency`.
 // The contents come from `image` (a disk image: a FAT file system made with
-// mkfs.vfat and mcopy, docs/BOARDS.md) and stay in memory: the file is never
-// written. Pin `detect` is the slot's card-detect switch (closed to GND
+// mkfs.vfat and mcopy, docs/BOARDS.md) or `folder` (its files on a FAT16
+// volume the part makes) and stay in memory: the image is written only with
+// `write_back: yes`, each block as the firmware writes it. Pin `detect` is the slot's card-detect switch (closed to GND
 // with a card in).
 #pragma once
 
@@ -18,10 +19,11 @@
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
 #include "parts/SpiBus.hpp"
+#include "parts/StoredFiles.hpp"
 
 namespace avrbench {
 
-class SdCard final : public Part, public SpiSlave {
+class SdCard final : public Part, public SpiSlave, public StoredFiles {
 public:
     static const FindingKind kCommandCrc;     // sd-command-crc
     static const FindingKind kIllegalCommand;  // sd-illegal-command
@@ -38,6 +40,7 @@ public:
     std::uint64_t blocks_written() const { return blocks_written_; }
 
     std::optional<std::uint8_t> exchange(const SpiTransfer& transfer) override;
+    std::optional<std::vector<FatFile>> stored_files() const override;
     const std::string& spi_name() const override { return name(); }
     void on_bus_contention(const std::string& others, Cycle cycle) override;
 
@@ -50,6 +53,7 @@ private:
     void respond(std::vector<std::uint8_t> bytes) { out_ = std::move(bytes); out_pos_ = 0; }
     void queue_block(std::uint64_t offset);
     std::uint8_t r1() const;
+    void write_back(std::uint64_t offset, const std::uint8_t* block) const;
     std::vector<std::uint8_t> csd() const;
     std::vector<std::uint8_t> cid() const;
 
@@ -58,6 +62,7 @@ private:
     bool sdhc_;
     double init_time_s_, write_latency_s_;
     std::vector<std::uint8_t> memory_;
+    std::string write_back_path_;  // the image the firmware's writes go to as well; empty: none
 
     bool selected_ = false;
     bool idle_ = true;          // R1 bit 0: in the idle state until ACMD41 completes

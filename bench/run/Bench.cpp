@@ -16,6 +16,7 @@
 #include "core/UserStop.hpp"
 #include "parts/AcceptedMoves.hpp"
 #include "stimulus/CommandedTarget.hpp"
+#include "run/CardPrint.hpp"
 #include "run/CommandedPath.hpp"
 #include "run/HeatTargets.hpp"
 
@@ -215,13 +216,17 @@ namespace {
 // lines read again; where the judge cannot (the machine began one of those
 // moves) or a G92 is among them, the judge stops.
 struct SentLineFeed {
-    SentLineFeed(CommandedMoves& j, FirmwareFamily family) : judge(&j), path(j), grbl(family == FirmwareFamily::Grbl) {
+    SentLineFeed(CommandedMoves& j, FirmwareFamily family, std::vector<const StoredFiles*> card_slots)
+        : judge(&j), path(j), grbl(family == FirmwareFamily::Grbl), cards(std::move(card_slots)) {
         const FamilyArcs arcs = family_arcs(family);
         path.set_arc_rule({arcs.tolerance_mm, arcs.segment_mm});
     }
     CommandedMoves* judge;
     CommandedPath path;
     bool grbl;
+    std::vector<const StoredFiles*> cards;
+    std::string selected_file;  // the last M23's
+    bool selected_started = false;  // an M24 started it: another resumes it
     // grbl 1.1 picks its realtime commands out of the stream wherever they
     // are, in a line it then refuses too (serial.c's receive interrupt, the
     // CMD_ bytes of config.h): those that change how the machine moves are
@@ -265,12 +270,38 @@ struct SentLineFeed {
             u.lost_for_good = true;
             path.stop_now(quoted, kRealtimeWhy);
         }
-        path.accept(grbl ? line_grbl_reads(line.text) : line.text, quoted);
+        if (const auto card = grbl ? std::nullopt : card_print_command(line.text)) {
+            print_from_card(*card, quoted);
+        } else {
+            path.accept(grbl ? line_grbl_reads(line.text) : line.text, quoted);
+        }
         u.moves = path.moves_told() - u.before.moves_told();
         u.renamed = path.renames_told() != u.before.renames_told();
         u.changed = u.moves != 0 || u.renamed || !path.same_state(u.before);
         u.lost_frame = path.lost() && !u.before.lost();
         unanswered.push_back(std::move(u));
+    }
+    // M23 selects the file; M24 starts it: its lines are what the firmware
+    // is told next (a firmware reads the host's later lines while it prints,
+    // so a job that also sends moves then is not judged in order).
+    void print_from_card(const CardPrintCommand& card, const std::string& quoted) {
+        if (card.kind == CardPrintCommand::Kind::Select) {
+            selected_file = card.file;
+            selected_started = false;
+            return;
+        }
+        if (selected_file.empty()) return path.lose(quoted, "starts a card print with no file selected (M23)");
+        if (selected_started) return;
+        selected_started = true;
+        std::string why;
+        const auto program = card_file(cards, selected_file, why);
+        if (!program) return path.lose(quoted, why);
+        // Its lines as a firmware's reader takes them: comments and blank lines dropped.
+        for (const GcodeLine& line : parse_gcode(*program, selected_file)) {
+            if (path.lost()) break;
+            path.accept(line.text, quoted + ": card file " + selected_file + " line " + std::to_string(line.number) + " " +
+                                       quoted_line(line.text));
+        }
     }
     // Bytes sent outside the lines, at a time (--realtime).
     void bytes_sent(const std::string& bytes) {
@@ -324,7 +355,11 @@ void Bench::judge_job_by(const std::function<bool()>& all_answered) const {
 
 void Bench::follow_sent_lines(UartHost& host) {
     auto feeds = std::make_shared<std::vector<SentLineFeed>>();
-    for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge, host.options().family);
+    std::vector<const StoredFiles*> cards;
+    for (Part* part : board_->parts()) {
+        if (const auto* card = dynamic_cast<const StoredFiles*>(part)) cards.push_back(card);
+    }
+    for (CommandedMoves* judge : motion_judges()) feeds->emplace_back(*judge, host.options().family, cards);
     if (feeds->empty()) return;
     judge_job_by([&host] { return host.done(); });
     auto last_sent = std::make_shared<std::size_t>(0);

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "boards/Board.hpp"
+#include "boards/BoardFile.hpp"
+#include "core/Errors.hpp"
 #include "parts/SdCard.hpp"
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
@@ -103,6 +105,56 @@ TEST(SdCard, AnEmptySlotAnswersNothing) {
     // bytes (nobody drives MISO: its pull-up makes every byte 0xFF).
     EXPECT_EQ(board.mcu().read_ram_u8("card_detect"), 1u << 0);
     EXPECT_EQ(board.mcu().read_ram_u8("r1_cmd0"), 0xFF);
+}
+
+TEST(SdCard, WithWriteBackTheFirmwaresBlocksReachTheImage) {
+    const auto dir = test::scratch_dir("sd-card-write-back");
+    const std::string image = make_image(dir);
+    Board board = sd_board(image, ", write_back: \"yes\"");
+    board.run_for_seconds(1);
+    ASSERT_EQ(board.mcu().read_ram_u8("done"), 1);
+    // sd_probe writes "AVRB" and 508 zeros to block 1 (bytes 512..1023).
+    const std::string after = test::slurp(image);
+    EXPECT_EQ(after.size(), 1u << 20);
+    EXPECT_EQ(after.substr(512, 4), "AVRB");
+    EXPECT_EQ(after.substr(0, 4), "FAT!");
+}
+
+// The card on the Einsy's SPI pins, after a board file's parts.
+const char* kSdNets = "nets:\n  sck: [mega.PB1, sd.sck]\n  mosi: [mega.PB2, sd.mosi]\n  miso: [mega.PB3, sd.miso]\n"
+                      "  sd_cs: [mega.PJ6, sd.cs]\n";
+
+// An image or folder named in a board file is found beside the board file,
+// wherever avrbench runs (as an MCU's firmware is).
+TEST(SdCard, AnImageIsFoundBesideTheBoardFileThatNamesIt) {
+    const auto dir = test::scratch_dir("sd-card-relative");
+    make_image(dir);
+    std::ofstream(dir / "board.yaml") << "board: rel\nmcus:\n  mega: {type: atmega2560, clock: 16MHz}\n"
+                                         "parts:\n  sd: {type: sd_card, image: card.img}\n" << kSdNets;
+    Board board(load_board_file((dir / "board.yaml").string()), {{"mega", test::firmware("sd_probe")}});
+    EXPECT_EQ(dynamic_cast<SdCard&>(board.part("sd")).contents().size(), 1u << 20);
+}
+
+TEST(SdCard, AFolderBecomesTheCardsFilesAndFolderErrorsNameTheFile) {
+    const auto dir = test::scratch_dir("sd-card-folder");
+    std::filesystem::create_directories(dir / "jobs");
+    std::ofstream(dir / "jobs" / "part.gco") << "G1 X1\n";
+    std::ofstream(dir / "board.yaml") << "board: f\nmcus:\n  mega: {type: atmega2560, clock: 16MHz}\n"
+                                         "parts:\n  sd: {type: sd_card, folder: jobs}\n" << kSdNets;
+    Board board(load_board_file((dir / "board.yaml").string()), {{"mega", test::firmware("sd_probe")}});
+    const auto files = dynamic_cast<SdCard&>(board.part("sd")).stored_files();
+    ASSERT_TRUE(files.has_value());
+    ASSERT_EQ(files->size(), 1u);
+    EXPECT_EQ((*files)[0].name, "PART.GCO");
+    EXPECT_EQ((*files)[0].bytes, "G1 X1\n");
+
+    std::ofstream(dir / "jobs" / "long-name.gcode") << "G1 X2\n";
+    try {
+        Board bad(load_board_file((dir / "board.yaml").string()), {{"mega", test::firmware("sd_probe")}});
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("'long-name.gcode' is not an 8.3 name"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
