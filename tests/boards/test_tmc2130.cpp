@@ -193,15 +193,19 @@ namespace {
 
 TEST(PrusaMk3sBoard, HomesXSensorlessAgainstTheEndOfItsTravel) {
     // The standard board: X starts mid-travel at 127.5 mm, 100 steps/mm at
-    // 1/16; the stall-homing firmware drives it to 0 (12750 microsteps) and the
-    // 12751st finds it blocked: stallGuard2 on DIAG1, the firmware stops.
+    // 1/16. The stall-homing firmware steps with DIR low, which on the MK3S
+    // is X+ (INVERT_X_DIR 1): it drives X to its upper end, 255 mm - 127.5 mm
+    // = 12750 microsteps away, and the 12751st finds it blocked. Its SGT 0 is
+    // below the motor's tuned 3, so the blocked reading is 0 all the more:
+    // stallGuard2 on DIAG1, the firmware stops.
     Board board(load_board_file("prusa-mk3s"), {{"mega", test::firmware("tmc2130_stall_home")}});
     board.run_for_seconds(2);
     ASSERT_EQ(board.mcu().read_ram_u8("done"), 1);
     auto& x = dynamic_cast<Tmc2130&>(board.part("x_driver"));
     EXPECT_EQ(x.steps_taken(), 12751u);
     EXPECT_TRUE(x.stalled());
-    EXPECT_NEAR(dynamic_cast<Axis&>(board.part("x")).position_mm(), 0.0, 1e-9);
+    EXPECT_NEAR(dynamic_cast<Axis&>(board.part("x")).position_mm(), 255.0, 1e-9);
+    EXPECT_TRUE(board.findings().empty());  // one microstep into the frame: within the stall allowance
     // 12750 = 796 * 16 + 14: the stall comes in the 797th full-step loop.
     EXPECT_EQ(board.mcu().read_ram_u16("steps_to_stall"), 797);
 }
