@@ -74,6 +74,9 @@ std::unique_ptr<Fix> install_eeprom_timing(avr_t* avr);
 // SPI master: a byte takes 8 SCK periods at the SPR/SPI2X clock (simavr:
 // 100 us whatever the clock); SPDR written during a transfer sets WCOL.
 std::unique_ptr<Fix> install_spi_timing(avr_t* avr);
+// SPI master: an input SS driven low makes it a slave (MSTR cleared, SPIF
+// set, the interrupt); simavr ignores SS.
+std::unique_ptr<Fix> install_spi_slave_select(avr_t* avr);
 // SPM only from the boot loader section (BOOTSZ fuses); elsewhere a no-op.
 std::unique_ptr<Fix> install_self_programming(avr_t* avr);
 

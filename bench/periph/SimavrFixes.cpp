@@ -9,7 +9,8 @@ SimavrFixes::SimavrFixes(avr_t* avr) {
                          // peripherals
                          &install_port_overrides, &install_interrupt_timing, &install_external_interrupts, &install_port_pins,
                          &install_watchdog, &install_adc_conversion, &install_uart_transmitter,
-                         &install_uart_ursel, &install_eeprom_timing, &install_spi_timing, &install_self_programming,
+                         &install_uart_ursel, &install_eeprom_timing, &install_spi_timing, &install_spi_slave_select,
+                         &install_self_programming,
                          // timers
                          &install_timer_flags, &install_timer_model}) {
         if (auto fix = install(avr)) fixes_.push_back(std::move(fix));

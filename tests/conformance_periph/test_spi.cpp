@@ -41,5 +41,53 @@ TEST_P(SpiTiming, WritingSpdrDuringATransferSetsWcol) {
 
 INSTANTIATE_TEST_SUITE_P(Parts, SpiTiming, ::testing::Values(&test::kAtmega328p, &test::kAtmega2560), test::part_name);
 
+// The master's SS pin (328P §19.3.2, 2560 §21.3.2; firmware/conformance/
+// peripherals/spi_slave_select): as an input it must stay high; driven low
+// it makes the SPI a slave (MSTR cleared) and sets SPIF, with the interrupt
+// if enabled; as an output it does not matter.
+class SpiSlaveSelect : public ::testing::TestWithParam<const Part*> {};
+
+constexpr std::uint8_t kSpif = 0x80, kMstr = 0x10, kSpe = 0x40, kSpie = 0x80;
+
+bool run_until_stage(Mcu& mcu, std::uint8_t stage) {
+    for (int i = 0; i < 4000 && mcu.read_ram_u8("stage") < stage; ++i) mcu.run_for(50);
+    return mcu.read_ram_u8("stage") >= stage;
+}
+
+TEST_P(SpiSlaveSelect, AnInputSsDrivenLowMakesTheMasterASlave) {
+    const Part& part = *GetParam();
+    Mcu mcu = test::load("spi_slave_select", part);
+    Pin& ss = mcu.pin(std::string(part.mcu) == "atmega2560" ? "PB0" : "PB2");  // SS: 2560 Table 13-6, 328P Table 14-3
+    ASSERT_TRUE(run_until_stage(mcu, 2)) << part.name;
+    // Held high by its pull-up, or an output (even low): the byte goes out, still master.
+    EXPECT_EQ(mcu.read_ram_u8("spsr_input_high") & kSpif, kSpif) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spcr_input_high"), kSpe | kMstr) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spsr_output_low") & kSpif, kSpif) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spcr_output_low"), kSpe | kMstr) << part.name;
+
+    ss.drive(true);
+    ASSERT_TRUE(run_until_stage(mcu, 3)) << part.name;
+    mcu.run_for(500);
+    ss.drive(false);
+    ASSERT_TRUE(run_until_stage(mcu, 4)) << part.name;
+    // "The MSTR bit in SPCR is cleared ... The SPIF Flag in SPSR is set".
+    EXPECT_EQ(mcu.read_ram_u8("spcr_driven_low"), kSpe) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spsr_driven_low") & kSpif, kSpif) << part.name;
+
+    ss.drive(true);
+    ASSERT_TRUE(run_until_stage(mcu, 5)) << part.name;
+    mcu.run_for(500);
+    ss.drive(false);
+    mcu.run_for(20000);
+    ASSERT_EQ(mcu.read_ram_u8("done"), 1) << part.name;
+    // "... and if the SPI interrupt is enabled, and the I-bit in SREG is set,
+    // the interrupt routine will be executed": once, MSTR already cleared.
+    EXPECT_EQ(mcu.read_ram_u8("isr_count"), 1) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spcr_in_isr"), kSpe | kSpie) << part.name;
+    EXPECT_EQ(mcu.read_ram_u8("spcr_after_isr"), kSpe | kSpie) << part.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Parts, SpiSlaveSelect, ::testing::Values(&test::kAtmega328p, &test::kAtmega2560), test::part_name);
+
 }  // namespace
 }  // namespace avrbench
