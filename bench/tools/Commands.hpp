@@ -27,6 +27,7 @@ Command add_run_command(CLI::App& app);                   // RunCommand.cpp
 std::vector<Command> add_check_commands(CLI::App& app);   // CheckCommand.cpp: check, golden update
 std::vector<Command> add_info_commands(CLI::App& app);    // InfoCommands.cpp: boards, findings, cam
 Command add_fuzz_command(CLI::App& app);                  // FuzzCommand.cpp
+Command add_board_command(CLI::App& app);                 // BoardCommand.cpp: board from-config
 
 // The exit code of a verdict, its message (if any) on stderr.
 int exit_code(const RunVerdict& verdict);

@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
     for (Command& c : add_check_commands(app)) commands.push_back(std::move(c));
     for (Command& c : add_info_commands(app)) commands.push_back(std::move(c));
     commands.push_back(add_fuzz_command(app));
+    commands.push_back(add_board_command(app));
 
     try {
         app.parse(argc, argv);
