@@ -256,7 +256,9 @@ std::string board_from_config(const MachineConfig& config, const BoardFromConfig
         // (a homing cycle overshoots the trip point by a step or more).
         if (a.min_switch || a.max_switch) inset = std::max(inset, 2.0);
         double travel = length_mm(ax.get("travel"), axis + ".travel");
-        if (a.min_mm && a.max_mm && a.max_mm->value > a.min_mm->value) {
+        // The travel follows the firmware's range where switches bound it; an
+        // axis homed without one (against its frame) keeps the board's.
+        if (a.min_mm && a.max_mm && a.max_mm->value > a.min_mm->value && (a.min_switch || a.max_switch)) {
             travel = a.max_mm->value - a.min_mm->value + 2 * inset;
             ax.set("travel", mm(travel));
             ax.set("start_position", mm(travel / 2));

@@ -240,3 +240,21 @@ TEST(BoardFromConfigCli, WritesTheBoardAndRefusesToOverwriteAnInput) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(BoardFromConfig, APrusaVariantGivesTheTmcDirectionsAndStallTuning) {
+    const std::string text = generate({fixture("prusa_variant.h")});
+    EXPECT_TRUE(has_line(text, "extends: prusa-mk3s")) << text;
+    // INVERT_X_DIR 1: DIR low is +; TMC2130_SG_THRS_X 3; 1/16 from TMC2130_USTEPS_XY.
+    EXPECT_TRUE(has_line(text, "  x_driver: {type: tmc2130, microsteps: 16, forward_dir: low, stall_sgt: 3}")) << text;
+    EXPECT_TRUE(has_line(text, "  z_driver: {type: tmc2130, microsteps: 16, forward_dir: low, stall_sgt: 4}")) << text;
+    // 3200/8 = 400 steps/mm; no switches: the board's travel and start stay.
+    EXPECT_TRUE(has_line(text, "  z: {type: linear_axis, steps_per_mm: 400, travel: 210mm, start_position: 20mm}")) << text;
+    EXPECT_NE(text.find("filament_steps_per_mm: 280}"), std::string::npos) << text;
+    load_generated(text, "prusa");
+}
+
+}  // namespace
+}  // namespace avrbench
