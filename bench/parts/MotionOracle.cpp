@@ -714,7 +714,13 @@ std::string MotionOracle::summary() {
     char line[200];
     std::snprintf(line, sizeof line, "oracle     %s: %zu moves judged, %zu findings", name().c_str(), moves_judged_now(), found);
     std::string text = line;
-    if (lost_) text += "; stopped judging: " + lost_why_;
+    if (lost_) {
+        text += "; stopped judging: " + lost_why_;
+    } else if (commands_ == 0) {
+        // Nothing to judge is not "all clean": say why the oracle saw no G-code.
+        text += "; nothing was commanded through the bench (no G-code job; a host on --pty, such as klippy with "
+                "Klipper's binary protocol, talks to the firmware itself)";
+    }
     return text;
 }
 

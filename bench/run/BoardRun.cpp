@@ -18,6 +18,7 @@
 #include "stimulus/RecordHost.hpp"
 #include "trace/HtmlReport.hpp"
 #include "trace/WaveformFiles.hpp"
+#include "run/LiveStatus.hpp"
 
 namespace avrbench {
 namespace {
@@ -37,6 +38,33 @@ void append_text_tail(std::vector<std::string>& out, const std::string& text, st
     if (!line.empty()) lines.push_back(line);
     const std::size_t from = lines.size() > max_lines ? lines.size() - max_lines : 0;
     for (std::size_t i = from; i < lines.size(); ++i) out.push_back("    " + hex_escaped(lines[i]));
+}
+
+// A port's bytes, when they are a binary protocol (Klipper's frames, seed
+// 002's records: more than one byte in ten a control byte other than line
+// ends and tabs), as their count and the last 48 in hex, each frame ending
+// at Klipper's sync byte 0x7E on a line of its own: escaped "lines" of
+// binary say nothing.
+bool append_binary_tail(std::vector<std::string>& out, const std::string& bytes) {
+    std::size_t control = 0;
+    for (const char c : bytes) {
+        const auto b = static_cast<unsigned char>(c);
+        if ((b < 0x20 && b != '\n' && b != '\r' && b != '\t') || b >= 0x7F) ++control;
+    }
+    if (bytes.empty() || control * 10 <= bytes.size()) return false;
+    const std::size_t from = bytes.size() > 48 ? bytes.size() - 48 : 0;
+    out.push_back(format_text("    (binary: %zu bytes; the last %zu in hex)", bytes.size(), bytes.size() - from));
+    std::string line = "    ";
+    for (std::size_t i = from; i < bytes.size(); ++i) {
+        const auto b = static_cast<unsigned char>(bytes[i]);
+        line += format_text(line.size() > 4 ? " %02x" : "%02x", b);
+        if (b == 0x7E) {
+            out.push_back(line);
+            line = "    ";
+        }
+    }
+    if (line.size() > 4) out.push_back(line);
+    return true;
 }
 
 // PB5, PORTB or all name pins of every MCU; MCU.PB5, MCU.PORTB or MCU.all
@@ -295,10 +323,23 @@ void BoardRun::after_slice(std::chrono::steady_clock::time_point wall_start) {
         }
     }
     drain_(bench.now_ps());
+    const bool asked = options_.status_now != nullptr && options_.status_now->exchange(false);
+    if (asked || (options_.status_every_ps > 0 && bench.now_ps() >= next_status_ps_)) {
+        report_status(wall_start);
+        while (options_.status_every_ps > 0 && next_status_ps_ <= bench.now_ps()) next_status_ps_ += options_.status_every_ps;
+    }
     if (options_.on_progress) {
         options_.on_progress(static_cast<double>(bench.now_ps()) / static_cast<double>(options_.duration_ps),
                              bench.now_seconds());
     }
+}
+
+void BoardRun::report_status(std::chrono::steady_clock::time_point wall_start) {
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const LiveStatus status = live_status(*bench_, host_, wall_s);
+    if (options_.on_status) options_.on_status(status.line);
+    // Written to a temporary file and renamed: a reader never sees half a status.
+    if (!options_.status_file.empty()) write_output_file(options_.status_file, status.json, "--status-file");
 }
 
 IdleResult BoardRun::run() {
@@ -462,8 +503,9 @@ std::vector<std::string> BoardRun::summary() const {
         const SerialLink& u = decl.link();
         out.push_back(format_text("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
                              u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
-                             u.transmitted().empty() ? "" : "; last lines:"));
-        append_text_tail(out, u.transmitted_text(), 10);
+                             u.transmitted().empty() ? "" : ":"));
+        const std::string bytes = u.transmitted_text();
+        if (!append_binary_tail(out, bytes)) append_text_tail(out, bytes, 10);
     }
     if (!options_.vcd.empty()) {
         const Timeline& timeline = bench_->timeline();

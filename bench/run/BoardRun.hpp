@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <functional>
+#include <atomic>
 #include <map>
 #include <memory>
 #include <optional>
@@ -95,6 +96,13 @@ struct BoardRunOptions {
 
     // After every slice: the fraction of duration_ps done and the simulated seconds.
     std::function<void(double fraction, double simulated_s)> on_progress;
+    // A status line (run/LiveStatus.hpp) every status_every_ps of simulated
+    // time (0: none), and when *status_now is set (a signal handler's flag);
+    // each also rewrites status_file ("" = none) with the JSON, whole.
+    Picoseconds status_every_ps = 0;
+    std::atomic<bool>* status_now = nullptr;
+    std::string status_file;
+    std::function<void(const std::string& line)> on_status;
     // Lines to show at once while the run goes on (the pty's path).
     std::function<void(const std::string& line)> on_announce;
 };
@@ -146,6 +154,8 @@ private:
     std::unique_ptr<PtyBridge> pty_;
     Mcu* pty_mcu_ = nullptr;
     unsigned resets_on_open_ = 0;
+    Picoseconds next_status_ps_ = 0;
+    void report_status(std::chrono::steady_clock::time_point wall_start);
     struct I2cCount {
         std::uint64_t transfers = 0, bytes = 0, nacks = 0;
     };

@@ -3,6 +3,8 @@
 
 #include <cerrno>
 #include <chrono>
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -55,6 +57,8 @@ struct RunArgs {
     std::string pty_link;       // and a stable symlink to it
     std::string pace = "free";  // free | realtime
     bool reset_on_open = false; // --pty: a host opening the port resets its MCU
+    std::string status_every;   // a status line every this much simulated time
+    std::string status_file;    // and the JSON status rewritten there
     std::string gcode;
     bool gcode_bytes = false;  // --gcode-bytes: no text check (fuzzing reproducers)
     std::string host;
@@ -219,6 +223,23 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
     o.trace = args.trace;
     o.trace_only = args.trace_only;
     o.on_progress = [&progress](double fraction, double simulated_s) { progress.show(fraction, simulated_s); };
+    if (!args.status_every.empty()) {
+        o.status_every_ps = ps_from_seconds(parse_quantity(args.status_every, Dimension::Time, "--status-every"), "--status-every");
+        if (o.status_every_ps <= 0) throw BadInput("--status-every " + args.status_every + ": give a time above 0 (e.g. 5s)");
+    }
+    o.status_file = args.status_file;
+    if (!args.status_file.empty()) o.more_files.output(args.status_file, "--status-file");
+    // SIGUSR1 (kill -USR1 PID) asks for a status now, whatever the interval.
+    static std::atomic<bool> status_signal{false};
+    struct sigaction on_usr1 {};
+    on_usr1.sa_handler = [](int) { status_signal.store(true, std::memory_order_relaxed); };
+    sigemptyset(&on_usr1.sa_mask);
+    sigaction(SIGUSR1, &on_usr1, nullptr);
+    o.status_now = &status_signal;
+    o.on_status = [](const std::string& line) {
+        std::fprintf(stderr, "%s\n", line.c_str());
+        std::fflush(stderr);
+    };
     o.on_announce = [](const std::string& line) {
         std::printf("%s\n", line.c_str());
         std::fflush(stdout);
@@ -250,6 +271,10 @@ int run_board_command(const RunArgs& args) {
 int run_command(const RunArgs& args) {
     if (!args.board.empty()) return run_board_command(args);
     if (!args.gcode.empty()) throw BadInput("--gcode needs --board (the board file names the serial port)");
+    if (!args.status_every.empty() || !args.status_file.empty()) {
+        throw BadInput(std::string(args.status_every.empty() ? "--status-file" : "--status-every") +
+                       " needs --board (the status reports the board's axes and temperatures)");
+    }
     if (!args.dxf.empty()) throw BadInput("--dxf needs --board (the board file names the serial port)");
     if (!args.report.empty()) throw BadInput("--report needs --board");
     if (!args.realtime.empty()) throw BadInput("--realtime needs --board and --gcode");
@@ -338,6 +363,10 @@ Command add_run_command(CLI::App& app) {
     run_cmd->add_option("--pty-link", run.pty_link, "--pty: also make a symlink to the pty here, e.g. traces/ttyUNO");
     run_cmd->add_flag("--reset-on-open", run.reset_on_open,
                       "--pty: reset the port's MCU whenever host software opens the pty, as an Arduino's auto-reset does");
+    run_cmd->add_option("--status-every", run.status_every,
+                        "a status line on stderr every this much simulated time (positions, steps, temperatures, findings "
+                        "so far; kill -USR1 asks for one at any time)");
+    run_cmd->add_option("--status-file", run.status_file, "the status as JSON, rewritten whole at each status line");
     run_cmd->add_option("--pace", run.pace,
                         "free (default: as fast as it runs) | realtime (simulated time never ahead of wall time)");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");

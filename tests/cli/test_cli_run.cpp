@@ -307,3 +307,28 @@ TEST(CliRun, UntilSleepOnASleepWithInterruptsOffSaysTheCoreHaltedNotTheTimeLimit
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// A port carrying a binary protocol is shown as bytes, not as escaped
+// "lines": uart_echo's banner "avrbench uart_echo\r\n" (20 bytes, ASCII)
+// then two frames of ours echoed back, each ending at 0x7E (Klipper's sync
+// byte), one per line.
+TEST(CliRun, ABinaryPortIsSummarisedAsFramesInHex) {
+    const auto dir = test::scratch_dir("binary-port");
+    std::ofstream(dir / "frames.bin", std::ios::binary) << std::string("\x05\x10\x81\x22\x9a\x7e\x06\x11\x81\x33\x44\x7e", 12);
+    const auto r = test::run_command(std::string(test::cli()) + " run " + test::quoted(test::firmware("uart_echo")) + " --board " +
+                                         test::source_path("bench/boards/arduino-uno.yaml") + " --uart-in " +
+                                         (dir / "frames.bin").string() + " --for 0.1s", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("  serial host 32 bytes from firmware, 12 bytes to firmware:\n"
+                         "    (binary: 32 bytes; the last 32 in hex)\n"
+                         "    61 76 72 62 65 6e 63 68 20 75 61 72 74 5f 65 63 68 6f 0d 0a 05 10 81 22 9a 7e\n"
+                         "    06 11 81 33 44 7e\n"),
+              std::string::npos)
+        << r.out;
+}
+
+}  // namespace
+}  // namespace avrbench

@@ -257,3 +257,52 @@ TEST(Gtkw, SaveFileNamesTheDumpRelativeToItself) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// A status while the run goes on (--status-every, --status-file): our card
+// print (firmware/boards/sd_print) draws a 20 mm square and its diagonal,
+// 6400 steps on each axis (tests/scenarios/ramps_sd_print.yaml); with a
+// status every 2 s the first comes after the first slice, the others at 2,
+// 4, 6 and 8 s of the 8.2 s job, and the last has both carriages back at
+// 100 mm with all 6400 steps made.
+TEST(LiveStatus, AStatusLineEveryIntervalAndTheJsonRewritten) {
+    const auto dir = test::scratch_dir("live-status");
+    std::ofstream(dir / "job.g") << "M23 square.gco\nM24\n";
+    const std::string json = (dir / "status.json").string();
+    const auto r = test::run_command(kWorkflowCli + " run -q " + test::firmware("sd_print") + " --board " +
+                                         test::source_path("tests/scenarios/boards/ramps-sd-square.yaml") + " --gcode " +
+                                         (dir / "job.g").string() + " --status-every 2s --status-file " + json, dir, 120);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::vector<std::string> lines;
+    std::istringstream err(r.err);
+    for (std::string line; std::getline(err, line);) {
+        if (line.rfind("status ", 0) == 0) lines.push_back(line);
+    }
+    ASSERT_EQ(lines.size(), 5u) << r.err;
+    EXPECT_EQ(lines[1].rfind("status 2.000 s (wall ", 0), 0u) << lines[1];
+    EXPECT_NE(lines[4].find("x 100.000 mm (6400 steps), y 100.000 mm (6400 steps)"), std::string::npos) << lines[4];
+    EXPECT_NE(lines[4].find("job 2 of 2 lines answered, findings 0"), std::string::npos) << lines[4];
+    const std::string status = test::slurp(json);
+    EXPECT_NE(status.find("\"x\": {\"position_mm\": 100.000000, \"steps\": 6400}"), std::string::npos) << status;
+    // A JSON reader that is not ours takes it.
+    const auto parsed = test::run_command("python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d[\"findings\"], "
+                                          "d[\"job\"][\"answered\"])' " + json, dir);
+    EXPECT_EQ(parsed.out, "0 2\n") << parsed.err;
+}
+
+// kill -USR1 asks a long run for its status at once, without ending it
+// (it ends here on SIGINT; the busy loop runs far longer than the test waits).
+TEST(LiveStatus, SigusrOneAsksForAStatusNow) {
+    const auto dir = test::scratch_dir("live-status-usr1");
+    const auto r = test::run_command("(" + kWorkflowCli + " run -q --board " + uno() + " " + test::firmware("busy_poll") +
+                                         " --for 100000s & pid=$!; sleep 1; kill -USR1 $pid; sleep 1; kill -INT $pid; wait $pid)",
+                                     dir, 60);
+    EXPECT_EQ(r.exit_code, 130) << r.err;
+    EXPECT_NE(r.err.find("status "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("findings 0"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace avrbench
