@@ -65,7 +65,7 @@ void Board::build_mcus(const std::map<std::string, std::string>& firmware) {
         auto it = firmware.find(decl.name);
         const std::string elf_path = it != firmware.end() ? it->second : decl.firmware;
         if (elf_path.empty()) {
-            throw BadInput(decl.location + ": MCU '" + decl.name + "' has no firmware (give an ELF)");
+            throw BadInput(decl.location + ": MCU '" + decl.name + "' has no firmware: give it one (run --firmware " + decl.name + "=ELF, a scenario's firmware: {" + decl.name + ": ELF}, or the board file's firmware:)");
         }
         const ElfImage elf = ElfImage::load(elf_path);
         if (!elf.embedded_mcu().empty() && elf.embedded_mcu() != decl.type) {

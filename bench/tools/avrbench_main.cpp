@@ -11,6 +11,7 @@
 #include "core/InputFile.hpp"
 #include "core/UserStop.hpp"
 #include "tools/Commands.hpp"
+#include "tools/UsageHint.hpp"
 #include "tools/FuzzCommand.hpp"
 
 namespace avrbench {
@@ -97,7 +98,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "avrbench: usage error: %s (see avrbench --help)\n", escaped(e.what()).c_str());
+        std::fprintf(stderr, "avrbench: usage error: %s%s (see avrbench --help)\n", escaped(e.what()).c_str(),
+                     escaped(usage_hint(app, argc, argv)).c_str());
         return kExitBadInput;
     }
     install_user_stop_handlers();

@@ -332,3 +332,36 @@ TEST(CliRun, ABinaryPortIsSummarisedAsFramesInHex) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// A mistyped option or subcommand: the usage error names the one meant.
+TEST(CliUsage, ATypoGetsTheNearestOptionOrSubcommand) {
+    const auto dir = test::scratch_dir("cli-typo");
+    const std::string cli = std::string(test::cli());
+    const auto option = test::run_command(cli + " run x.elf --gcod job.g", dir);
+    EXPECT_EQ(option.exit_code, 2);
+    EXPECT_EQ(option.err, "avrbench: usage error: The following arguments were not expected: job.g --gcod; did you mean "
+                          "--gcode? (see avrbench --help)\n");
+    const auto sub = test::run_command(cli + " runn x.elf", dir);
+    EXPECT_EQ(sub.exit_code, 2);
+    EXPECT_EQ(sub.err, "avrbench: usage error: A subcommand is required; did you mean 'run'? (see avrbench --help)\n");
+    const auto nested = test::run_command(cli + " board from-confg x.h", dir);
+    EXPECT_NE(nested.err.find("did you mean 'from-config'?"), std::string::npos) << nested.err;
+    // Nothing near: no guess.
+    const auto far = test::run_command(cli + " zzzzzz", dir);
+    EXPECT_EQ(far.err, "avrbench: usage error: A subcommand is required (see avrbench --help)\n");
+}
+
+// A board MCU left without firmware: the message says how to give it one.
+TEST(CliUsage, AnMcuWithoutFirmwareSaysHowToGiveIt) {
+    const auto dir = test::scratch_dir("cli-no-firmware");
+    const auto r = test::run_command(std::string(test::cli()) + " run " + test::quoted(test::firmware("printer3d_interp")) +
+                                         " --board printer3d-seed001", dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("MCU 'drive_x' has no firmware: give it one (run --firmware drive_x=ELF"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace avrbench
