@@ -268,5 +268,28 @@ TEST(GtkwaveAcceptsOurFiles, CliRunOpensFromAnyFolderWithLabelsAndUartText) {
     }
 }
 
+// The save file opens zoomed to the whole run (docs/CLI.md), as gtkwave
+// itself reports its window: from 0 to at least the dump's end, and not
+// zoomed out past a sixth more (a 310 ms run once opened at 0-287 ms).
+TEST(GtkwaveAcceptsOurFiles, TheSaveFileOpensOnTheWholeRun) {
+    ScratchDir dir;
+    for (const char* length : {"310ms", "3s"}) {
+        trace_test::run_command(quoted(::avrbench::test::cli()) + " run -q " +
+                                    quoted(std::string(::avrbench::test::firmware_dir()) + "/blink_timer1.elf") + " --for " +
+                                    length + " --vcd " + quoted(dir.file("b.vcd")),
+                                dir.file("run.log"));
+        const std::string tcl =
+            "puts \"START [gtkwave::getWindowStartTime]\"\n"
+            "puts \"END [gtkwave::getWindowEndTime]\"\n"
+            "puts \"MAX [gtkwave::getMaxTime]\"\n";
+        auto values = run_gtkwave(dir, dir.file("b.gtkw"), tcl);
+        if (values.empty()) return;
+        const double end = std::stod(values["END"]), max = std::stod(values["MAX"]);
+        EXPECT_EQ(values["START"], "0") << length;
+        EXPECT_GE(end, max) << length;
+        EXPECT_LE(end, max * 7 / 6) << length;
+    }
+}
+
 }  // namespace
 }  // namespace avrbench
