@@ -19,6 +19,7 @@ extern "C" {
 #include "mcu/SimavrStep.hpp"
 #include "mcu/TimingProfile.hpp"
 #include "periph/interrupts/Interrupts.hpp"
+#include "periph/watchdog/WatchdogWatch.hpp"
 
 namespace avrbench {
 namespace {

@@ -180,6 +180,13 @@ std::string stats_json(const CycleStats& s) {
     return text;
 }
 
+// A byte address as the summary prints it ("0x04d2"), beside the JSON's number.
+std::string pc_hex(std::uint32_t pc_bytes) {
+    char text[16];
+    std::snprintf(text, sizeof text, "0x%04x", pc_bytes);
+    return text;
+}
+
 std::string json_string(const std::string& text) {
     std::string out = "\"";
     for (const char c : text) {
@@ -253,10 +260,11 @@ std::string TimingProfiler::json() const {
                       std::to_string(sleeping_) + ", \"idle_loop_skipped\": " + std::to_string(mcu_.idle_cycles_skipped()) +
                       "}, \"stack\": {\"lowest_sp\": " + std::to_string(lowest_sp_) + ", \"headroom_bytes\": " +
                       std::to_string(static_cast<long>(lowest_sp_) + 1 - static_cast<long>(floor)) + ", \"pc\": " +
-                      std::to_string(lowest_sp_pc_) + ", \"symbol\": " + json_string(mcu_.describe_pc(lowest_sp_pc_)) +
+                      std::to_string(lowest_sp_pc_) + ", \"pc_hex\": " + json_string(pc_hex(lowest_sp_pc_)) + ", \"symbol\": " + json_string(mcu_.describe_pc(lowest_sp_pc_)) +
                       ", \"cycle\": " + std::to_string(lowest_sp_cycle_) + "}, \"interrupts_off\": {\"longest_cycles\": " +
                       std::to_string(longest_off_) + ", \"from_cycle\": " + std::to_string(longest_off_start_) +
                       ", \"vector\": " + std::to_string(longest_off_vector_) + ", \"pc\": " + std::to_string(longest_off_pc_) +
+                      ", \"pc_hex\": " + json_string(pc_hex(longest_off_pc_)) +
                       ", \"first_sei_cycle\": " + (first_sei_ == ~Cycle{0} ? std::string("null") : std::to_string(first_sei_)) +
                       ", \"symbol\": " + json_string(mcu_.describe_pc(longest_off_pc_)) + "}, \"vectors\": [";
     bool first = true;

@@ -44,6 +44,14 @@ TEST(TimingProfile, BlinkTimer1sIsrMatchesItsListing) {
     EXPECT_LT(p.first_sei_cycle(), 16000u);
     // Every cycle is accounted for: executed, asleep or jumped over.
     EXPECT_EQ(p.active_cycles() + p.sleeping_cycles() + mcu.idle_cycles_skipped(), mcu.cycle());
+    // The JSON gives each PC as a number and as the summary writes it.
+    const std::string json = p.json();
+    const auto at = json.find("\"pc\": ", json.find("\"interrupts_off\""));
+    ASSERT_NE(at, std::string::npos) << json;
+    const unsigned long pc = std::stoul(json.substr(at + 6));
+    char hex[32];
+    std::snprintf(hex, sizeof hex, "\"pc_hex\": \"0x%04lx\"", pc);
+    EXPECT_NE(json.find(hex, at), std::string::npos) << json;
 }
 
 // grbl_stepper (firmware/boards/grbl_stepper/README.md): the step vector
