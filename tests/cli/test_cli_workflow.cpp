@@ -306,3 +306,19 @@ TEST(LiveStatus, SigusrOneAsksForAStatusNow) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+// The GitHub Action's check step (ci/action/check) with a pattern that
+// matches nothing says so, exit 2, before avrbench is run at all.
+TEST(ActionCheck, APatternMatchingNoScenarioSaysSo) {
+    const auto dir = test::scratch_dir("action-no-match");
+    const auto r = test::run_command("AVRBENCH_SCENARIOS='tests/*.yaml' AVRBENCH_RESULTS=results bash " +
+                                         test::source_path("ci/action/check"), dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, "avrbench action: no scenario files match 'tests/*.yaml'\n");
+}
+
+}  // namespace
+}  // namespace avrbench
