@@ -322,6 +322,23 @@ ScenarioExpectation parse_expectation(const Item& item, const BoardNames& names)
     } else if (k == "text") {
         names.check_serial(k, item.location);
         e.action = ExpectText{item.scalar_value()};
+    } else if (k == "signal") {
+        item.expect_keys({"name"}, {"min", "max", "from"});
+        if (!item.has("min") && !item.has("max")) throw BadInput(item.location + ": 'signal' needs min, max or both");
+        ExpectSignal sig;
+        const std::string name = item.get("name");
+        const auto dot = name.find('.');
+        if (dot == std::string::npos || dot == 0 || dot + 1 == name.size()) {
+            throw BadInput(item.at("name") + ": '" + name + "' is not PART.SIGNAL (e.g. hotend.block_degC)");
+        }
+        sig.part = name.substr(0, dot);
+        names.check_part(sig.part, item.at("name"));
+        sig.signal = name.substr(dot + 1);
+        if (item.has("min")) sig.min = parse_quantity(item.get("min"), Dimension::Dimensionless, item.at("min") + ": min");
+        if (item.has("max")) sig.max = parse_quantity(item.get("max"), Dimension::Dimensionless, item.at("max") + ": max");
+        if (sig.min && sig.max && *sig.min > *sig.max) throw BadInput(item.at("min") + ": min is above max");
+        if (item.has("from")) sig.from_ps = parse_duration_ps(item.get("from"), item.at("from") + ": from");
+        e.action = sig;
     } else if (k == "lcd_shows") {
         ExpectLcdShows shows;
         if (item.value.IsMap()) {
@@ -536,7 +553,7 @@ ScenarioSpec load_scenario_checked(const std::string& path, const std::string& f
     if (const YAML::Node steps = sequence("steps")) {
         for (const auto& node : steps) spec.steps.push_back(parse_step(read_item(node, path, kSteps, "step"), path, names));
     }
-    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "lcd_shows", "findings", "isr", "stack", "interrupts_off", "cpu"};
+    static const std::set<std::string> kExpect = {"steps", "position", "pin", "text", "lcd_shows", "signal", "findings", "isr", "stack", "interrupts_off", "cpu"};
     if (const YAML::Node expect = sequence("expect")) {
         for (const auto& node : expect) spec.expectations.push_back(parse_expectation(read_item(node, path, kExpect, "expectation"), names));
     }

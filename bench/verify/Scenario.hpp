@@ -51,6 +51,14 @@ struct ExpectText { std::string text; };
 // A display part's text (an hd44780's lines) matches `pattern` (RE2): on line
 // `line` (1-based), or anywhere in the lines joined with newlines (line 0).
 struct ExpectLcdShows { std::string part; int line = 0; std::string pattern; };
+// A part's signal (PART.SIGNAL, as the VCD names it: hotend.block_degC)
+// stayed within [min, max] from `from_ps` to the end of the run: the value in
+// force at `from_ps` and every change after it.
+struct ExpectSignal {
+    std::string part, signal;
+    std::optional<double> min, max;
+    Picoseconds from_ps = 0;
+};
 struct ExpectFindingCount { std::uint64_t count = 0; };
 struct ExpectFindingKinds { std::vector<std::string> kinds; };  // as a multiset
 
@@ -64,8 +72,8 @@ struct ExpectIsr {
 struct ExpectStack { std::string mcu; std::int64_t min_headroom_bytes = 0; };
 struct ExpectInterruptsOff { std::string mcu; std::uint64_t max_cycles = 0; };
 struct ExpectCpu { std::string mcu; double max_busy_percent = 100; };  // executing / (executing + asleep + idle loop)
-using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectLcdShows, ExpectFindingCount,
-                                  ExpectFindingKinds, ExpectIsr, ExpectStack, ExpectInterruptsOff, ExpectCpu>;
+using ExpectAction = std::variant<ExpectSteps, ExpectPosition, ExpectPin, ExpectText, ExpectLcdShows, ExpectSignal,
+                                  ExpectFindingCount, ExpectFindingKinds, ExpectIsr, ExpectStack, ExpectInterruptsOff, ExpectCpu>;
 
 struct ScenarioExpectation {
     ExpectAction action;

@@ -274,9 +274,57 @@ private:
     Picoseconds deadline_;
 };
 
+// What a `signal` expectation saw of its signal while the steps ran: the
+// value in force when its window opened and the extremes after.
+struct SignalWatch {
+    bool found = false;
+    std::string known;  // the part's signals, for the message when not found
+    std::size_t index = 0;
+    Cycle from_cycle = 0;
+    double clock_hz = 1;
+    double before = 0;  // the last value before from_cycle (the initial one at first)
+    bool changed_after = false;
+    double low = 0, high = 0;
+    Cycle low_at = 0, high_at = 0;
+};
+using SignalWatches = std::map<const ExpectSignal*, std::shared_ptr<SignalWatch>>;
+
+SignalWatches watch_expected_signals(Bench& bench, const std::vector<ScenarioExpectation>& expectations) {
+    SignalWatches watches;
+    for (const auto& e : expectations) {
+        const auto* sig = std::get_if<ExpectSignal>(&e.action);
+        if (sig == nullptr) continue;
+        auto w = std::make_shared<SignalWatch>();
+        watches[sig] = w;
+        Part& part = bench.board().part(sig->part);
+        for (std::size_t i = 0; i < part.signals().size(); ++i) {
+            w->known += (w->known.empty() ? "" : ", ") + part.signals()[i].name;
+            if (part.signals()[i].name != sig->signal) continue;
+            w->found = true;
+            w->index = i;
+        }
+        if (!w->found) continue;
+        w->clock_hz = part.clock().frequency_hz();
+        w->from_cycle = part.clock().cycles_from_seconds(seconds_from_ps(sig->from_ps));
+        w->before = part.signal_value(w->index);
+        part.watch_signals([w](std::size_t signal, Cycle cycle, double value) {
+            if (signal != w->index) return;
+            if (cycle < w->from_cycle) {
+                w->before = value;
+                return;
+            }
+            if (!w->changed_after || value < w->low) w->low = value, w->low_at = cycle;
+            if (!w->changed_after || value > w->high) w->high = value, w->high_at = cycle;
+            w->changed_after = true;
+        });
+    }
+    return watches;
+}
+
 class ExpectationChecker {
 public:
-    ExpectationChecker(Bench& bench, const std::vector<Finding>& findings) : bench_(bench), findings_(findings) {}
+    ExpectationChecker(Bench& bench, const std::vector<Finding>& findings, const SignalWatches& watches)
+        : bench_(bench), findings_(findings), watches_(watches) {}
     std::string check(const ScenarioExpectation& e) {
         return std::visit([this](const auto& action) { return (*this)(action); }, e.action);
     }
@@ -321,6 +369,30 @@ private:
         for (const auto& l : lines) screen += "|" + l + "|";
         return e.part + (e.line > 0 ? " line " + std::to_string(e.line) : std::string()) + " does not show /" + e.pattern +
                "/; it shows " + screen;
+    }
+    std::string operator()(const ExpectSignal& e) {
+        const SignalWatch& w = *watches_.at(&e);
+        const std::string name = e.part + "." + e.signal;
+        if (!w.found) return "part " + e.part + " has no signal '" + e.signal + "' (it has " + w.known + ")";
+        const Picoseconds end = bench_.now_ps();
+        if (end < e.from_ps) return "the run ended at " + seconds_text(end) + ", before " + seconds_text(e.from_ps);
+        // The value in force at `from`, then every change after it.
+        double low = w.before, high = w.before;
+        Cycle low_at = w.from_cycle, high_at = w.from_cycle;
+        if (w.changed_after && w.low < low) low = w.low, low_at = w.low_at;
+        if (w.changed_after && w.high > high) high = w.high, high_at = w.high_at;
+        char buf[240];
+        if (e.min && low < *e.min) {
+            std::snprintf(buf, sizeof buf, "%s went down to %g at %.6f s, below %g (from %s on)", name.c_str(), low,
+                          static_cast<double>(low_at) / w.clock_hz, *e.min, seconds_text(e.from_ps).c_str());
+            return buf;
+        }
+        if (e.max && high > *e.max) {
+            std::snprintf(buf, sizeof buf, "%s went up to %g at %.6f s, above %g (from %s on)", name.c_str(), high,
+                          static_cast<double>(high_at) / w.clock_hz, *e.max, seconds_text(e.from_ps).c_str());
+            return buf;
+        }
+        return "";
     }
     const TimingProfiler& profile(const std::string& mcu) {
         return *(mcu.empty() ? bench_.mcu() : bench_.mcu(mcu)).profile();
@@ -394,6 +466,7 @@ private:
 
     Bench& bench_;
     const std::vector<Finding>& findings_;
+    const SignalWatches& watches_;
 };
 
 // Checks what only the built board can say (fault names), before anything runs.
@@ -616,6 +689,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
         result.expectation_failures.push_back(message);
     };
 
+    const SignalWatches watches = watch_expected_signals(bench, spec.expectations);
     StepRunner runner(bench, spec.time_limit_ps);
     std::size_t index = 0;
     for (const auto& step : spec.steps) {
@@ -630,7 +704,7 @@ ScenarioResult run_scenario(const ScenarioSpec& spec, const ScenarioRunOptions& 
     if (bench.timeline().overflowed()) throw BadInput(spec.path + ": " + bench.timeline().overflow_message());
 
     const std::vector<Finding> findings = bench.findings();
-    ExpectationChecker checker(bench, findings);
+    ExpectationChecker checker(bench, findings, watches);
     for (const auto& e : spec.expectations) {
         const std::string why = checker.check(e);
         if (!why.empty()) fail("expect " + e.kind + " (" + e.location + "): " + why);

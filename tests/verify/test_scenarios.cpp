@@ -261,5 +261,40 @@ TEST(Scenarios, ATimingBoundForAnUnknownMcuIsAFileLineError) {
     }
 }
 
+// A part signal held to a band from a time on (`signal`): the card print
+// (firmware/boards/sd_print) takes X out to 120 mm on the square's first
+// side (100 mm start + 20 mm), so a band ending at 119 mm from 0 s fails
+// naming the highest value; after the print X is back at 100 mm: four 20 mm
+// sides at 1200 mm/min (4 s), the 28.3 mm diagonal at 600 (2.83 s) and back
+// at 3000 (0.57 s) end about 7.7 s in (0.3 s to boot and take the lines),
+// so a band around 100 mm from 7.8 s passes. Load errors name the line.
+TEST(Scenarios, ASignalOutsideItsBandFailsWithTheValueAndTime) {
+    const auto dir = test::scratch_dir("scenario-signal");
+    auto scenario = [&](const std::string& expect) {
+        const fs::path path = dir / "signal.yaml";
+        std::ofstream(path) << "name: signal\n"
+                            << "board: " << test::source_path("tests/scenarios/boards/ramps-sd-square.yaml") << "\n"
+                            << "firmware: {mega: sd_print}\ntime_limit: 20s\n"
+                            << "steps:\n  - wait_for_text: start\n  - send: M23 square.gco\n  - send: M24\n"
+                            << "  - wait_for_text: Done printing file\n  - wait_idle: 100ms\n"
+                            << "expect:\n  - " << expect << "\n";
+        return path.string();
+    };
+    const ScenarioResult over = run_scenario(load_scenario(scenario("signal: {name: x.position_mm, max: 119}"),
+                                                           ::avrbench::test::firmware_dir()), {});
+    ASSERT_EQ(over.expectation_failures.size(), 1u) << over.text();
+    EXPECT_NE(over.expectation_failures[0].find("x.position_mm went up to 120 at "), std::string::npos)
+        << over.expectation_failures[0];
+    const ScenarioResult after = run_scenario(load_scenario(scenario("signal: {name: x.position_mm, min: 99.99, max: 100.01, from: 7.8s}"),
+                                                            ::avrbench::test::firmware_dir()), {});
+    EXPECT_TRUE(after.passed) << after.text();
+    try {
+        load_scenario(scenario("signal: {name: x.position_mm}"), ::avrbench::test::firmware_dir());
+        FAIL() << "no error";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("signal.yaml:12: 'signal' needs min, max or both"), std::string::npos) << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace avrbench
