@@ -263,7 +263,8 @@ double cli_peak_rss_mib(const std::string& elf, double seconds, const std::strin
 namespace avrbench_perf {
 // perf_qemu.cpp
 std::string qemu_version();
-double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::uint32_t to_addr, std::string& why);
+double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::uint32_t to_addr, std::string& why,
+                        bool stop_on_entry = false);
 }  // namespace avrbench_perf
 
 // The coil-driven motor's overhead (perf_motor.cpp, docs/MOTOR.md).
@@ -411,6 +412,97 @@ void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
 // QEMU's TCG, not cycle-exact). The instructions are the bench's count to
 // the end (all three run the same program to the same place); CPU seconds,
 // median of `repeats` interleaved runs of each.
+// One program run to its end on every side, `repeats` interleaved times:
+// the instructions and cycles to its end (the bench's count) and each
+// side's median CPU seconds (qemu's < 0 when it cannot run: `why`).
+struct SideTimes {
+    std::uint64_t instructions = 0;
+    avr_cycle_count_t cycles = 0;
+    double bench = 0, bench_simavr_core = 0, bare = 0, qemu = -1;
+    std::string why;
+};
+
+SideTimes time_program(const std::string& path, const std::string& done_symbol, int repeats, const std::string& vcd_path,
+                       bool with_qemu) {
+    SideTimes t;
+    const auto elf = avrbench::ElfImage::load(path);
+    const auto main_addr = elf.symbol_address("main"), done_addr = elf.symbol_address(done_symbol);
+    if (!main_addr || !done_addr) {
+        t.why = path + " has no main or " + done_symbol;
+        return t;
+    }
+    {
+        avrbench::Mcu mcu(elf);
+        while (mcu.run_until(mcu.cycle() + mcu.frequency_hz()) != avrbench::StopReason::Halted) {
+        }
+        t.instructions = mcu.steps();
+        t.cycles = mcu.cycle();
+    }
+    std::vector<double> bare, bench, bench_simavr_core, emu;
+    std::uint64_t events = 0;
+    avrbench::McuOptions simavr_core;
+    simavr_core.predecoded_core = false;
+    for (int i = 0; i < repeats; ++i) {
+        bench.push_back(run_avrbench(elf, t.cycles, vcd_path, &events));
+        bench_simavr_core.push_back(run_avrbench(elf, t.cycles, vcd_path, &events, simavr_core));
+        bare.push_back(run_bare_simavr(elf, t.cycles));
+        if (with_qemu && t.why.empty()) {
+            // The kernels run in functions of their own: timed to the PC's
+            // arrival at workload_done or the 20 bytes after it (set_sleep_mode,
+            // sleep_enable, cli and the SLEEP loop, avr-objdump of workload_1).
+            const double s = avrbench_perf::qemu_cpu_seconds(path, *done_addr, *done_addr + 20, t.why, true);
+            if (s > 0) emu.push_back(s);
+        }
+    }
+    std::filesystem::remove(vcd_path);
+    t.bench = median(bench);
+    t.bench_simavr_core = median(bench_simavr_core);
+    t.bare = median(bare);
+    if (!emu.empty()) t.qemu = median(emu);
+    return t;
+}
+
+// --workloads: the suite of firmware/workloads (nine CPU kernels, each to
+// its workload_done), every side as --mips runs busy_poll_passes; the
+// bench's speed against qemu-system-avr per kernel (qemu CPU / bench CPU:
+// above 1 the bench is faster), their geometric mean and the worst kernel.
+void run_workloads(const std::string& firmware_dir, int repeats, const std::string& vcd_path) {
+    static const char* const kNames[] = {"int_div", "fixed_mul", "soft_float", "memory", "flash_table",
+                                         "branches", "calls", "interrupts", "mixed"};
+    const std::string qemu = avrbench_perf::qemu_version();
+    std::printf("workload suite (firmware/workloads): CPU seconds, median of %d interleaved runs; %s\n", repeats,
+                qemu.empty() ? "qemu-system-avr not installed (bash ci/setup --perf)" : qemu.c_str());
+    std::printf("%-14s %8s %8s %9s %9s %9s %9s %9s %11s\n", "kernel", "M instr", "M cycles", "bench", "simavr-c",
+                "bare", "qemu", "MIPS", "qemu/bench");
+    double log_sum = 0, log_sum_cpu = 0;
+    int measured = 0, measured_cpu = 0;
+    double worst = 0;
+    std::string worst_name;
+    for (int k = 1; k <= 9; ++k) {
+        const std::string path = firmware_dir + "/workload_" + std::to_string(k) + ".elf";
+        const SideTimes t = time_program(path, "workload_done", repeats, vcd_path, !qemu.empty());
+        const double ratio = t.qemu > 0 ? t.qemu / t.bench : 0;
+        std::printf("%-14s %8.1f %8.1f %9.3f %9.3f %9.3f %9.3f %9.1f %11.3f%s\n", kNames[k - 1],
+                    static_cast<double>(t.instructions) / 1e6, static_cast<double>(t.cycles) / 1e6, t.bench,
+                    t.bench_simavr_core, t.bare, t.qemu, static_cast<double>(t.instructions) / t.bench / 1e6, ratio,
+                    t.qemu > 0 ? "" : (" (" + t.why + ")").c_str());
+        if (t.qemu > 0) {
+            log_sum += std::log(ratio);
+            ++measured;
+            // qemu's timers run on its own clock, not per instruction: the
+            // interrupt kernel measures that more than its CPU (below apart).
+            if (k != 8) log_sum_cpu += std::log(ratio), ++measured_cpu;
+            if (worst_name.empty() || ratio < worst) worst = ratio, worst_name = kNames[k - 1];
+        }
+    }
+    if (measured > 0) {
+        std::printf("geometric mean qemu/bench %.3f over %d kernels (goal >= 1), without interrupts %.3f over %d; worst kernel "
+                    "%s %.3f (goal >= 0.8)\n",
+                    std::exp(log_sum / measured), measured, measured_cpu > 0 ? std::exp(log_sum_cpu / measured_cpu) : 0.0,
+                    measured_cpu, worst_name.c_str(), worst);
+    }
+}
+
 void run_mips(const std::string& firmware_dir, int repeats, const std::string& vcd_path) {
     const std::string path = firmware_dir + "/busy_poll_passes.elf";
     const auto elf = avrbench::ElfImage::load(path);
@@ -559,6 +651,8 @@ int perf_main(int argc, char** argv) {
     app.add_flag("--no-strict", no_strict, "with --printer: leave out the strict-lockstep row (about two minutes a run)");
     bool printer_part_once = false;
     app.add_flag("--printer-part-once", printer_part_once, "the printer's part job once, lookahead (for callgrind)");
+    bool only_workloads = false;
+    app.add_flag("--workloads", only_workloads, "only the workload suite (firmware/workloads): the bench, bare simavr and qemu per kernel");
     bool only_mips = false;
     app.add_flag("--mips", only_mips, "only MIPS on busy_poll_passes: the bench, bare simavr and qemu-system-avr");
     std::size_t check_rss_edges = 0;
@@ -591,6 +685,10 @@ int perf_main(int argc, char** argv) {
     }
     if (only_mips) {
         run_mips(firmware_dir, repeats, vcd_path);
+        return 0;
+    }
+    if (only_workloads) {
+        run_workloads(firmware_dir, repeats, vcd_path);
         return 0;
     }
     if (check_rss_edges > 0) {

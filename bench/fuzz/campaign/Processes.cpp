@@ -1,5 +1,6 @@
 #include "fuzz/campaign/Processes.hpp"
 
+#include <algorithm>
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
