@@ -501,11 +501,14 @@ std::vector<std::string> BoardRun::summary() const {
     for (const auto& decl : bench_->serial_ports()) {
         if ((host_ != nullptr || plot_) && bench_->serial_port(options_.job_port).name == decl.name) continue;
         const SerialLink& u = decl.link();
-        out.push_back(format_text("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
-                             u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
-                             u.transmitted().empty() ? "" : ":"));
         const std::string bytes = u.transmitted_text();
-        if (!append_binary_tail(out, bytes)) append_text_tail(out, bytes, 10);
+        std::vector<std::string> tail;
+        const bool binary = append_binary_tail(tail, bytes);
+        if (!binary) append_text_tail(tail, bytes, 10);
+        out.push_back(format_text("  serial %-4s %zu bytes from firmware, %llu bytes to firmware%s", decl.name.c_str(),
+                                  u.transmitted().size(), static_cast<unsigned long long>(u.bytes_delivered()),
+                                  u.transmitted().empty() ? "" : binary ? ":" : "; last lines:"));
+        out.insert(out.end(), tail.begin(), tail.end());
     }
     if (!options_.vcd.empty()) {
         const Timeline& timeline = bench_->timeline();
