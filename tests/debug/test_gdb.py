@@ -362,7 +362,17 @@ class GdbTests(unittest.TestCase):
             if packet[:1] in (b"c", b"s", b"b", b"k", b"D") or packet.startswith(b"vKill"):
                 continue  # run control: it would run, step, replay or end the program, not malformed
             exchange(packet)
-        self.assertEqual(exchange(b"m800102,2"), b"0000")  # ticks before the first instruction: 0
+        # The server still reads memory right: tick()'s first 4 flash bytes
+        # as binutils gives them (avr-objcopy of .text, at avr-nm's address).
+        import tempfile
+        tick = symbol_address(target, "tick")
+        with tempfile.TemporaryDirectory() as tmp:
+            text = os.path.join(tmp, "text.bin")
+            subprocess.run(["avr-objcopy", "-O", "binary", "-j", ".text", target, text], check=True)
+            with open(text, "rb") as f:
+                expected = f.read()[tick:tick + 4].hex().encode()
+        self.assertNotEqual(expected, b"00000000")
+        self.assertEqual(exchange(b"m%x,4" % tick), expected)
         self.assertEqual(exchange(b"D"), b"OK")
         conn.close()
         rc, _, err = s.finish()
