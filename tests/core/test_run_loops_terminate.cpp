@@ -112,10 +112,12 @@ TEST(RunLoopsTerminate, CliRunsThatUsedToHang) {
     const auto dir = test::scratch_dir("cli-hang");
     const std::string cli = ::avrbench::test::cli();
     const std::string board = test::source_path("bench/boards/arduino-uno.yaml");
-    for (const char* t : {"50ms", "100ms", "200ms", "700ms"}) {
+    // Each ends exactly at its limit: "simulated  0.050000 s" ... (the summary's 6 decimals).
+    for (const auto& [t, shown] : {std::pair{"50ms", "0.050000"}, std::pair{"100ms", "0.100000"}, std::pair{"200ms", "0.200000"},
+                                   std::pair{"700ms", "0.700000"}}) {
         const auto r = test::run_command(cli + " run -q --board " + board + " " + test::firmware("busy_poll") + " --for " + t, dir, 60);
         EXPECT_EQ(r.exit_code, 0) << t << ": " << r.err;
-        EXPECT_NE(r.out.find("simulated  " + std::string(t == std::string("700ms") ? "0.700000" : "")), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find(std::string("simulated  ") + shown + " s"), std::string::npos) << t << ": " << r.out;
     }
     // A scenario whose awaited text never comes ends at its time limit.
     const fs::path scenario = dir / "never.yaml";

@@ -9,6 +9,7 @@
 #include "support/Paths.hpp"
 #include "support/RunCommand.hpp"
 #include "run/BoardRun.hpp"
+#include "trace/VcdReader.hpp"
 
 namespace avrbench {
 namespace {
@@ -39,6 +40,16 @@ TEST(BoardRun, RunsABoardFromTheCxxApiAndStreamsItsVcd) {
     std::size_t stamps = 0;
     for (std::size_t at = text.str().find("\n#"); at != std::string::npos; at = text.str().find("\n#", at + 1)) ++stamps;
     EXPECT_GE(stamps, 20u);
+    // The LED's changes, read back: a toggle every 16000 cycles from Timer1's
+    // first match, which comes 16000 cycles after main starts it - at most
+    // 1000 cycles of start-up and setup in: the first toggle at 16000..17000
+    // cycles, so 20 ms (320000 cycles) hold 19 or 20 toggles, besides the
+    // initial value $dumpvars writes.
+    const VcdDump dump = read_vcd((dir / "blink.vcd").string());
+    const VcdVariable* led = dump.find("uno.PB5");
+    ASSERT_NE(led, nullptr);
+    EXPECT_GE(led->changes.size(), 1u + 19u);
+    EXPECT_LE(led->changes.size(), 1u + 20u);
     EXPECT_TRUE(std::filesystem::exists(dir / "blink.gtkw"));
     const auto summary = run.summary();
     ASSERT_FALSE(summary.empty());
