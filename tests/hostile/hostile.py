@@ -338,11 +338,10 @@ def cases(fw):
     out.append(Case("output-cam-own-input", ["cam", "{w}/plot.nc"], files={"plot.nc": dxf}, check_files=("plot.nc",), says="is also read"))
     out.append(Case("output-cam-o-input", ["cam", "{w}/d.dxf", "-o", "{w}/d.dxf"], files={"d.dxf": dxf}, check_files=("d.dxf",),
                     says="is also read"))
-    cnc = fw.get("cnc2axis")
-    if cnc:
-        out.append(Case("output-run-dxf-nc-on-drawing", ["run", cnc, "--board", "cnc2axis-seed002", "--dxf", "{w}/d.dxf",
-                                                         "--nc", "{w}/d.dxf", "-q"], files={"d.dxf": dxf}, check_files=("d.dxf",),
-                        says="is also read"))
+    cnc = fw["cnc2axis"]
+    out.append(Case("output-run-dxf-nc-on-drawing", ["run", cnc, "--board", "cnc2axis-seed002", "--dxf", "{w}/d.dxf",
+                                                     "--nc", "{w}/d.dxf", "-q"], files={"d.dxf": dxf}, check_files=("d.dxf",),
+                    says="is also read"))
     # golden update writes goldens only, where goldens live.
     for label, golden, expect in (("outside-txt", "../sentinel/victim.txt", 2), ("outside-timeline", "../sentinel/victim.timeline", 2),
                                   ("inside-not-golden", "notes.timeline", 2), ("absolute", "/tmp/avrbench-hostile-victim.timeline", 2)):
@@ -702,8 +701,10 @@ def main():
     fw = {}
     for name in ("blink_timer1", "uart_echo", "cnc2axis"):
         path = os.path.join(ARGS.firmware_dir, name + ".elf")
-        if os.path.exists(path):
-            fw[name] = path
+        # A missing ELF is a broken build, not a case to leave out quietly.
+        if not os.path.exists(path):
+            sys.exit(f"hostile: {path} is missing (build the firmware first)")
+        fw[name] = path
     all_cases = cases(fw)
     driven = driver_cases(fw)
     if ARGS.python:
