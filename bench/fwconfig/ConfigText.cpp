@@ -1,10 +1,11 @@
 #include "fwconfig/ConfigText.hpp"
 
+#include <re2/re2.h>
+
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <regex>
 #include <sstream>
 
 namespace avrbench {
@@ -289,16 +290,16 @@ void ConfigText::add(const std::string& text, const std::string& file) {
     std::vector<Level> levels;
     auto active = [&] { return levels.empty() || levels.back().active; };
     // `const bool X = false;`, `float axis_steps_per_unit[] = {...};`, `const int X_MAX_LENGTH = 200;`
-    static const std::regex declaration(
-        R"(^\s*(?:static\s+)?(?:const\s+)?(?:bool|int|long|float|double|char|unsigned(?:\s+(?:int|long|char))?|u?int\d+_t)\s+(\w+)\s*(?:\[[^\]]*\])?\s*=\s*(.+?)\s*;\s*$)");
-    static const std::regex define(R"(^\s*#\s*define\s+(\w+)(\(?)(.*)$)");
-    static const std::regex directive(R"(^\s*#\s*(\w+)\s*(.*)$)");
+    // (RE2, as the project's other patterns: linear time, no recursion).
+    static const RE2 declaration(
+        R"(\s*(?:static\s+)?(?:const\s+)?(?:bool|int|long|float|double|char|unsigned(?:\s+(?:int|long|char))?|u?int\d+_t)\s+(\w+)\s*(?:\[[^\]]*\])?\s*=\s*(.+?)\s*;\s*)");
+    static const RE2 define(R"(\s*#\s*define\s+(\w+)(\(?)(.*))");
+    static const RE2 directive(R"(\s*#\s*(\w+)\s*(.*))");
     for (const auto& [line, number] : logical_lines(text)) {
         const std::string where = file + ":" + std::to_string(number);
-        std::smatch m;
-        if (std::regex_match(line, m, directive)) {
-            const std::string word = m[1];
-            const std::string rest = trim(m[2]);
+        std::string word, rest, name, paren, value;
+        if (RE2::FullMatch(line, directive, &word, &rest)) {
+            rest = trim(rest);
             if (word == "if" || word == "ifdef" || word == "ifndef") {
                 bool on = false;
                 if (active()) {
@@ -325,15 +326,15 @@ void ConfigText::add(const std::string& text, const std::string& file) {
                 l.taken = true;
             } else if (word == "endif" && !levels.empty()) {
                 levels.pop_back();
-            } else if (word == "define" && active() && std::regex_match(line, m, define)) {
-                if (m[2].length() != 0) continue;  // a function-like macro: no setting
-                entries_[m[1]] = {m[1], squeezed(m[3]), where};
+            } else if (word == "define" && active() && RE2::FullMatch(line, define, &name, &paren, &value)) {
+                if (!paren.empty()) continue;  // a function-like macro: no setting
+                entries_[name] = {name, squeezed(value), where};
             } else if (word == "undef" && active()) {
                 entries_.erase(trim(rest));
             }
             continue;
         }
-        if (active() && std::regex_match(line, m, declaration)) entries_[m[1]] = {m[1], squeezed(m[2]), where};
+        if (active() && RE2::FullMatch(line, declaration, &name, &value)) entries_[name] = {name, squeezed(value), where};
     }
 }
 
