@@ -124,12 +124,18 @@ MachineConfig read_marlin(const std::vector<ConfigFile>& files) {
                 continue;
             }
             if (!present) continue;
-            // READ(X_MIN_PIN) != X_MIN_ENDSTOP_INVERTING: triggered high unless inverting.
-            std::string inverting = A + "_" + end + "_ENDSTOP_INVERTING";
-            if (!c.defined(inverting)) inverting = A + "_ENDSTOP_INVERT";  // Sprinter
-            if (!c.defined(inverting)) inverting = A + "_ENDSTOPS_INVERTING";
+            // READ(X_MIN_PIN) != X_MIN_ENDSTOP_INVERTING: triggered high unless
+            // inverting; Marlin 2.1 says the level itself, X_MIN_ENDSTOP_HIT_STATE HIGH/LOW.
             EndstopLogic logic;
-            logic.triggered_high = !(c.number(inverting).value_or(0) != 0);
+            std::string inverting = A + "_" + end + "_ENDSTOP_HIT_STATE";
+            if (c.defined(inverting)) {
+                logic.triggered_high = c.number(inverting).value_or(1) != 0;
+            } else {
+                inverting = A + "_" + end + "_ENDSTOP_INVERTING";
+                if (!c.defined(inverting)) inverting = A + "_ENDSTOP_INVERT";  // Sprinter
+                if (!c.defined(inverting)) inverting = A + "_ENDSTOPS_INVERTING";
+                logic.triggered_high = !(c.number(inverting).value_or(0) != 0);
+            }
             const std::string pullup = std::string("ENDSTOPPULLUP_") + A + end;
             logic.pull_up = all_pullups || enabled(c, pullup);
             std::string source = why + "; " + c.cite(inverting) + "; " +

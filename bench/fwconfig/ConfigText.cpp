@@ -243,6 +243,9 @@ private:
         if (name.empty()) return std::nullopt;
         if (name == "true") return 1.0;
         if (name == "false") return 0.0;
+        // Arduino's pin levels, which Marlin 2.1's *_ENDSTOP_HIT_STATE use, unless a file defines them.
+        if (name == "HIGH" && !config_.defined(name)) return 1.0;
+        if (name == "LOW" && !config_.defined(name)) return 0.0;
         if (name == "defined" || name == "ENABLED" || name == "DISABLED" || name == "ANY" || name == "BOTH") {
             const bool parens = eat("(");
             std::vector<std::string> names{identifier()};

@@ -258,3 +258,22 @@ TEST(BoardFromConfig, APrusaVariantGivesTheTmcDirectionsAndStallTuning) {
 
 }  // namespace
 }  // namespace avrbench
+
+namespace avrbench {
+namespace {
+
+TEST(BoardFromConfig, Marlin21HitStatesAndPlugsFromTheHomingDirection) {
+    const std::string text = generate({fixture("marlin2.h")});
+    // X_MIN_ENDSTOP_HIT_STATE HIGH with pull-ups: a normally-closed switch to GND;
+    // Y's LOW: normally open. The min ends have switches (X/Y_HOME_DIR -1).
+    EXPECT_TRUE(has_line(text, "  x_min: {type: limit_switch, side: min, position: 2mm, contact: NC, switched_to: gnd, pull: internal_up}")) << text;
+    EXPECT_TRUE(has_line(text, "  y_min: {type: limit_switch, side: min, position: 2mm, contact: NO, switched_to: gnd, pull: internal_up}")) << text;
+    // X_BED_SIZE 220: travel 224 mm; Z_MAX_POS 250: 254 mm at 400 steps/mm.
+    EXPECT_TRUE(has_line(text, "  x: {type: linear_axis, steps_per_mm: 80, travel: 224mm, start_position: 112mm}")) << text;
+    EXPECT_TRUE(has_line(text, "  z: {type: linear_axis, steps_per_mm: 400, travel: 254mm, start_position: 127mm}")) << text;
+    EXPECT_NE(text.find("  y_driver: {type: step_dir_driver, preset: a4988, microsteps: 16, forward_dir: low"), std::string::npos) << text;
+    load_generated(text, "marlin2");
+}
+
+}  // namespace
+}  // namespace avrbench
