@@ -16,6 +16,7 @@ namespace {
 
 constexpr const char* kAxisUpper[3] = {"X", "Y", "Z"};
 constexpr const char* kAxisLower[3] = {"x", "y", "z"};
+constexpr const char* kNothingForBaud = ": nothing to set (the host follows the baud rate the firmware programs)";
 
 std::string base_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
@@ -66,6 +67,11 @@ void note_base(MachineConfig& out, const ConfigText& c, const std::string& setti
     } else {
         out.base_unknown = c.cite(setting) + ": no standard board for it";
     }
+}
+
+// A baud rate setting: the host follows whatever UBRR the firmware programs.
+void note_baud_rate(MachineConfig& out, const ConfigText& c, const std::string& setting) {
+    if (c.defined(setting)) out.not_mapped.push_back(c.cite(setting) + kNothingForBaud);
 }
 
 // Marlin's thermistor tables (Marlin's thermistortables.h numbering, which
@@ -169,9 +175,7 @@ MachineConfig read_marlin(const std::vector<ConfigFile>& files) {
     }
     thermistor(out, out.hotend_thermistor, c, sprinter ? "THERMISTORHEATER" : "TEMP_SENSOR_0");
     thermistor(out, out.bed_thermistor, c, sprinter ? "THERMISTORBED" : "TEMP_SENSOR_BED");
-    if (c.defined("BAUDRATE")) {
-        out.not_mapped.push_back(c.cite("BAUDRATE") + ": nothing to set (the host follows the baud rate the firmware programs)");
-    }
+    note_baud_rate(out, c, "BAUDRATE");
     return out;
 }
 
@@ -205,9 +209,7 @@ MachineConfig read_repetier(const std::vector<ConfigFile>& files) {
     out.e_steps_per_mm = sourced_number(c, "EXT0_STEPS_PER_MM");
     out.soft_min = sourced_flag(c, "min_software_endstop_x");
     out.soft_max = sourced_flag(c, "max_software_endstop_x");
-    if (c.defined("BAUDRATE")) {
-        out.not_mapped.push_back(c.cite("BAUDRATE") + ": nothing to set (the host follows the baud rate the firmware programs)");
-    }
+    note_baud_rate(out, c, "BAUDRATE");
     return out;
 }
 
@@ -251,7 +253,7 @@ MachineConfig read_teacup(const std::vector<ConfigFile>& files) {
     out.homing_not_judged = "Teacup's home.c zeroes where the switch releases on the slow back-off, a place the "
                             "configuration does not fix to a step";
     if (const auto per_m = c.number("STEPS_PER_M_E")) out.e_steps_per_mm = Sourced<double>{*per_m / 1000.0, c.cite("STEPS_PER_M_E")};
-    if (c.defined("BAUD")) out.not_mapped.push_back(c.cite("BAUD") + ": nothing to set (the host follows the baud rate the firmware programs)");
+    note_baud_rate(out, c, "BAUD");
     return out;
 }
 
@@ -466,7 +468,7 @@ MachineConfig read_klipper(const std::vector<ConfigFile>& files) {
         out.not_mapped.push_back(ini["extruder"]["rotation_distance"].where + ": the extruder's axis keeps the board's steps");
     }
     if (ini.count("mcu") && ini["mcu"].count("baud")) {
-        out.not_mapped.push_back(ini["mcu"]["baud"].where + ": nothing to set (the host follows the baud rate the firmware programs)");
+        out.not_mapped.push_back(ini["mcu"]["baud"].where + kNothingForBaud);
     }
     return out;
 }

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -158,6 +159,13 @@ public:
     // Signals for the trace recorder, and a subscription to their changes.
     const std::vector<PartSignalInfo>& signals() const { return signal_infos_; }
     double signal_value(std::size_t signal) const { return signal_values_[signal]; }
+    // The signal of that name, if the part has one.
+    std::optional<std::size_t> signal_index(std::string_view name) const {
+        for (std::size_t i = 0; i < signal_infos_.size(); ++i) {
+            if (signal_infos_[i].name == name) return i;
+        }
+        return std::nullopt;
+    }
     // How many times the signal was published since the start (0: never changed).
     std::uint64_t signal_changes(std::size_t signal) const { return signal_changes_[signal]; }
 
@@ -179,6 +187,12 @@ public:
         std::function<double()> value;
     };
     const std::vector<Readout>& readouts() const { return readouts_; }
+    const Readout* find_readout(std::string_view name) const {
+        for (const auto& r : readouts_) {
+            if (r.name == name) return &r;
+        }
+        return nullptr;
+    }
     // Text a part shows (an LCD's lines): one string per line.
     struct TextReadout {
         std::string name;

@@ -479,12 +479,8 @@ void bind_part(py::module_& m) {
             return d;
         })
         .def("signal", [](Part& p, const std::string& name) {
-            for (std::size_t i = 0; i < p.signals().size(); ++i) {
-                if (p.signals()[i].name == name) return py::object(py::float_(p.signal_value(i)));
-            }
-            for (const auto& r : p.readouts()) {
-                if (r.name == name) return readout_value(r.value());
-            }
+            if (const auto i = p.signal_index(name)) return py::object(py::float_(p.signal_value(*i)));
+            if (const auto* r = p.find_readout(name)) return readout_value(r->value());
             // Text (an LCD's): `lines` as a list of str, `text` the lines joined with newlines.
             if (const auto* t = p.find_text_readout(name)) return py::object(py::cast(t->lines()));
             if (name == "text") {

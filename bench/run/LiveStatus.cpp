@@ -10,12 +10,8 @@ namespace {
 
 // A part's signal or readout by name, if it has it.
 std::optional<double> value_of(const Part& part, const std::string& name) {
-    for (std::size_t i = 0; i < part.signals().size(); ++i) {
-        if (part.signals()[i].name == name) return part.signal_value(i);
-    }
-    for (const auto& r : part.readouts()) {
-        if (r.name == name) return r.value();
-    }
+    if (const auto i = part.signal_index(name)) return part.signal_value(*i);
+    if (const auto* r = part.find_readout(name)) return r->value();
     return std::nullopt;
 }
 

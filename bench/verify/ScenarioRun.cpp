@@ -297,13 +297,11 @@ SignalWatches watch_expected_signals(Bench& bench, const std::vector<ScenarioExp
         auto w = std::make_shared<SignalWatch>();
         watches[sig] = w;
         Part& part = bench.board().part(sig->part);
-        for (std::size_t i = 0; i < part.signals().size(); ++i) {
-            w->known += (w->known.empty() ? "" : ", ") + part.signals()[i].name;
-            if (part.signals()[i].name != sig->signal) continue;
-            w->found = true;
-            w->index = i;
-        }
-        if (!w->found) continue;
+        for (const auto& info : part.signals()) w->known += (w->known.empty() ? "" : ", ") + info.name;
+        const auto index = part.signal_index(sig->signal);
+        if (!index) continue;
+        w->found = true;
+        w->index = *index;
         w->clock_hz = part.clock().frequency_hz();
         w->from_cycle = part.clock().cycles_from_seconds(seconds_from_ps(sig->from_ps));
         w->before = part.signal_value(w->index);
