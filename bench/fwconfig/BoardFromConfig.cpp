@@ -347,8 +347,16 @@ std::string board_from_config(const MachineConfig& config, const BoardFromConfig
             continue;
         }
         PartOut& t = w.part(name);
-        t.set("preset", (*slot)->value);
-        t.comments.push_back("thermistor: " + (*slot)->source);
+        if ((*slot)->value == "ad595") {
+            // The same ports (body, out) as the thermistor it replaces, so the base's nets hold.
+            t.type = "thermocouple_amplifier";
+            t.params.clear();
+            t.set("preset", "ad595");
+            t.comments.push_back("a thermocouple on an AD595: " + (*slot)->source);
+        } else {
+            t.set("preset", (*slot)->value);
+            t.comments.push_back("thermistor: " + (*slot)->source);
+        }
     }
 
     std::ostringstream header;

@@ -75,13 +75,17 @@ void note_baud_rate(MachineConfig& out, const ConfigText& c, const std::string& 
 }
 
 // Marlin's thermistor tables (Marlin's thermistortables.h numbering, which
-// Prusa-Firmware and Sprinter share): 1 is the EPCOS 100k B57560G104F.
+// Prusa-Firmware and Sprinter share): 1 is the EPCOS 100k B57560G104F, -1
+// a thermocouple on an AD595 (Marlin 1.0 Configuration.h: "-1 is thermocouple
+// with AD595"; Sprinter's THERMISTORHEATER has no such number).
 void thermistor(MachineConfig& out, std::optional<Sourced<std::string>>& slot, const ConfigText& c,
                 const std::string& setting) {
     const auto v = c.number(setting);
     if (!v) return;
     if (*v == 1) {
         slot = Sourced<std::string>{"epcos_b57560g104f", c.cite(setting)};
+    } else if (*v == -1 && setting.rfind("TEMP_SENSOR_", 0) == 0) {
+        slot = Sourced<std::string>{"ad595", c.cite(setting)};
     } else if (*v != 0) {
         out.not_mapped.push_back(c.cite(setting) + ": the bench has no preset for this table (the board's stays)");
     }

@@ -44,7 +44,8 @@ struct MachineConfig {
     std::array<AxisConfig, 3> axes;          // X, Y, Z
     std::optional<Sourced<double>> e_steps_per_mm;
     std::optional<Sourced<bool>> soft_min, soft_max;  // software endstops on
-    std::optional<Sourced<std::string>> hotend_thermistor, bed_thermistor;  // thermistor preset names
+    // The sensors' presets: a thermistor's, or "ad595" (a thermocouple_amplifier).
+    std::optional<Sourced<std::string>> hotend_thermistor, bed_thermistor;
     // Set when the firmware's G28 does not end at its 0 (Marlin's
     // Z_SAFE_HOMING parks over the bed): the oracle is given no home, so a
     // G28 ends the judging, said in the summary.

@@ -266,6 +266,11 @@ void MotionOracle::commanded(const CommandedMove& move) {
         if (!move.to_mm[k]) return lose(move.line + " ends where the bench cannot know", true);
         t.to[i] = *move.to_mm[k] + *origin_mm_[k];
         t.origin[i] = *origin_mm_[k];
+        if (home && move.homed[k]) {
+            const double approach = t.to[i] - t.from[i];
+            settling_[k].reset();
+            if (approach != 0) settling_[k] = HomeSettle{command, t.to[i], approach > 0 ? 1.0 : -1.0, t.from[i]};
+        }
     }
     // A slow feed steps seldom: at F mm/min the carriage moving fastest does
     // at least F / sqrt(3) of it, a step every step_mm sqrt(3) / (F / 60) s;
@@ -511,12 +516,61 @@ void MotionOracle::on_carriage() {
         rest_judged_ = false;
         arm_rest_check();
     }
+    settle_homes(p);
     if (!moves_.empty()) {
         observe(moves_.front(), p, now);
         advance(p);
         check_tool(p, now);
     }
     last_position_ = p;
+}
+
+// A homed axis' zero is where homing left it, if that is within
+// path_tolerance of home_x...: the last place the carriage reached moving
+// towards the switch, once the first straight move after the G28 that
+// drives the axis carries it away by more than path_tolerance (a homing
+// back-off before that move is the cursor's is not the end of homing; one
+// taking the axis towards the switch leaves home_x as it is); for an axis
+// the first move after the G28 leaves alone, where it stands once that move
+// is path_tolerance under way. The moves told since the G28 move with it.
+void MotionOracle::settle_homes(const Eigen::Vector3d& p) {
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!settling_[k]) continue;
+        HomeSettle& s = *settling_[k];
+        const auto i = static_cast<Eigen::Index>(k);
+        if ((p[i] - last_position_[i]) * s.approach_sign > 0) s.turn_mm = p[i];
+        if (moves_.empty() || lost_) continue;
+        const Tracked& front = moves_.front();
+        if (front.barrier || front.command <= s.home_command) continue;
+        const double travel = front.to[i] - front.from[i];
+        const bool straight = !front.free && (front.kind == CommandedMove::Kind::Feed || front.kind == CommandedMove::Kind::Rapid);
+        double rest_mm = 0;
+        if (travel == 0) {
+            // An axis this move leaves alone rests where homing left it, once the move is under way.
+            if (front.free || front.progress <= path_tolerance_mm_) continue;
+            rest_mm = p[i];
+        } else {
+            if (!straight) continue;
+            if (travel * s.approach_sign > 0) {
+                settling_[k].reset();
+                continue;
+            }
+            if ((s.turn_mm - p[i]) * s.approach_sign <= path_tolerance_mm_) continue;
+            rest_mm = s.turn_mm;
+        }
+        const double shift = rest_mm - s.home_mm;
+        settling_[k].reset();
+        if (std::abs(shift) > path_tolerance_mm_ || shift == 0) continue;
+        for (Tracked& m : moves_) {
+            if (m.barrier || m.command <= s.home_command) continue;
+            m.from[i] += shift;
+            m.to[i] += shift;
+            m.origin[i] += shift;
+            if (k < 2) m.centre[i] += shift;
+            m.closest_end = (m.closest_at - m.to).norm();
+        }
+        if (origin_mm_[k]) origin_mm_[k] = *origin_mm_[k] + shift;
+    }
 }
 
 Cycle MotionOracle::rest_cycles_now() const {

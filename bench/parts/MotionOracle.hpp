@@ -158,6 +158,8 @@ private:
     Finding make_finding(FindingKind kind, Cycle cycle, std::string detail) const;
     std::string firmware_text(const Tracked& m, const Eigen::Vector3d& carriage_mm) const;
     void lose(const std::string& why, bool by_move = false);
+    // Where a homed axis came to rest (see settle_homes).
+    void settle_homes(const Eigen::Vector3d& p);
 
     std::array<Carriage*, 3> carriages_{};
     Effector* effector_ = nullptr;
@@ -176,6 +178,18 @@ private:
     std::array<std::optional<double>, 3> origin_given_mm_{};
     std::array<std::optional<double>, 3> home_mm_{};
     std::array<std::optional<double>, 3> origin_mm_{};  // the firmware's zero on each carriage
+    // A homed axis whose zero is taken where homing left it: a firmware
+    // stops a step or two past the switch (Marlin 1.0 wants two readings in
+    // a row), and calls that 0. Until a later straight move carries the axis
+    // clearly away, `turn_mm` is the last place it reached moving towards
+    // the switch.
+    struct HomeSettle {
+        std::uint64_t home_command = 0;  // the G28's move
+        double home_mm = 0;              // where home_x puts the switch's 0 (carriage mm)
+        double approach_sign = 0;        // +1 or -1: the direction the carriage homed in
+        double turn_mm = 0;
+    };
+    std::array<std::optional<HomeSettle>, 3> settling_{};
     std::deque<Tracked> moves_;  // the cursor's move first
     std::optional<Tracked> last_drawing_;  // the last drawing move the cursor left
     Eigen::Vector3d last_position_ = Eigen::Vector3d::Zero();

@@ -11,6 +11,12 @@
  *                    the move is made (one step event every 400 us)
  *   G1 ... F0        refused with grbl's "error:22" (undefined feed rate),
  *                    not moved
+ *   G28 P<n>         homes X and Y to their min switches (PB1, PB2: normally
+ *                    open to GND with pull-ups, low = triggered), one step
+ *                    every 100 us, each axis stopping <n> steps after its
+ *                    switch first reads low (a firmware that wants n + 1
+ *                    readings in a row, as Marlin 1.0 wants two), and calls
+ *                    where it stopped 0
  * anything else is answered "ok" and ignored.
  */
 #include <avr/io.h>
@@ -64,10 +70,30 @@ static void step(uint8_t bits)
     _delay_us(396);
 }
 
+static void home_xy(uint8_t extra_steps)
+{
+    PORTD |= _BV(PD5) | _BV(PD6); /* DIR high = - */
+    _delay_us(4);
+    uint8_t x_after = 0, y_after = 0;
+    for (;;) {
+        uint8_t bits = 0;
+        if (!(PINB & _BV(PB1)) && x_after <= extra_steps) ++x_after;
+        if (!(PINB & _BV(PB2)) && y_after <= extra_steps) ++y_after;
+        if (x_after <= extra_steps) bits |= _BV(PD2);
+        if (y_after <= extra_steps) bits |= _BV(PD3);
+        if (bits == 0) return;
+        PORTD |= bits;
+        _delay_us(4);
+        PORTD &= (uint8_t)~bits;
+        _delay_us(96);
+    }
+}
+
 int main(void)
 {
     DDRD = _BV(PD2) | _BV(PD3) | _BV(PD5) | _BV(PD6);
     DDRB = _BV(PB0); /* PB0 low: drivers enabled */
+    PORTB = _BV(PB1) | _BV(PB2); /* the switches' pull-ups */
     UCSR0A = _BV(U2X0);
     UBRR0 = 16;
     UCSR0B = _BV(RXEN0) | _BV(TXEN0);
@@ -78,6 +104,12 @@ int main(void)
         if (line[0] == 'G' && line[1] == '1' && strstr(line, "F0") != 0) {
             put('e'); put('r'); put('r'); put('o'); put('r'); put(':'); put('2'); put('2'); put('\r'); put('\n');
             continue;
+        }
+        if (line[0] == 'G' && line[1] == '2' && line[2] == '8') {
+            const char *p = strchr(line, 'P');
+            home_xy(p ? (uint8_t)atoi(p + 1) : 0);
+            x = 0;
+            y = 0;
         }
         if (line[0] == 'G' && line[1] == '1' && line[2] == ' ') {
             const long tx = target_steps('X', x), ty = target_steps('Y', y);

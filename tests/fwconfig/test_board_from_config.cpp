@@ -209,6 +209,16 @@ TEST(BoardFromConfig, WithoutABoardItSaysWhichSettingAndAsksForBase) {
     EXPECT_THROW(detect_config_format({{"notes.txt", "hello\n"}}), BadInput);
 }
 
+TEST(BoardFromConfig, AThermocoupleOnAnAd595ReplacesTheThermistor) {
+    // Marlin 1.0's Configuration.h: "-1 is thermocouple with AD595" (its stock TEMP_SENSOR_0).
+    const std::string text = generate({{"Configuration.h", "#define MOTHERBOARD 33\n#define TEMP_SENSOR_0 -1\n#define DEFAULT_AXIS_STEPS_PER_UNIT {80,80,400,100}\n"}});
+    EXPECT_TRUE(has_line(text, "  # a thermocouple on an AD595: Configuration.h:2: TEMP_SENSOR_0 -1")) << text;
+    EXPECT_TRUE(has_line(text, "  hotend_thermistor: {type: thermocouple_amplifier, preset: ad595}")) << text;
+    // The base's nets (the plant's body, T0 = PK5) hold for the new part.
+    Board board(load_generated(text, "ad595"), {{"mega", test::firmware("ramps_home")}});
+    EXPECT_EQ(board.part("hotend_thermistor").type(), "thermocouple_amplifier");
+}
+
 }  // namespace
 }  // namespace avrbench
 

@@ -169,6 +169,58 @@ TEST(OracleResolution, AStrayBeyondTheQuantumIsStillAFinding) {
     EXPECT_TRUE(strays);
 }
 
+// A firmware's zero after G28 is where its homing stopped: dda_line's
+// "G28 P<n>" stops n steps past the switch (as Marlin 1.0 does, which wants
+// two readings in a row). Switches at 2 mm, carriages from 3 mm: with P2
+// the zero is 2 - 2 x 0.004 = 1.992 mm, and G1 X1 Y0.3 ends at 2.992 /
+// 2.292 mm. Judged from home_x (2 mm) the end would be 2 steps (0.008 mm)
+// off, over the one-step tolerance (0.004 mm); taken where homing left the
+// carriages, it is exact. 40 steps past (0.16 mm) is over path_tolerance
+// (0.1 mm): a homing that far off is still judged against home_x.
+struct HomedRun {
+    double x_mm;
+    std::vector<Finding> findings;
+};
+HomedRun home_past_the_switch(int extra_steps) {
+    const auto dir = test::scratch_dir("verdict-home-" + std::to_string(extra_steps));
+    const auto board = dir / "homing.yaml";
+    {
+        std::ofstream out(board);
+        out << "board: cnc-shield-homing\n"
+               "extends: arduino-uno-cnc-shield-v3\n"
+               "parts:\n"
+               "  x: {type: linear_axis, steps_per_mm: 250, travel: 200mm, start_position: 3mm}\n"
+               "  y: {type: linear_axis, steps_per_mm: 250, travel: 200mm, start_position: 3mm}\n"
+               "  x_limit: {type: limit_switch, side: min, position: 2mm, contact: NO, switched_to: gnd, pull: internal_up}\n"
+               "  y_limit: {type: limit_switch, side: min, position: 2mm, contact: NO, switched_to: gnd, pull: internal_up}\n"
+               "  motion: {type: motion_oracle, home_x: 2mm, home_y: 2mm, home_z: 100mm}\n"
+               "  host: {type: serial_host, flow: send_and_wait, family: generic}\n";
+    }
+    Bench bench(board.string(), test::firmware("dda_line"));
+    bench.host().add_lines("G28 P" + std::to_string(extra_steps) + "\nG1 X1 Y0.3\n");
+    EXPECT_EQ(bench.run_until_idle(10.0), IdleResult::Idle) << bench.host().tail(6);
+    EXPECT_TRUE(bench.host().done());
+    EXPECT_EQ(bench.board().part_as<MotionOracle>("motion").moves_judged(), 2u);
+    return {bench.axis("x").position_mm(), bench.findings()};
+}
+
+TEST(OracleResolution, TheZeroIsWhereHomingStoppedWithinPathTolerance) {
+    const HomedRun at_trip = home_past_the_switch(0);
+    EXPECT_NEAR(at_trip.x_mm, 3.0, 1e-9);
+    for (const Finding& f : at_trip.findings) ADD_FAILURE() << f.describe();
+    const HomedRun two_past = home_past_the_switch(2);
+    EXPECT_NEAR(two_past.x_mm, 2.992, 1e-9);
+    for (const Finding& f : two_past.findings) ADD_FAILURE() << f.describe();
+    const HomedRun far_past = home_past_the_switch(40);
+    EXPECT_NEAR(far_past.x_mm, 2.84, 1e-9);
+    // Its zero 0.16 mm short of home_x: G1 X1 Y0.3 starts at Y-0.160 as
+    // the oracle counts, hypot(0.16, 0.16) = 0.226 mm off the line.
+    ASSERT_FALSE(far_past.findings.empty());
+    EXPECT_EQ(far_past.findings[0].kind, MotionOracle::kPathDeviation) << far_past.findings[0].describe();
+    EXPECT_NE(far_past.findings[0].detail.find("strays 0.226 mm"), std::string::npos) << far_past.findings[0].describe();
+    EXPECT_NE(far_past.findings[0].detail.find("at X-0.160 Y-0.160"), std::string::npos) << far_past.findings[0].describe();
+}
+
 TEST(OracleResolution, ARefusedLineIsNeverJudgedEvenWhenALaterLineStoppedTheJudging) {
     // grbl's character counting sends lines 2 and 3 before line 1's answer:
     // line 2 ("1", a bare number) stops the oracle judging, then line 1
