@@ -210,6 +210,17 @@ MachineConfig read_repetier(const std::vector<ConfigFile>& files) {
                 Sourced<EndstopLogic>{logic, c.cite(hw) + "; " + c.cite(inv) + "; " + c.cite(pull)};
         }
     }
+    // Printer.cpp (homeXAxis...) moves back ENDSTOP_X_BACK_ON_HOME mm after
+    // the second approach; run on the board made from the stock
+    // configuration, its 0 was that far off the switch (less the steps past
+    // it) and Z stood ENDSTOP_Z_BACK_MOVE above its switch until the next
+    // move took it down: a G28 whose end the oracle cannot place.
+    for (const char* a : {"X", "Y", "Z"}) {
+        const std::string back = std::string("ENDSTOP_") + a + "_BACK_ON_HOME";
+        if (c.number(back).value_or(0) > 0 && !out.homing_not_judged) {
+            out.homing_not_judged = c.cite(back) + ": Repetier moves back after homing and its 0 is not at the switch";
+        }
+    }
     out.e_steps_per_mm = sourced_number(c, "EXT0_STEPS_PER_MM");
     out.soft_min = sourced_flag(c, "min_software_endstop_x");
     out.soft_max = sourced_flag(c, "max_software_endstop_x");

@@ -146,6 +146,10 @@ TEST(BoardFromConfig, RepetierEnablesActiveHighAndSwitchesAtBothEnds) {
     EXPECT_TRUE(has_line(text, "  x_max_switch: {type: limit_switch, side: max, position: 252mm, contact: NO, switched_to: gnd, pull: internal_up}")) << text;
     EXPECT_TRUE(has_line(text, "  x_max_switch: [mega.PE4, x_max_switch.out]")) << text;
     EXPECT_NE(text.find("filament_steps_per_mm: 255}"), std::string::npos) << text;
+    // Its 0 after G28 is 1 mm off the switch: the oracle gets no home (G28 ends the judging).
+    EXPECT_EQ(text.find("home_x:"), std::string::npos) << text;
+    EXPECT_NE(text.find("no home: repetier.h:22: ENDSTOP_X_BACK_ON_HOME 1: Repetier moves back after homing"), std::string::npos)
+        << text;
     load_generated(text, "repetier");
 }
 
