@@ -173,19 +173,25 @@ def cases(fw):
     for depth in (4, 6, 8, 10):
         lines, alias = laughs(depth)
         head = "\n".join(lines) + "\n"
+        # 10^depth nodes: past 10^6 the expansion is refused; under it, the
+        # laughs' own top-level keys (l0, l1, ...) are what is wrong.
         bomb = "nodes (aliases of aliases?)" if depth >= 6 else ""
         out.append(Case(f"yaml-laughs-board-description-{depth}", run_board, files={"board.yaml": head + board_with(description=alias)},
-                        says=bomb))
+                        says=bomb or "board.yaml:1: unknown section 'l0'"))
         out.append(Case(f"yaml-laughs-board-params-{depth}", run_board,
-                        files={"board.yaml": head + board_with(parts=f"  sw: {{type: limit_switch, bounce: {alias}}}")}))
-        out.append(Case(f"yaml-laughs-board-top-{depth}", run_board, files={"board.yaml": head + board_with(extra_top=f"y: {alias}\n")}))
+                        files={"board.yaml": head + board_with(parts=f"  sw: {{type: limit_switch, bounce: {alias}}}")},
+                        says=bomb or "board.yaml:1: unknown section 'l0'"))
+        out.append(Case(f"yaml-laughs-board-top-{depth}", run_board, files={"board.yaml": head + board_with(extra_top=f"y: {alias}\n")},
+                        says=bomb or "board.yaml:1: unknown section 'l0'"))
         out.append(Case(f"yaml-laughs-scenario-{depth}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
                         files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
-                               "s.yaml": head + scenario_with(extra=f"description: {alias}\n")}))
+                               "s.yaml": head + scenario_with(extra=f"description: {alias}\n")},
+                        says=bomb or "s.yaml:1: unknown key 'l0'"))
     # YAML: nesting.
     for depth in (100, 1000, 20000):
         out.append(Case(f"yaml-nesting-{depth}", run_board,
-                        files={"board.yaml": board_with(description="[" * depth + "]" * depth)}))
+                        files={"board.yaml": board_with(description="[" * depth + "]" * depth)},
+                        says="nested more than 64 levels deep" if depth == 100 else "board.yaml:2: YAML syntax error"))
     # YAML of the wrong shape, section by section.
     shapes = {"list": "[a, b]", "scalar": "hello", "number": "42", "null": "~", "nested": "{a: {b: [c]}}", "empty-map": "{}"}
     sections = {"mcus": "\n  uno: {type: atmega328p, clock: 16MHz}", "parts": " {}", "nets": " {}",
@@ -197,16 +203,31 @@ def cases(fw):
                 for name, value in sections.items())
             # An empty or null parts, nets, serial or labels section is a board without them.
             legal = section != "mcus" and shape in ("null", "empty-map")
-            out.append(Case(f"yaml-shape-{section}-{shape}", run_board, expect=0 if legal else 2, files={"board.yaml": board}))
-    for entry, text in (("serial-port-list", "  host: [mcu, uno]"), ("serial-port-scalar", "  host: uno"),
-                        ("serial-port-nested", "  host: {mcu: [uno], usart: 0}")):
-        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(serial=text)}))
-    for entry, text in (("mcu-list", "  uno: [atmega328p, 16MHz]"), ("mcu-scalar", "  uno: atmega328p"),
-                        ("mcu-type-list", "  uno: {type: [atmega328p], clock: 16MHz}")):
-        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(mcus=text)}))
-    for entry, text in (("part-list", "  sw: [limit_switch]"), ("part-scalar", "  sw: limit_switch"),
-                        ("part-param-map", "  sw: {type: limit_switch, bounce: {a: 1}}")):
-        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(parts=text)}))
+            # {a: {b: [c]}}: a map, so the error is about what is inside it.
+            nested = {"mcus": "MCU 'a': unknown key 'b'", "parts": "parameter b must be a single value",
+                      "nets": "net 'a' must list at least two endpoints", "serial": "b must be a single value",
+                      "labels": "a net endpoint must be a single value"}
+            wrong_shape = {"mcus": "the board needs an 'mcus' map", "parts": "'parts' must be a map", "nets": "'nets' must be a map",
+                           "serial": "'serial' must be a map", "labels": "'labels' must be a map"}
+            says = "" if legal else nested[section] if shape == "nested" else wrong_shape[section]
+            out.append(Case(f"yaml-shape-{section}-{shape}", run_board, expect=0 if legal else 2, files={"board.yaml": board},
+                            says=says))
+    for entry, text, says in (("serial-port-list", "  host: [mcu, uno]", "serial port 'host' must be a map"),
+                              ("serial-port-scalar", "  host: uno", "serial port 'host' must be a map"),
+                              ("serial-port-nested", "  host: {mcu: [uno], usart: 0}", "mcu must be a single value")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(serial=text)}, says=says))
+    for entry, text, says in (("mcu-list", "  uno: [atmega328p, 16MHz]", "MCU 'uno' must be a map"),
+                              ("mcu-scalar", "  uno: atmega328p", "MCU 'uno' must be a map"),
+                              ("mcu-type-list", "  uno: {type: [atmega328p], clock: 16MHz}", "type must be a single value")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(mcus=text)}, says=says))
+    for entry, text, says in (("part-list", "  sw: [limit_switch]", "part 'sw' must be a map"),
+                              ("part-scalar", "  sw: limit_switch", "part 'sw' must be a map"),
+                              ("part-param-map", "  sw: {type: limit_switch, bounce: {a: 1}}", "parameter bounce must be a single value")):
+        out.append(Case(f"yaml-shape-{entry}", run_board, files={"board.yaml": board_with(parts=text)}, says=says))
+    scenario_says = {"steps-map": "'steps' is a list", "steps-scalar": "'steps' is a list",
+                     "step-list": "each step is one 'kind: value' entry", "expect-map": "'expect' is a list",
+                     "firmware-list": "the scenario needs 'firmware: {mcu: name-or-path}'",
+                     "tolerances-map": "'tolerances' is a list"}
     for entry, text in (("steps-map", "steps: {delay: 1ms}"), ("steps-scalar", "steps: delay"),
                         ("step-list", "steps:\n  - [delay, 1ms]"), ("expect-map", "expect: {findings: 0}"),
                         ("firmware-list", "firmware: [fw.elf]"), ("tolerances-map", "tolerances: {signals: x}")):
@@ -214,31 +235,41 @@ def cases(fw):
         if entry.startswith("firmware"):
             scenario = scenario.replace("firmware: {uno: fw.elf}\n", "")
         out.append(Case(f"yaml-shape-scenario-{entry}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"],
-                        files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(), "s.yaml": scenario + text + "\n"}))
+                        files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(), "s.yaml": scenario + text + "\n"},
+                        says=scenario_says[entry]))
     # Names and identifiers: empty, control characters, escape sequences.
     for label, name in (("empty", "''"), ("newline", '"a\\nb"'), ("ansi", '"\\e[31mred\\e[0m"'), ("space", '"a b"'),
                         ("long", "x" * 300), ("unicode", '"\u00e9t\u00e9"')):
-        out.append(Case(f"name-board-{label}", run_board, files={"board.yaml": board_with(name=name)}))
+        out.append(Case(f"name-board-{label}", run_board, files={"board.yaml": board_with(name=name)},
+                        says="is not 1 to 64 letters, digits"))
+        # A type that names no MCU: the ELF (an ATmega328P's) does not match it.
         out.append(Case(f"name-mcu-type-{label}", run_board,
-                        files={"board.yaml": board_with(mcus=f"  uno: {{type: {name}, clock: 16MHz}}")}))
+                        files={"board.yaml": board_with(mcus=f"  uno: {{type: {name}, clock: 16MHz}}")},
+                        says="missing 'type'" if label == "empty" else "built for atmega328p, but"))
+        # A long name is a name (only board names have a length limit); its switch has no axis.
         out.append(Case(f"name-part-{label}", run_board,
-                        files={"board.yaml": board_with(parts=f"  {name}: {{type: limit_switch}}")}))
+                        files={"board.yaml": board_with(parts=f"  {name}: {{type: limit_switch}}")},
+                        says="port 'axis' is not connected" if label == "long" else "is not a valid part name"))
         out.append(Case(f"name-description-{label}", run_board, expect=0,
                         files={"board.yaml": board_with(description=name if label not in ("empty",) else "''")}))
     for label, value in (("newline", "1\nms"), ("ansi", "1\x1b[2Jms"), ("nul-like", "1ms\x7f")):
-        out.append(Case(f"cli-for-{label}", ["run", blink, "--for", value, "-q"]))
-        out.append(Case(f"cli-mcu-{label}", ["run", blink, "--mcu", value, "-q"]))
-        out.append(Case(f"cli-elf-{label}", ["run", "{w}/fw" + value + ".elf", "-q"]))
-        out.append(Case(f"cli-trace-{label}", ["run", blink, "--trace", value, "--for", "1ms", "-q"]))
-        out.append(Case(f"cli-trace-only-{label}", ["run", blink, "--trace-only", value, "--for", "1ms", "-q"]))
-    out.append(Case("cli-trace-and-trace-only", ["run", blink, "--trace", "PB5", "--trace-only", "PB1", "--for", "1ms", "-q"]))
-    out.append(Case("cli-vcd-format-unknown", ["run", blink, "--vcd-format", "wide", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"]))
+        out.append(Case(f"cli-for-{label}", ["run", blink, "--for", value, "-q"], says="--for: unknown unit"))
+        out.append(Case(f"cli-mcu-{label}", ["run", blink, "--mcu", value, "-q"], says="unknown MCU"))
+        out.append(Case(f"cli-elf-{label}", ["run", "{w}/fw" + value + ".elf", "-q"], says="no such file"))
+        out.append(Case(f"cli-trace-{label}", ["run", blink, "--trace", value, "--for", "1ms", "-q"], says="--trace: bad pin name"))
+        out.append(Case(f"cli-trace-only-{label}", ["run", blink, "--trace-only", value, "--for", "1ms", "-q"],
+                        says="--trace-only: bad pin name"))
+    out.append(Case("cli-trace-and-trace-only", ["run", blink, "--trace", "PB5", "--trace-only", "PB1", "--for", "1ms", "-q"],
+                    says="--trace excludes --trace-only"))
+    out.append(Case("cli-vcd-format-unknown", ["run", blink, "--vcd-format", "wide", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"],
+                    says="--vcd-format: wide not in"))
     out.append(Case("cli-trace-duplicate", ["run", blink, "--trace", "PB5,PB5,pb5", "--vcd", "{w}/o.vcd", "--for", "1ms", "-q"],
                     expect=0))
     # Clocks outside 1 Hz .. 64 MHz, in boards.
     for clock in ("0Hz", "64000001", "2147483648", "4294967295", "1e300Hz", "-16MHz", "nan"):
         out.append(Case(f"board-clock-{clock}", run_board,
-                        files={"board.yaml": board_with(mcus=f"  uno: {{type: atmega328p, clock: {clock}}}")}))
+                        files={"board.yaml": board_with(mcus=f"  uno: {{type: atmega328p, clock: {clock}}}")},
+                        says=f"clock: '{clock}' is not " + ("finite" if clock == "nan" else "a whole number of Hz from 1 Hz to 64 MHz")))
     # Too many MCUs.
     for count in (17, 200):
         mcus = "\n".join(f"  m{i}: {{type: atmega328p, clock: 16MHz}}" for i in range(count))
@@ -286,8 +317,6 @@ def cases(fw):
                                                     "fuses: {low: 0xFF, high: 0xDE, extended: 0xFD}}")
             # A golden that is not there fails the scenario (exit 1: "create it with golden update").
             expect = 1 if role == "golden" and kind == "missing" else 2
-            if role in ("elf", "scenario", "dxf") and kind in ("dir",):
-                says = ""  # named by the command's own check first
             out.append(Case(f"input-{role}-{kind}", make_args(target), expect=expect, files=files, fifos=fifos, dirs=dirs,
                             says=says if expect == 2 else ""))
         # A sparse file far over the role's cap (the ELF one is legal: see below).
@@ -359,6 +388,13 @@ def cases(fw):
     # Golden timelines that are malformed or that claim far more than a run.
     head = ("avrbench-timeline 1\nbench 0.1.0\nend 16001 16000000\nsignal uno.PB5 wire 1 16000000\n"
             "signal uno.PB1 wire 1 16000000\nsignal uno.uart0_tx bus 8 16000000\n\n@uno.PB5\n0 0\n")
+    # The head is 9 lines: a body's error is on line 10. The repeat bomb's
+    # changes fall on cycles 1, 2, ...: the first past the end (16001) is 16002.
+    golden_says = {"two-changes-on-a-line": "g.timeline:10: '+15' after a change", "value-missing": "g.timeline:10: '+17' has no value",
+                   "junk-after": "g.timeline:10: 'junk' after a change", "repeat-odd": "g.timeline:10: repeat block: '+5' has no value",
+                   "past-end": "g.timeline:10: cycle 99999 is after the timeline's end",
+                   "repeat-bomb-past-end": "g.timeline:10: cycle 16002 is after the timeline's end",
+                   "signal-missing-clock": "g.timeline:5: 'signal' needs scope.name, kind, width and clock"}
     for label, body, expect in (
             ("two-changes-on-a-line", "+17 0 +15 1\n", 2), ("value-missing", "+17\n", 2), ("junk-after", "+17 1 junk\n", 2),
             ("repeat-odd", "*3 +5 1 +5\n", 2), ("past-end", "+99999 1\n", 2),
@@ -369,7 +405,7 @@ def cases(fw):
             text = text.replace("signal uno.PB1 wire 1 16000000", "signal uno.PB1 wire 1")
         out.append(Case(f"golden-{label}", ["check", "{w}/s.yaml", "--firmware-dir", "{w}"], expect=expect,
                         files={"board.yaml": UNO_BOARD, "fw.elf": open(blink, "rb").read(),
-                               "s.yaml": scenario_with(golden="g.timeline"), "g.timeline": text}))
+                               "s.yaml": scenario_with(golden="g.timeline"), "g.timeline": text}, says=golden_says[label]))
     # A repeat inside the timeline's end but far past the run: read no further
     # than the run went, so it fails (exit 1) at once.
     big_end = head.replace("end 16001 16000000", "end 1000000000000 16000000")
@@ -657,7 +693,9 @@ def run(case):
         lines = stderr.splitlines()
         if len(lines) != 1 or not (lines[0].startswith("avrbench: error: ") or lines[0].startswith("avrbench: usage error: ")):
             problems.append(f"stderr is not one 'avrbench: error:' line: {stderr[:300]!r}")
-        elif case.says and case.says not in lines[0]:
+        elif not case.says:
+            problems.append("an exit-2 case without a fragment of its error (says=): it would pass for any error")
+        elif case.says not in lines[0]:
             problems.append(f"the error does not say '{case.says}'")
     if case.stdout_has and case.stdout_has not in stdout:
         problems.append(f"stdout does not hold '{case.stdout_has}'")
