@@ -261,6 +261,22 @@ bool Debugger::stop_condition(Target& t, std::string& reply) {
         t.pending_reply.clear();
         return true;
     }
+    // Before a step's or breakpoint's stop: a finding made by this
+    // instruction is told now, once, not on the next resume (a stepi onto it
+    // would leave it for the next continue to stop at again, an instruction later).
+    if (findings_recorded() != findings_seen_) {
+        findings_seen_ = findings_recorded();
+        if (options_.break_at_finding && view_.findings) {
+            const auto all = view_.findings();
+            if (!all.empty()) {
+                t.finding = all.back();
+                t.conn->send_packet("O" + to_hex("avrbench: stopped at a finding: " + all.back().describe() + "\n"));
+                t.stop_at.reset();
+                reply = "S05";
+                return true;
+            }
+        }
+    }
     if (t.stop_at && t.executed >= *t.stop_at) {
         t.stop_at.reset();
         reply = "S05";
@@ -270,18 +286,6 @@ bool Debugger::stop_condition(Target& t, std::string& reply) {
     if (t.executed != t.resumed_at && t.breakpoints.count(avr->pc) != 0) {
         reply = "S05";
         return true;
-    }
-    if (findings_recorded() != findings_seen_) {
-        findings_seen_ = findings_recorded();
-        if (options_.break_at_finding && view_.findings) {
-            const auto all = view_.findings();
-            if (!all.empty()) {
-                t.finding = all.back();
-                t.conn->send_packet("O" + to_hex("avrbench: stopped at a finding: " + all.back().describe() + "\n"));
-                reply = "S05";
-                return true;
-            }
-        }
     }
     if (!break_at_done_ && (options_.break_at_cycle || options_.break_at_ps) && &t == targets_.front().get()) {
         const Cycle at = options_.break_at_cycle ? *options_.break_at_cycle : cycle_at_ps(*t.mcu, *options_.break_at_ps);

@@ -162,6 +162,27 @@ class GdbTests(unittest.TestCase):
         self.assertEqual(stop.group(1), reported.group(1))
         self.assertEqual(rc, 130, err)  # killed by the debugger: interrupted (docs/CLI.md)
 
+    def test_a_finding_stepped_over_again_is_told_where_it_was_and_not_again(self):
+        """step_boundaries on the CNC shield: its first STEP pulse is 15 cycles
+        (step-high-too-short, A4988 needs 16), its second low time 15 cycles
+        (step-low-too-short). Back 100 instructions from the first stop and
+        forward 100 again, the first is told at the same instruction; the
+        next continue goes on to the second (it stopped at the first again,
+        one instruction later, before)."""
+        target = elf("step_boundaries")
+        s = Session([target, "--board", "arduino-uno-cnc-shield-v3", "--for", "10ms", "--break-at-finding"])
+        out = gdb(s.port(), target, ["continue", "monitor time", "reverse-stepi 100", "monitor time", "stepi 100",
+                                     "monitor time", "continue", "monitor time", "kill"])
+        s.finish()
+        told = re.findall(r"avrbench: stopped at a finding: x_driver: (step-\S+) at [0-9.]+ s \(cycle (\d+)\)", out)
+        self.assertEqual([k for k, _ in told], ["step-high-too-short", "step-high-too-short", "step-low-too-short"], out)
+        self.assertEqual(told[0][1], told[1][1], out)
+        times = [int(n) for n in re.findall(r"MCU \S+: cycle \d+, [0-9.]+ s, (\d+) instructions", out)]
+        self.assertEqual(len(times), 4, out)
+        self.assertEqual(times[1], times[0] - 100, out)
+        self.assertEqual(times[2], times[0], out)
+        self.assertGreater(times[3], times[2] + 1, out)
+
     def test_reverse_stepi_100_then_stepi_100_returns_to_the_identical_state(self):
         target = elf("gdb_target")
         s = Session([target, "--for", "10ms"])
