@@ -1,6 +1,7 @@
 #include "parts/Part.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/Errors.hpp"
 
@@ -95,6 +96,14 @@ std::size_t Part::add_signal(PartSignalInfo info, double initial) {
 
 void Part::publish(std::size_t signal, double value) {
     signal_values_[signal] = value;
+    if (trace_resolution_ > 0 && signal_infos_[signal].real) {
+        // A deadband, not rounding: a value dithering about a rounding
+        // boundary (a PWM-heated block's ripple) would be recorded at every swing.
+        if (traced_values_.size() < signal_infos_.size()) traced_values_.resize(signal_infos_.size(), std::nan(""));
+        const double last = traced_values_[signal];
+        if (!std::isnan(last) && std::abs(value - last) < trace_resolution_) return;
+        traced_values_[signal] = value;
+    }
     ++signal_changes_[signal];
     const Cycle now = clock_->cycle();
     for (auto& fn : signal_listeners_) fn(signal, now, value);

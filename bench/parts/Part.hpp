@@ -168,6 +168,12 @@ public:
     }
     // How many times the signal was published since the start (0: never changed).
     std::uint64_t signal_changes(std::size_t signal) const { return signal_changes_[signal]; }
+    // The board file's `trace_resolution` (every part type has it): a real
+    // signal's value reaches the trace (the listeners) only when it differs
+    // from the last one recorded by at least this much (0: every value).
+    // signal_value() is always the latest.
+    void set_trace_resolution(double step) { trace_resolution_ = step; }
+    double trace_resolution() const { return trace_resolution_; }
 
     // What a user can do to the part from a scenario or Python (press a
     // button, turn a knob): `arguments` numbers each. act() throws BadInput
@@ -309,6 +315,8 @@ private:
     std::vector<TextReadout> text_readouts_;
     std::vector<double> signal_values_;
     std::vector<std::uint64_t> signal_changes_;
+    double trace_resolution_ = 0;
+    std::vector<double> traced_values_;  // what the listeners were last told, per signal
     std::vector<SignalListener> signal_listeners_;
     std::vector<std::function<void()>> activity_listeners_;
     std::string fault_ = "none";

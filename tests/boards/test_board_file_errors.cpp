@@ -96,7 +96,7 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"unknown_parameter", 4, "  x_driver: {type: step_dir_driver, preset: a4988, step_hi_min: 2us}",
              "bad.yaml:4: part 'x_driver': unknown parameter 'step_hi_min' (known: preset, step_edge, step_high_min, "
              "step_low_min, dir_setup, dir_hold, max_step_rate, enable_active, microsteps, forward_dir, current, "
-             "motor_supply)"},
+             "motor_supply, trace_resolution)"},
         Case{"bad_preset", 4, "  x_driver: {type: step_dir_driver, preset: a4989}",
              "bad.yaml:4: part 'x_driver': preset: 'a4989' is not one of a4988, drv8825, tmc2208, generic"},
         Case{"unknown_part_pin", 8, "  x_step: [uno.PD2, x_driver.stp]",
