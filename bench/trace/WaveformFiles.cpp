@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "trace/FstFile.hpp"
 #include "trace/GtkwWriter.hpp"
 
 namespace avrbench {
@@ -17,14 +18,17 @@ WaveformFiles::WaveformFiles(Timeline& timeline, std::string vcd_path, bool stre
                              std::vector<std::string> background_scopes)
     : timeline_(timeline),
       path_(std::move(vcd_path)),
+      vcd_file_(is_fst_path(path_) ? vcd_for_fst(path_) : path_),
       stream_wanted_(stream && !path_.empty()),
       layout_(layout),
-      background_scopes_(std::move(background_scopes)) {}
+      background_scopes_(std::move(background_scopes)) {
+    if (is_fst_path(path_)) (void)vcd2fst_program("--vcd " + path_);  // before the run, not after it
+}
 
 WaveformFiles::~WaveformFiles() = default;
 
 void WaveformFiles::start() {
-    if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, path_, layout_);
+    if (stream_wanted_) stream_ = std::make_unique<VcdStream>(timeline_, vcd_file_, layout_);
 }
 
 void WaveformFiles::drain(Picoseconds now_ps) {
@@ -36,7 +40,8 @@ std::string WaveformFiles::finish(Cycle end_cycle, std::uint32_t clock_hz) {
     VcdOptions vcd_options = layout_;
     vcd_options.end_cycle = end_cycle;
     vcd_options.end_clock_hz = clock_hz;
-    const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, path_, vcd_options);
+    const VcdResult vcd = stream_ ? stream_->finish(timeline_, vcd_options) : write_vcd(timeline_, vcd_file_, vcd_options);
+    if (vcd_file_ != path_) convert_vcd_to_fst(vcd_file_, path_, "--vcd " + path_);
     const std::string gtkw_path = with_extension(path_, ".gtkw");
     GtkwOptions gtkw_options;
     gtkw_options.buses = layout_.buses;

@@ -5,7 +5,9 @@
 //
 // The VCD is written as the run goes (VcdStream: memory does not grow with
 // the run's length) when `stream` is set, else at the end from the timeline
-// in memory (when a report needs the whole timeline anyway).
+// in memory (when a report needs the whole timeline anyway). A path ending
+// in .fst gets an FST file instead (trace/FstFile.hpp: the VCD written
+// beside it, converted at the end).
 #pragma once
 
 #include <memory>
@@ -46,7 +48,8 @@ public:
 
 private:
     Timeline& timeline_;
-    std::string path_;
+    std::string path_;      // what the user asked for: a .vcd or an .fst
+    std::string vcd_file_;  // where the VCD goes (path_, or beside an .fst)
     bool stream_wanted_;
     VcdOptions layout_;
     std::vector<std::string> background_scopes_;

@@ -7,6 +7,7 @@
 // ci/setup. A missing tool fails the test (it must not skip silently in CI).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -66,6 +67,8 @@ Timeline many_signals() {
     return timeline;
 }
 
+void expect_same_changes(const VcdDump& original, const VcdDump& converted);
+
 // vcd2fst, then fst2vcd, then compare every variable's changes with the original.
 void expect_fst_round_trip(const std::string& vcd2fst, const std::string& fst2vcd, const ScratchDir& dir,
                            const std::string& name) {
@@ -80,8 +83,10 @@ void expect_fst_round_trip(const std::string& vcd2fst, const std::string& fst2vc
     ASSERT_EQ(trace_test::run_command(quoted(fst2vcd) + " " + quoted(fst) + " >" + quoted(back), log), 0)
         << read_text(log);
 
-    const VcdDump original = read_vcd(vcd);
-    const VcdDump converted = read_vcd(back);
+    expect_same_changes(read_vcd(vcd), read_vcd(back));
+}
+
+void expect_same_changes(const VcdDump& original, const VcdDump& converted) {
     EXPECT_EQ(converted.timescale_fs, original.timescale_fs);
     EXPECT_EQ(converted.end_time, original.end_time);
     ASSERT_EQ(converted.variables.size(), original.variables.size());
@@ -111,6 +116,40 @@ TEST(GtkwaveAcceptsOurFiles, VcdConvertsToFstAndBackUnchanged) {
     expect_fst_round_trip(vcd2fst, fst2vcd, dir, "demo");
     write_vcd(many_signals(), dir.file("many.vcd"));
     expect_fst_round_trip(vcd2fst, fst2vcd, dir, "many");
+}
+
+// `run --vcd NAME.fst` writes gtkwave's FST (through Debian's vcd2fst) with
+// the very changes `--vcd NAME.vcd` writes, a save file naming the .fst, and
+// nothing else beside it; without vcd2fst on PATH it stops before the run
+// with one line (exit 2).
+TEST(GtkwaveAcceptsOurFiles, RunWritesFstWithTheVcdsChanges) {
+    const std::string fst2vcd = require_tool("fst2vcd");
+    if (fst2vcd.empty()) return;
+    ScratchDir dir;
+    const std::string run = quoted(::avrbench::test::cli()) + " run -q " +
+                            quoted(std::string(::avrbench::test::firmware_dir()) + "/blink_timer1.elf") + " --for 20ms --vcd ";
+    ASSERT_EQ(trace_test::run_command(run + quoted(dir.file("b.vcd")), dir.file("vcd.log")), 0) << read_text(dir.file("vcd.log"));
+    ASSERT_EQ(trace_test::run_command(run + quoted(dir.file("b.fst")), dir.file("fst.log")), 0) << read_text(dir.file("fst.log"));
+    ASSERT_EQ(trace_test::run_command(quoted(fst2vcd) + " " + quoted(dir.file("b.fst")) + " >" + quoted(dir.file("back.vcd")),
+                                      dir.file("back.log")),
+              0);
+    const VcdDump vcd = read_vcd(dir.file("b.vcd"));
+    const VcdDump back = read_vcd(dir.file("back.vcd"));
+    // blink_timer1 toggles PB5 every 16000 cycles from 16051: 19 times in 20 ms, plus its initial value.
+    ASSERT_NE(vcd.find("mcu.PB5"), nullptr);
+    EXPECT_EQ(vcd.find("mcu.PB5")->changes.size(), 20u);
+    expect_same_changes(vcd, back);
+    EXPECT_NE(read_text(dir.file("b.gtkw")).find("[dumpfile] \"b.fst\""), std::string::npos) << read_text(dir.file("b.gtkw"));
+    std::vector<std::string> left;
+    for (const auto& e : std::filesystem::directory_iterator(dir.file(""))) left.push_back(e.path().filename().string());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"b.fst", "b.gtkw", "b.vcd", "back.log", "back.vcd", "fst.log", "vcd.log"}));
+
+    const int code = trace_test::run_command("PATH=/nonexistent " + run + quoted(dir.file("c.fst")), dir.file("nofst.log"));
+    EXPECT_EQ(code, 2);
+    const std::string err = read_text(dir.file("nofst.log"));
+    EXPECT_NE(err.find("writing FST needs vcd2fst (Debian's gtkwave package)"), std::string::npos) << err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("c.fst")));
 }
 
 // Runs gtkwave headless on `gtkw` (which names its dump) with a Tcl script that
