@@ -169,6 +169,12 @@ UartHost& Bench::host(const std::string& port, std::optional<UartHostOptions> op
             o = default_host_options(serial);
         }
         slot = std::make_unique<UartHost>(*serial.mcu, serial.link(), o);
+        // A step anywhere on the board is the firmware at work on a waiting line.
+        Mcu& host_mcu = *serial.mcu;
+        slot->set_activity_probe([this, &host_mcu]() -> std::optional<Cycle> {
+            if (!last_step_ps_) return std::nullopt;
+            return cycle_at_ps(host_mcu, *last_step_ps_);
+        });
         check_accepted_moves(*slot);
         // Heater targets from the lines the firmware took (not those it refused).
         Mcu& clock = *serial.mcu;

@@ -582,12 +582,26 @@ void UartHost::send_line(std::size_t index) {
 // earlier lines is not timed out while it keeps answering them.
 void UartHost::arm_line_timeout() {
     const std::uint64_t generation = ++timeout_generation_;
-    std::weak_ptr<bool> alive = alive_;
     // The clock starts once the firmware has the whole line: bytes still
     // queued for its receiver (a long line at 115200 baud takes seconds).
     const Cycle still_sending = static_cast<Cycle>(uart_.pending_rx()) * uart_.cycles_per_frame();
-    mcu_.scheduler().after(mcu_.cycles_from_seconds(timeout_for_oldest_s()) + still_sending, [this, alive, generation](Cycle) {
+    timeout_armed_cycle_ = mcu_.cycle() + still_sending;
+    schedule_line_timeout(generation, timeout_armed_cycle_ + mcu_.cycles_from_seconds(timeout_for_oldest_s()));
+}
+
+void UartHost::schedule_line_timeout(std::uint64_t generation, Cycle at) {
+    std::weak_ptr<bool> alive = alive_;
+    mcu_.scheduler().at(std::max(at, mcu_.cycle() + 1), [this, alive, generation](Cycle) {
         if (alive.expired() || generation != timeout_generation_) return;
+        // The machine stepped since the timeout started: the firmware is at
+        // work on it; count again from its last step.
+        if (activity_probe_) {
+            if (const std::optional<Cycle> last = activity_probe_(); last && *last > timeout_armed_cycle_) {
+                timeout_armed_cycle_ = *last;
+                schedule_line_timeout(generation, *last + mcu_.cycles_from_seconds(timeout_for_oldest_s()));
+                return;
+            }
+        }
         on_line_timeout();
     });
 }

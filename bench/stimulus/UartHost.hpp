@@ -257,6 +257,11 @@ public:
     // it refused the line; before the next line goes out.
     using AnswerListener = std::function<void(const GcodeLine& line, std::size_t index, bool refused)>;
     void on_answer(AnswerListener fn) { answer_listeners_.push_back(std::move(fn)); }
+    // The cycle (of this host's MCU) of the machine's last visible work - a
+    // STEP edge on the board -, if any: a line waiting while the machine
+    // moves is not timed out; its timeout counts from the last step
+    // (a firmware that answers a move when it is done, however long it takes).
+    void set_activity_probe(std::function<std::optional<Cycle>()> probe) { activity_probe_ = std::move(probe); }
     // Called when a job line first goes out (not for resends, nor for grbl's
     // real-time bytes), before the firmware has its first byte.
     using SentListener = std::function<void(const GcodeLine& line)>;
@@ -313,6 +318,7 @@ private:
     void pump();
     void send_line(std::size_t index);
     void arm_line_timeout();
+    void schedule_line_timeout(std::uint64_t generation, Cycle at);
     void on_line_timeout();
     void fail(HostEvent event);
     void record(HostEvent event);
@@ -339,6 +345,8 @@ private:
     bool ready_ = false;
     bool failed_ = false;
     std::uint64_t timeout_generation_ = 0;
+    Cycle timeout_armed_cycle_ = 0;  // when the running line timeout started counting
+    std::function<std::optional<Cycle>()> activity_probe_;
     bool stop_mcu_when_finished_ = false;
 
     std::vector<UartByte> received_;

@@ -378,7 +378,7 @@ Command add_run_command(CLI::App& app) {
                         "REGEX (RE2): a line the firmware prints that is an error, besides its family's own "
                         "(repeatable; needs --gcode)");
     run_cmd->add_option("--line-timeout", run.line_timeout,
-                        "a line unanswered this long with no output at all is a timeout (default: the board's, else the family's: marlin 5s, teacup 2.5s, grbl and generic 2s; never under 2.5 times the keep-alive period seen)");
+                        "a line unanswered this long with no output at all and no STEP edge on the board is a timeout (default: the board's, else the family's: marlin 5s, teacup 2.5s, grbl and generic 2s; never under 2.5 times the keep-alive period seen)");
     run_cmd->add_option("--realtime", run.realtime,
                         "TIME=BYTES sent at that simulated time outside the line stream, e.g. 2s=! 4s=~ (grbl "
                         "feed hold/resume), 1s=^X, 3s=0x85 (repeatable; needs --gcode)");

@@ -11,6 +11,8 @@
  *                    the move is made (one step event every 400 us)
  *   G1 ... F0        refused with grbl's "error:22" (undefined feed rate),
  *                    not moved
+ *   G1 ... Q         the move, then no answer at all (a firmware that goes
+ *                    silent after moving)
  *   G28 P<n>         homes X and Y to their min switches (PB1, PB2: normally
  *                    open to GND with pull-ups, low = triggered), one step
  *                    every 100 us, each axis stopping <n> steps after its
@@ -134,6 +136,7 @@ int main(void)
             }
             x = tx;
             y = ty;
+            if (strchr(line, 'Q') != 0) continue;
         }
         put('o');
         put('k');

@@ -91,6 +91,52 @@ TEST(JobDone, AFirmwareThatSaysItIsBusyAfterItsAnswerIsNotDone) {
     EXPECT_GE(bench.now_seconds(), 4.2);
 }
 
+// A firmware that answers a move when it is done (grbl_stepper: "ok" after
+// the last step) is at work while it steps: the line is not timed out.
+// X20000 at its default $110 = 6000 mm/min and $100 = 80 steps/mm is
+// 8000 steps/s: 2.5 s, over the generic family's 2 s line timeout. On the
+// shield's 250 steps/mm the 20000 steps are 80 mm.
+TEST(JobDone, ALineIsNotTimedOutWhileTheMachineStepsForIt) {
+    Bench bench(test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), test::firmware("grbl_stepper"));
+    UartHostOptions host = default_host_options(bench.serial_port(""));
+    host.family = FirmwareFamily::Generic;  // its own banner, not grbl's
+    bench.host("", host);
+    bench.host().add_lines("X20000\n");
+    ASSERT_EQ(bench.run_until_idle(10.0), IdleResult::Idle) << bench.host().tail(6);
+    EXPECT_TRUE(bench.host().done()) << bench.host().tail(6);
+    EXPECT_EQ(bench.host().errors(), 0u);
+    for (const Finding& f : bench.findings()) ADD_FAILURE() << f.describe();
+    EXPECT_NEAR(std::abs(bench.axis("x").position_mm() - 100.0), 80.0, 1e-9);
+}
+
+// The other side: a firmware that moves and then says nothing is timed
+// out the line timeout after its last step. dda_line's "G1 X25 Q": 25 mm at
+// 250 steps/mm = 6250 steps, one every 400 us and a little (its step() and
+// the loop): the last after 2.5 s; no answer. The timeout comes 2 s (the
+// generic family's) after that last step - not at 2 s, while it was still
+// stepping.
+TEST(JobDone, ALineIsTimedOutTheLineTimeoutAfterTheLastStep) {
+    const auto dir = test::scratch_dir("verdict-silent-after-move");
+    const auto board = dir / "generic.yaml";
+    std::ofstream(board) << "board: cnc-shield-generic\n"
+                            "extends: arduino-uno-cnc-shield-v3\n"
+                            "parts:\n"
+                            "  host: {type: serial_host, flow: send_and_wait, family: generic}\n";
+    Bench bench(board.string(), test::firmware("dda_line"));
+    bench.host().add_lines("G1 X25 Y0 Q\n");
+    bench.run_until_idle(10.0);
+    ASSERT_TRUE(bench.host().failed());
+    const HostEvent* timeout = nullptr;
+    for (const HostEvent& e : bench.host().events()) {
+        if (e.kind == HostEventKind::Timeout) timeout = &e;
+    }
+    ASSERT_NE(timeout, nullptr) << bench.host().tail(6);
+    const double at_s = static_cast<double>(timeout->cycle) / 16e6;
+    EXPECT_GE(bench.last_step_seconds(), 2.5);  // 6250 x 400 us, plus the loop's own cycles
+    EXPECT_NEAR(at_s - bench.last_step_seconds(), 2.0, 1e-6) << timeout->message;
+    EXPECT_NEAR(bench.axis("x").position_mm(), 125.0, 1e-9);
+}
+
 TEST(JobDone, TheCliEndsAJobPastItsLimitAsATimeoutSayingWhatWasGoing) {
     // Exit 3 (docs/CLI.md) and the heater named on stderr and in the summary.
     const auto dir = test::scratch_dir("verdict-job-done");
