@@ -238,7 +238,11 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
             }
         }
     }
-    if (detail.empty() && host != nullptr && g_config.hang_at_bound && !settling && !mcu.halted() &&
+    // Not a hang: a machine that stepped within the line timeout is at work
+    // on the line (an input that asks for more than the bound's time).
+    const bool stepping = bench.last_step_seconds() >= 0 && host != nullptr &&
+                          bench.now_seconds() - bench.last_step_seconds() < host->line_timeout_s();
+    if (detail.empty() && host != nullptr && g_config.hang_at_bound && !settling && !mcu.halted() && !stepping &&
         host->outstanding_lines() > 0 && host->lines_acknowledged() < host->lines().size()) {
         // The oldest line still waiting when the input's simulated time ran out.
         const GcodeLine& line = host->lines()[host->lines_acknowledged()];
