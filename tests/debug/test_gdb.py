@@ -183,6 +183,28 @@ class GdbTests(unittest.TestCase):
         self.assertEqual(times[2], times[0], out)
         self.assertGreater(times[3], times[2] + 1, out)
 
+    def test_inside_an_isr_the_interrupted_code_is_found_as_documented(self):
+        """docs/DEBUGGING.md, "A backtrace inside an interrupt handler": avr-gdb's
+        bt stops at the handler (its prologue analysis reads past RAMEND, which
+        the server refuses), and the return address is at $sp+5, high byte
+        first, under the 4 bytes blink_timer1's handler saved (r1, r0, SREG,
+        r24: its prologue in avr-objdump) - ATmega328P section 7.7. It is
+        main's idle loop, the `rjmp .-2` the compare match interrupts."""
+        target = elf("blink_timer1")
+        prologue = [m for _, m, _ in disassembly_of(target, "__vector_11")][:6]
+        self.assertEqual(prologue, ["push", "push", "in", "push", "eor", "push"])
+        idle_loop = [a for a, m, o in disassembly_of(target, "main") if m == "rjmp" and o.startswith(".-2")]
+        self.assertEqual(len(idle_loop), 1)
+        s = Session([target, "--for", "10ms"])
+        out = gdb(s.port(), target, ["break __vector_11", "continue", "bt", "x/2xb $sp+5", "kill"])
+        s.finish()
+        self.assertIn("#0  __vector_11 ()", out)
+        self.assertRegex(out, r"Backtrace stopped: Cannot access memory at address 0x8009[0-9a-f]{2}")
+        m = re.search(r"^0x8008[0-9a-f]{2}:\s+0x([0-9a-f]{2})\s+0x([0-9a-f]{2})$", out, re.M)
+        self.assertTrue(m, out)
+        return_word = int(m.group(1), 16) << 8 | int(m.group(2), 16)
+        self.assertEqual(return_word * 2, idle_loop[0], out)
+
     def test_reverse_stepi_100_then_stepi_100_returns_to_the_identical_state(self):
         target = elf("gdb_target")
         s = Session([target, "--for", "10ms"])
