@@ -76,6 +76,22 @@ TEST(Fuzz, FindsTheThesisParsersPlantedBugs) {
     EXPECT_GT(last, first) << "coverage must grow over the run\n" << out;
     EXPECT_NE(out.find("findings/finding-1.txt, " + (dir / "out/findings/finding-1.vcd").string()), std::string::npos) << out;
     EXPECT_TRUE(std::filesystem::exists(dir / "out/findings/finding-1.vcd"));
+    // Each root cause says when the engine first found it: within the fuzzing's own time.
+    double fuzzing_s = -1;
+    unsigned long executions = 0;
+    if (const auto at = out.find("  executions "); at != std::string::npos) {
+        std::sscanf(out.c_str() + at, "  executions %lu in %lf s", &executions, &fuzzing_s);
+    }
+    ASSERT_GT(fuzzing_s, 0) << out;
+    std::size_t told = 0;
+    for (auto at = out.find("; first found "); at != std::string::npos; at = out.find("; first found ", at + 1)) {
+        double first_s = -1;
+        ASSERT_EQ(std::sscanf(out.c_str() + at, "; first found %lf s into the fuzzing)", &first_s), 1) << out;
+        EXPECT_GE(first_s, 0.0) << out;
+        EXPECT_LE(first_s, fuzzing_s + 1.0) << out;  // a file time's and a clock's resolution
+        ++told;
+    }
+    EXPECT_GE(told, 2u) << out;  // the timeout and the crash
 }
 
 TEST(Fuzz, FindsNothingInTheImprovedInterpolator) {

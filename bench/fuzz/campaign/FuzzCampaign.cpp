@@ -71,6 +71,9 @@ struct FindingsRun {
     // with --runs, where the replays' count bounds it.
     std::optional<std::chrono::steady_clock::time_point> deadline;
     fs::path hits;  // the target's count of inputs per root cause ("": none)
+    // When the engine started, on the clock of file times: a reproducer's
+    // write time less this is when the engine found it.
+    fs::file_time_type engine_started;
 };
 
 // The target's <seen>.hits: one line per input that hit a root cause.
@@ -144,8 +147,18 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
         run_logged(run, {}, base + ".txt");
         const auto hit = hits.find(cause);
         const std::size_t inputs = hit != hits.end() ? hit->second : files.size();
-        std::printf("    %d. %s (%zu input%s hit it)\n       e.g. %s\n       %s: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
-                    index, cause.c_str(), inputs, inputs == 1 ? "" : "s", example[cause].c_str(),
+        // The first reproducer the engine wrote for this root cause.
+        fs::file_time_type first = fs::file_time_type::max();
+        for (const auto& f : files) {
+            std::error_code ec;
+            const auto t = fs::last_write_time(f, ec);
+            if (!ec) first = std::min(first, t);
+        }
+        const double first_s = first == fs::file_time_type::max()
+                                   ? -1.0
+                                   : std::max(0.0, std::chrono::duration<double>(first - how.engine_started).count());
+        std::printf("    %d. %s (%zu input%s hit it; first found %.1f s into the fuzzing)\n       e.g. %s\n       %s: %zu bytes (from %ju), %s.gcode; its run: %s.txt, %s.vcd\n",
+                    index, cause.c_str(), inputs, inputs == 1 ? "" : "s", first_s, example[cause].c_str(),
                     out_of_time ? "not minimized (the --for budget was spent)" : "minimized", minimal.size(),
                     static_cast<std::uintmax_t>(fs::file_size(shortest)), base.c_str(), base.c_str(), base.c_str());
     }
@@ -248,6 +261,7 @@ int run_fuzz_campaign(const FuzzCampaignOptions& args) {
         std::printf("avrbench fuzz: minimising takes at most %d replays per root cause after the %lu executions\n",
                     kMinimizeReplays, args.runs);
     }
+    const fs::file_time_type engine_started = fs::file_time_type::clock::now();
     Campaign campaign = args.engine == "afl" ? afl_campaign(args, env, out, corpus, engine_s, bound_s, family)
                                              : libfuzzer_campaign(args, env, out, corpus, findings, engine_s, family);
     const double campaign_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -263,7 +277,7 @@ int run_fuzz_campaign(const FuzzCampaignOptions& args) {
     }
 
     const fs::path hits = args.engine == "afl" ? fs::path() : out / "seen-findings.txt.hits";
-    return report_findings(campaign, env, FindingsRun{args, run_firmware, family, findings, bound_s, deadline, hits});
+    return report_findings(campaign, env, FindingsRun{args, run_firmware, family, findings, bound_s, deadline, hits, engine_started});
 }
 
 }  // namespace avrbench
