@@ -325,7 +325,10 @@ std::string board_from_config(const MachineConfig& config, const BoardFromConfig
     }
     if (!oracle.empty() && !grbl) {
         PartOut& o = w.part(oracle);
-        if (config.homing_not_judged) o.comments.push_back("no home: " + *config.homing_not_judged + ", so G28 ends the judging");
+        if (config.homing_not_judged) {
+            o.comments.push_back("no home: " + *config.homing_not_judged + ", so G28 ends the judging");
+            o.set("no_home_because", *config.homing_not_judged);
+        }
         if (config.soft_min && config.soft_min->value) o.comments.push_back("software endstops: " + config.soft_min->source);
         if (config.soft_max && config.soft_max->value && (!config.soft_min || config.soft_max->source != config.soft_min->source)) {
             o.comments.push_back("software endstops: " + config.soft_max->source);

@@ -90,6 +90,9 @@ std::vector<ParamSpec> MotionOracle::param_specs() {
                          .help = "where " + a + " = 0 is on the carriage after G28 (absent: G28 ends judging)",
                          .min = -10.0, .max = 10.0});
     }
+    specs.push_back({.name = "no_home_because", .type = PT::Text,
+                     .source = "the board (board from-config writes the configuration line)",
+                     .help = "why the board gives no home_x...: said when a G28 ends the judging"});
     return specs;
 }
 
@@ -106,6 +109,7 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
         if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
         start_mm_[k] = params.quantity("start_" + a) * 1e3;
         if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
+        if (params.has("no_home_because")) no_home_because_ = params.text("no_home_because");
         if (params.has("soft_min_" + a)) soft_limits_mm_[k][0] = params.quantity("soft_min_" + a) * 1e3;
         if (params.has("soft_max_" + a)) soft_limits_mm_[k][1] = params.quantity("soft_max_" + a) * 1e3;
         if (soft_limits_mm_[k][0] && soft_limits_mm_[k][1] && !(*soft_limits_mm_[k][0] < *soft_limits_mm_[k][1])) {
@@ -257,7 +261,8 @@ void MotionOracle::commanded(const CommandedMove& move) {
             origin_mm_[k] = home_mm_[k];
             if (!origin_mm_[k]) {
                 return lose(move.line + " homes " + kAxisLetters[k] + " and the board gives no home_" +
-                                static_cast<char>(kAxisLetters[k] - 'A' + 'a'),
+                                static_cast<char>(kAxisLetters[k] - 'A' + 'a') +
+                                (no_home_because_.empty() ? std::string() : " (" + no_home_because_ + ")"),
                             true);
             }
             // Where a switch trips is not a step-exact place.

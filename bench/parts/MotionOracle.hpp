@@ -177,6 +177,7 @@ private:
     Cycle rest_cycles_;
     std::array<std::optional<double>, 3> origin_given_mm_{};
     std::array<std::optional<double>, 3> home_mm_{};
+    std::string no_home_because_;  // the board's reason for giving no home
     std::array<std::optional<double>, 3> origin_mm_{};  // the firmware's zero on each carriage
     // A homed axis whose zero is taken where homing left it: a firmware
     // stops a step or two past the switch (Marlin 1.0 wants two readings in

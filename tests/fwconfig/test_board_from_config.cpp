@@ -150,6 +150,11 @@ TEST(BoardFromConfig, RepetierEnablesActiveHighAndSwitchesAtBothEnds) {
     EXPECT_EQ(text.find("home_x:"), std::string::npos) << text;
     EXPECT_NE(text.find("no home: repetier.h:22: ENDSTOP_X_BACK_ON_HOME 1: Repetier moves back after homing"), std::string::npos)
         << text;
+    // And the oracle says so when a G28 ends its judging.
+    EXPECT_NE(text.find("motion: {type: motion_oracle, no_home_because: \"repetier.h:22: ENDSTOP_X_BACK_ON_HOME 1: Repetier moves "
+                        "back after homing and its 0 is not at the switch\""),
+              std::string::npos)
+        << text;
     load_generated(text, "repetier");
 }
 
