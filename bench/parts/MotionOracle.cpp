@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/Errors.hpp"
+#include "core/InputFile.hpp"
 
 namespace avrbench {
 
@@ -109,7 +110,7 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
         if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
         start_mm_[k] = params.quantity("start_" + a) * 1e3;
         if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
-        if (params.has("no_home_because")) no_home_because_ = params.text("no_home_because");
+        if (params.has("no_home_because")) no_home_because_ = hex_escaped(params.text("no_home_because"));  // text for a terminal
         if (params.has("soft_min_" + a)) soft_limits_mm_[k][0] = params.quantity("soft_min_" + a) * 1e3;
         if (params.has("soft_max_" + a)) soft_limits_mm_[k][1] = params.quantity("soft_max_" + a) * 1e3;
         if (soft_limits_mm_[k][0] && soft_limits_mm_[k][1] && !(*soft_limits_mm_[k][0] < *soft_limits_mm_[k][1])) {

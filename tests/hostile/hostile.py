@@ -252,6 +252,16 @@ def cases(fw):
                         says="port 'axis' is not connected" if label == "long" else "is not a valid part name"))
         out.append(Case(f"name-description-{label}", run_board, expect=0,
                         files={"board.yaml": board_with(description=name if label not in ("empty",) else "''")}))
+    # A board's text that the summary prints (the oracle's reason for giving
+    # no home, said when dda_line's G28 ends the judging): escaped, never an
+    # escape sequence on the terminal (the runner checks).
+    out.append(Case("text-no-home-because-ansi",
+                    ["run", fw["dda_line"], "--board", "{w}/board.yaml", "--gcode", "{w}/job.gcode", "--for", "5s"], expect=0,
+                    files={"board.yaml": "board: t\nextends: arduino-uno-cnc-shield-v3\nparts:\n"
+                                         "  host: {type: serial_host, flow: send_and_wait, family: generic}\n"
+                                         "  motion: {type: motion_oracle, no_home_because: \"a\\e[2Jb\\nc\"}\n",
+                           "job.gcode": "G28\n"},
+                    stdout_has="(a\\x1b[2Jb\\x0ac)"))
     for label, value in (("newline", "1\nms"), ("ansi", "1\x1b[2Jms"), ("nul-like", "1ms\x7f")):
         out.append(Case(f"cli-for-{label}", ["run", blink, "--for", value, "-q"], says="--for: unknown unit"))
         out.append(Case(f"cli-mcu-{label}", ["run", blink, "--mcu", value, "-q"], says="unknown MCU"))
@@ -737,7 +747,7 @@ def main():
     ARGS.firmware_dir = os.path.abspath(ARGS.firmware_dir)
     ARGS.source = os.path.abspath(ARGS.source)
     fw = {}
-    for name in ("blink_timer1", "uart_echo", "cnc2axis"):
+    for name in ("blink_timer1", "uart_echo", "cnc2axis", "dda_line"):
         path = os.path.join(ARGS.firmware_dir, name + ".elf")
         # A missing ELF is a broken build, not a case to leave out quietly.
         if not os.path.exists(path):
