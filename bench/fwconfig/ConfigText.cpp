@@ -209,7 +209,18 @@ private:
         }
         return a;
     }
+    // Parentheses and unary operators nest at most this deep: the C standard
+    // asks a preprocessor for 63 levels (C11 5.2.4.1); a file with thousands
+    // would otherwise run the recursion off the stack.
+    static constexpr int kMaxNesting = 256;
+    struct Nest {
+        int& level;
+        explicit Nest(int& l) : level(++l) {}
+        ~Nest() { --level; }
+    };
     std::optional<double> unary() {
+        const Nest nest(nesting_);
+        if (nesting_ > kMaxNesting) return std::nullopt;
         if (eat("!")) {
             auto a = unary();
             if (!a) return std::nullopt;
@@ -257,7 +268,8 @@ private:
                 const ConfigEntry* e = config_.entry(n);
                 if (e == nullptr) return false;
                 if (trim(e->value).empty()) return true;
-                const auto v = config_.evaluate(e->value);
+                if (depth_ > 16) return false;  // defined through itself
+                const auto v = Expression(e->value, config_, depth_ + 1).value();
                 return v && *v != 0;
             };
             bool any = false, all = true;
@@ -280,6 +292,7 @@ private:
     const ConfigText& config_;
     int depth_;
     std::size_t pos_ = 0;
+    int nesting_ = 0;
 };
 
 }  // namespace
@@ -389,7 +402,12 @@ std::optional<std::vector<double>> ConfigText::numbers(const std::string& name) 
 std::string ConfigText::cite(const std::string& name) const {
     const ConfigEntry* e = entry(name);
     if (e == nullptr) return name + " (not defined)";
-    return e->where + ": " + name + (e->value.empty() ? "" : " " + e->value);
+    // A value is quoted whole up to a line's worth; longer, its start and its length.
+    constexpr std::size_t kQuoted = 120;
+    const std::string value = e->value.size() <= kQuoted
+                                  ? e->value
+                                  : e->value.substr(0, kQuoted) + "... (" + std::to_string(e->value.size()) + " characters)";
+    return e->where + ": " + name + (value.empty() ? "" : " " + value);
 }
 
 }  // namespace avrbench

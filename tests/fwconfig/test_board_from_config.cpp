@@ -63,6 +63,23 @@ TEST(ConfigText, ConditionsMacrosAndCommentsAsThePreprocessorSeesThem) {
     EXPECT_EQ(c.evaluate("UNDEFINED_NAME + 1"), 1.0);  // the preprocessor's 0
 }
 
+// What a hostile or broken configuration does: no crash, no hang, a value
+// it cannot read is "not a number". 100 000 nested parentheses (past the C
+// standard's 63 levels, C11 5.2.4.1) overran the stack before; a macro
+// enabled through itself (A is ENABLED(A)) recursed without end.
+TEST(ConfigText, DeepNestingAndSelfReferenceAreNotNumbersAndLongValuesAreCitedShort) {
+    ConfigText c;
+    const std::string deep = std::string(100000, '(') + "1" + std::string(100000, ')');
+    c.add("#define DEEP " + deep + "\n#define SHALLOW " + std::string(60, '(') + "1" + std::string(60, ')') +
+              "\n#define A ENABLED(A)\n#define B B\n",
+          "bad.h");
+    EXPECT_EQ(c.number("DEEP"), std::nullopt);
+    EXPECT_EQ(c.number("SHALLOW"), 1.0);  // what a preprocessor must take
+    EXPECT_NE(c.number("A"), std::nullopt);  // some answer, at once
+    EXPECT_EQ(c.number("B"), std::nullopt);
+    EXPECT_EQ(c.cite("DEEP"), "bad.h:1: DEEP " + std::string(120, '(') + "... (200001 characters)");
+}
+
 TEST(BoardFromConfig, MarlinSettingsBecomeTheRampsPartsWithTheirLines) {
     const std::string text = generate({fixture("marlin_ramps.h")});
     EXPECT_TRUE(has_line(text, "extends: ramps-1.4")) << text;

@@ -252,6 +252,18 @@ def cases(fw):
                         says="port 'axis' is not connected" if label == "long" else "is not a valid part name"))
         out.append(Case(f"name-description-{label}", run_board, expect=0,
                         files={"board.yaml": board_with(description=name if label not in ("empty",) else "''")}))
+    # Firmware configurations for `board from-config`: nesting past any
+    # preprocessor's, a macro through itself, a 100 000-deep #if with no
+    # #endif, NULs; read without a crash or a hang.
+    deep = "(" * 100000 + "1" + ")" * 100000
+    for label, text, expect, says in (
+            ("deep-parens", f"#define MOTHERBOARD 33\n#define DEFAULT_AXIS_STEPS_PER_UNIT {{{deep},80,400,100}}\n", 0, ""),
+            ("self-enabled", "#define MOTHERBOARD 33\n#define A ENABLED(A)\n#if ENABLED(A)\n#define DEFAULT_AXIS_STEPS_PER_UNIT {1,2,3,4}\n#endif\n",
+             0, ""),
+            ("unclosed-ifs", "#define MOTHERBOARD 33\n" + "#if 1\n" * 100000 + "#define DEFAULT_AXIS_STEPS_PER_UNIT {1,2,3,4}\n", 0, ""),
+            ("nul-bytes", "#define MOTHERBOARD 33\n#define DEFAULT_AXIS_STEPS_PER_UNIT {1\x00,2,3,4}\n\x00\x00", 0, "")):
+        out.append(Case(f"fwconfig-{label}", ["board", "from-config", "{w}/Configuration.h", "-o", "{w}/out.yaml"], expect=expect,
+                        files={"Configuration.h": text}, says=says))
     # A board's text that the summary prints (the oracle's reason for giving
     # no home, said when dda_line's G28 ends the judging): escaped, never an
     # escape sequence on the terminal (the runner checks).
