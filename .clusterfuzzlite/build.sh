@@ -5,7 +5,7 @@
 # ci/fuzz runs this same script with Debian's clang to keep it working.
 #
 # Fuzzers left in $OUT:
-#   fuzz_elf, fuzz_board, fuzz_scenario, fuzz_golden, fuzz_vcd  the bench's parsers
+#   fuzz_elf, fuzz_board, fuzz_scenario, fuzz_golden, fuzz_vcd, fuzz_fwconfig  the bench's parsers
 #   fuzz_firmware_<name>  a firmware of this repository on its board: G-code
 #     into its serial port (bench/fuzz/FirmwareTarget.hpp), configured by
 #     fuzz_firmware_<name>.avrbench beside it; the ELF and boards under
@@ -29,8 +29,8 @@ cmake -S . -B "$work/build" -DAVRBENCH_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
   -DCMAKE_C_COMPILER="$CC" -DCMAKE_CXX_COMPILER="$CXX" \
   -DAVRBENCH_LIB_FUZZING_ENGINE="$LIB_FUZZING_ENGINE" > "$work/build.log"
 cmake --build "$work/build" -j"$(nproc)" \
-  --target fuzz_elf fuzz_board fuzz_scenario fuzz_golden fuzz_vcd fuzz_firmware >> "$work/build.log"
-for parser in elf board scenario golden vcd; do
+  --target fuzz_elf fuzz_board fuzz_scenario fuzz_golden fuzz_vcd fuzz_fwconfig fuzz_firmware >> "$work/build.log"
+for parser in elf board scenario golden vcd fwconfig; do
   cp "$work/build/fuzz/fuzz_$parser" "$OUT/"
 done
 
