@@ -776,8 +776,10 @@ std::string MotionOracle::summary() {
     std::string text = line;
     if (lost_) {
         text += "; stopped judging: " + lost_why_;
+    } else if (commands_ == 0 && job_answered_) {
+        // Nothing to judge is not "all clean": say why the oracle saw no move.
+        text += "; the job commanded no move";
     } else if (commands_ == 0) {
-        // Nothing to judge is not "all clean": say why the oracle saw no G-code.
         text += "; nothing was commanded through the bench (no G-code job; a host on --pty, such as klippy with "
                 "Klipper's binary protocol, talks to the firmware itself)";
     }

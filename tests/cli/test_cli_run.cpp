@@ -126,6 +126,24 @@ TEST(CliRun, AFatalMessageEndsTheJobWithExitCode1) {
     EXPECT_NE(r.out.find("1 of 3 lines acknowledged"), std::string::npos) << r.out;
 }
 
+// The motion oracle's summary says why it judged nothing: a job without a
+// move, or no job at all (dda_line answers "ok" to any line that is not a G1).
+TEST(CliRun, TheOracleSaysWhyItJudgedNothing) {
+    const auto dir = test::scratch_dir("cli-oracle-nothing");
+    std::ofstream(dir / "board.yaml") << "board: t\nextends: arduino-uno-cnc-shield-v3\nparts:\n"
+                                         "  host: {type: serial_host, flow: send_and_wait, family: generic}\n";
+    std::ofstream(dir / "job.gcode") << "M105\nM114\n";
+    const std::string run = kCli + " run " + quoted(test::firmware("dda_line")) + " --board " + quoted((dir / "board.yaml").string());
+    const auto with_job = test::run_command(run + " --gcode " + quoted((dir / "job.gcode").string()) + " --for 5s", dir);
+    EXPECT_EQ(with_job.exit_code, 0) << with_job.out << with_job.err;
+    EXPECT_NE(with_job.out.find("motion: 0 moves judged, 0 findings; the job commanded no move\n"), std::string::npos) << with_job.out;
+    const auto without = test::run_command(run + " --for 10ms", dir);
+    EXPECT_EQ(without.exit_code, 0) << without.out << without.err;
+    EXPECT_NE(without.out.find("motion: 0 moves judged, 0 findings; nothing was commanded through the bench (no G-code job;"),
+              std::string::npos)
+        << without.out;
+}
+
 TEST(CliRun, UartInAndOut) {
     const auto dir = test::scratch_dir("cli-uart");
     const auto out = dir / "out.txt";
