@@ -269,7 +269,7 @@ private:
                 if (e == nullptr) return false;
                 if (trim(e->value).empty()) return true;
                 if (depth_ > 16) return false;  // defined through itself
-                const auto v = Expression(e->value, config_, depth_ + 1).value();
+                const auto v = config_.macro_value(n, depth_ + 1);
                 return v && *v != 0;
             };
             bool any = false, all = true;
@@ -285,7 +285,7 @@ private:
         const ConfigEntry* e = config_.entry(name);
         if (e == nullptr) return 0.0;  // the preprocessor's rule for an unknown name
         if (trim(e->value).empty()) return 1.0;
-        return Expression(e->value, config_, depth_ + 1).value();
+        return config_.macro_value(name, depth_ + 1);
     }
 
     const std::string& s_;
@@ -345,12 +345,17 @@ void ConfigText::add(const std::string& text, const std::string& file) {
             } else if (word == "define" && active() && RE2::FullMatch(line, define, &name, &paren, &value)) {
                 if (!paren.empty()) continue;  // a function-like macro: no setting
                 entries_[name] = {name, squeezed(value), where};
+                forget_values();
             } else if (word == "undef" && active()) {
                 entries_.erase(trim(rest));
+                forget_values();
             }
             continue;
         }
-        if (active() && RE2::FullMatch(line, declaration, &name, &value)) entries_[name] = {name, squeezed(value), where};
+        if (active() && RE2::FullMatch(line, declaration, &name, &value)) {
+            entries_[name] = {name, squeezed(value), where};
+            forget_values();
+        }
     }
 }
 
@@ -361,6 +366,18 @@ const ConfigEntry* ConfigText::entry(const std::string& name) const {
 
 std::optional<double> ConfigText::evaluate(const std::string& expression) const {
     return Expression(expression, *this, 0).value();
+}
+
+std::optional<double> ConfigText::macro_value(const std::string& name, int depth) const {
+    if (const auto known = values_.find(name); known != values_.end()) return known->second;
+    const ConfigEntry* e = entry(name);
+    if (e == nullptr || evaluating_.count(name) != 0) return std::nullopt;
+    evaluating_.insert(name);
+    const std::optional<double> v = Expression(e->value, *this, depth).value();
+    evaluating_.erase(name);
+    // Only values: a failure may be the depth's, not the macro's.
+    if (v) values_[name] = *v;
+    return v;
 }
 
 std::optional<double> ConfigText::number(const std::string& name) const {

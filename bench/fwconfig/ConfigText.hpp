@@ -11,6 +11,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,9 +41,17 @@ public:
     // Evaluates an expression as the preprocessor would (0 for unknown names);
     // empty when it cannot be read (a string, a cast it does not know).
     std::optional<double> evaluate(const std::string& expression) const;
+    // A macro's value as a number, `depth` macros deep (the evaluator's):
+    // each macro evaluated once while the definitions stand (a macro used
+    // twice by each of the next, 200 deep, is 200 evaluations, not 2^200),
+    // none through itself.
+    std::optional<double> macro_value(const std::string& name, int depth) const;
 
 private:
+    void forget_values() const { values_.clear(); }
     std::map<std::string, ConfigEntry> entries_;
+    mutable std::map<std::string, double> values_;  // macros evaluated since the last #define or #undef
+    mutable std::set<std::string> evaluating_;
 };
 
 }  // namespace avrbench

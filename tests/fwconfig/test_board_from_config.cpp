@@ -78,6 +78,15 @@ TEST(ConfigText, DeepNestingAndSelfReferenceAreNotNumbersAndLongValuesAreCitedSh
     EXPECT_NE(c.number("A"), std::nullopt);  // some answer, at once
     EXPECT_EQ(c.number("B"), std::nullopt);
     EXPECT_EQ(c.cite("DEEP"), "bad.h:1: DEEP " + std::string(120, '(') + "... (200001 characters)");
+    // Each macro used twice by the next: X15 = 2^15, each X evaluated once
+    // (the fuzzer's inputs of this shape took 27 times longer before); two
+    // macros through each other are not numbers.
+    ConfigText d;
+    std::string chain = "#define X0 1\n";
+    for (int k = 1; k <= 15; ++k) chain += "#define X" + std::to_string(k) + " (X" + std::to_string(k - 1) + " + X" + std::to_string(k - 1) + ")\n";
+    d.add(chain + "#define P (Q + 1)\n#define Q (P + 1)\n", "chain.h");
+    EXPECT_EQ(d.number("X15"), 32768.0);
+    EXPECT_EQ(d.number("P"), std::nullopt);
 }
 
 TEST(BoardFromConfig, MarlinSettingsBecomeTheRampsPartsWithTheirLines) {
