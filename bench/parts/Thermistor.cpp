@@ -102,7 +102,9 @@ const std::map<std::string, std::map<std::string, std::string>>& Thermistor::pre
 }
 
 Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params)
-    : Part(std::move(name), clock), rng_(static_cast<std::uint64_t>(params.integer("seed"))) {
+    : Part(std::move(name), clock),
+      rng_(static_cast<std::uint64_t>(params.integer("seed"))),
+      trace_(clock, params.quantity("sample_interval"), "part '" + this->name() + "': ") {
     const std::string where = "part '" + this->name() + "': ";
     if (!params.has("t1") || !params.has("r1")) throw BadInput(where + "a custom thermistor needs t1 and r1");
     if (params.has("beta")) {
@@ -126,9 +128,6 @@ Thermistor::Thermistor(std::string name, Mcu& clock, const ParamValues& params)
         throw BadInput(where + "pullup and reference must be positive, noise not negative");
     }
 
-    const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput(where + "sample_interval must be positive");
-    publish_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     require_port<ThermalBody>("body", true, "the thermal_plant whose sensor node it is",
                               [this](ThermalBody& body) { connect_body(body); });
     provide_analog("out", [this](Cycle c) { return sample(c); }, "the divider's output, for an ADC pin");
@@ -170,9 +169,7 @@ double Thermistor::sample(Cycle cycle) {
     plant_->sensor_read(cycle);
     double v = volts_now();
     if (noise_v_ > 0) v = std::clamp(v + noise_v_ * gaussian(), 0.0, reference_v_);
-    if (!published_once_ || cycle - last_publish_ >= publish_cycles_) {
-        published_once_ = true;
-        last_publish_ = cycle;
+    if (trace_.due(cycle)) {
         publish(sig_temperature_, plant_->sensor_degC());
         publish(sig_volts_, v);
     }

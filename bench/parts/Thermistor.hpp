@@ -23,6 +23,7 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/TraceThrottle.hpp"
 
 namespace avrbench {
 
@@ -76,9 +77,7 @@ private:
     std::mt19937_64 rng_;
     Fault fault_state_ = Fault::None;
     std::uint64_t samples_ = 0;
-    Cycle publish_cycles_;
-    Cycle last_publish_ = 0;
-    bool published_once_ = false;
+    TraceThrottle trace_;
     std::size_t sig_temperature_ = 0, sig_volts_ = 0;
 };
 

@@ -36,15 +36,12 @@ const std::map<std::string, std::map<std::string, std::string>>& ThermocoupleAmp
 }
 
 ThermocoupleAmplifier::ThermocoupleAmplifier(std::string name, Mcu& clock, const ParamValues& params)
-    : Part(std::move(name), clock) {
+    : Part(std::move(name), clock), trace_(clock, params.quantity("sample_interval"), "part '" + this->name() + "': ") {
     const std::string where = "part '" + this->name() + "': ";
     if (!params.has("gain_mV_per_degC")) throw BadInput(where + "a custom thermocouple_amplifier needs gain_mV_per_degC");
     volts_per_degC_ = params.quantity("gain_mV_per_degC") / 1000.0;
     supply_v_ = params.quantity("supply");
     if (!(supply_v_ > 0)) throw BadInput(where + "supply must be positive");
-    const double interval = params.quantity("sample_interval");
-    if (!(interval > 0)) throw BadInput(where + "sample_interval must be positive");
-    publish_cycles_ = std::max<Cycle>(1, clock.cycles_from_seconds(interval));
     require_port<ThermalBody>("body", true, "the thermal_plant whose sensor node the junction is on",
                               [this](ThermalBody& body) { connect_body(body); });
     provide_analog("out", [this](Cycle c) { return sample(c); }, "the amplifier's output, for an ADC pin");
@@ -65,9 +62,7 @@ double ThermocoupleAmplifier::sample(Cycle cycle) {
     ++samples_;
     plant_->sensor_read(cycle);
     const double v = open_ ? supply_v_ : output_volts(plant_->sensor_degC());
-    if (!published_once_ || cycle - last_publish_ >= publish_cycles_) {
-        published_once_ = true;
-        last_publish_ = cycle;
+    if (trace_.due(cycle)) {
         publish(sig_temperature_, plant_->sensor_degC());
         publish(sig_volts_, v);
     }

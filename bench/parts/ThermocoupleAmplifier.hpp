@@ -19,6 +19,7 @@
 
 #include "parts/Params.hpp"
 #include "parts/Part.hpp"
+#include "parts/TraceThrottle.hpp"
 
 namespace avrbench {
 
@@ -49,9 +50,7 @@ private:
     double volts_per_degC_, supply_v_;
     bool open_ = false;
     std::uint64_t samples_ = 0;
-    Cycle publish_cycles_;
-    Cycle last_publish_ = 0;
-    bool published_once_ = false;
+    TraceThrottle trace_;
     std::size_t sig_temperature_ = 0, sig_volts_ = 0;
 };
 
