@@ -8,6 +8,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "core/Errors.hpp"
+
 namespace avrbench {
 
 namespace {
@@ -325,6 +327,12 @@ void ConfigText::add(const std::string& text, const std::string& file) {
                     } else {
                         on = defined(trim(rest.substr(0, rest.find_first_of(" \t")))) == (word == "ifdef");
                     }
+                }
+                // A preprocessor must take 63 levels (C11 5.2.4.1); a file of
+                // thousands is not a configuration.
+                constexpr std::size_t kMaxConditionalNesting = 256;
+                if (levels.size() >= kMaxConditionalNesting) {
+                    throw BadInput(where + ": #" + word + " nested more than " + std::to_string(kMaxConditionalNesting) + " deep");
                 }
                 levels.push_back({active(), on, on});
             } else if (word == "elif" && !levels.empty()) {

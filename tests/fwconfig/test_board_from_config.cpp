@@ -87,6 +87,21 @@ TEST(ConfigText, DeepNestingAndSelfReferenceAreNotNumbersAndLongValuesAreCitedSh
     d.add(chain + "#define P (Q + 1)\n#define Q (P + 1)\n", "chain.h");
     EXPECT_EQ(d.number("X15"), 32768.0);
     EXPECT_EQ(d.number("P"), std::nullopt);
+    // 256 nested #ifs are read (C11 asks for 63), the 257th is an error with its line.
+    ConfigText e;
+    std::string nested;
+    for (int k = 0; k < 256; ++k) nested += "#if 1\n";
+    nested += "#define INSIDE 7\n";
+    for (int k = 0; k < 256; ++k) nested += "#endif\n";
+    e.add(nested, "ok.h");
+    EXPECT_EQ(e.number("INSIDE"), 7.0);
+    try {
+        ConfigText f;
+        f.add("#if 1\n" + nested, "deep.h");
+        ADD_FAILURE() << "no error";
+    } catch (const BadInput& err) {
+        EXPECT_EQ(std::string(err.what()), "deep.h:257: #if nested more than 256 deep");
+    }
 }
 
 TEST(BoardFromConfig, MarlinSettingsBecomeTheRampsPartsWithTheirLines) {

@@ -260,7 +260,8 @@ def cases(fw):
             ("deep-parens", f"#define MOTHERBOARD 33\n#define DEFAULT_AXIS_STEPS_PER_UNIT {{{deep},80,400,100}}\n", 0, ""),
             ("self-enabled", "#define MOTHERBOARD 33\n#define A ENABLED(A)\n#if ENABLED(A)\n#define DEFAULT_AXIS_STEPS_PER_UNIT {1,2,3,4}\n#endif\n",
              0, ""),
-            ("unclosed-ifs", "#define MOTHERBOARD 33\n" + "#if 1\n" * 100000 + "#define DEFAULT_AXIS_STEPS_PER_UNIT {1,2,3,4}\n", 0, ""),
+            ("unclosed-ifs", "#define MOTHERBOARD 33\n" + "#if 1\n" * 100000 + "#define DEFAULT_AXIS_STEPS_PER_UNIT {1,2,3,4}\n", 2,
+             "Configuration.h:258: #if nested more than 256 deep"),
             ("nul-bytes", "#define MOTHERBOARD 33\n#define DEFAULT_AXIS_STEPS_PER_UNIT {1\x00,2,3,4}\n\x00\x00", 0, "")):
         out.append(Case(f"fwconfig-{label}", ["board", "from-config", "{w}/Configuration.h", "-o", "{w}/out.yaml"], expect=expect,
                         files={"Configuration.h": text}, says=says))
