@@ -98,6 +98,11 @@ MachineConfig read_marlin(const std::vector<ConfigFile>& files) {
     const bool prusa = c.defined("PRINTER_TYPE") || c.defined("TMC2130_SG_THRS_X");
     out.firmware = sprinter ? "Sprinter" : prusa ? "Prusa-Firmware" : "Marlin";
     note_base(out, c, "MOTHERBOARD");
+    // The RepRapDiscount Smart Controller on RAMPS (Marlin 1.1/2.x pins_RAMPS.h, NEWPANEL): the board with its LCD, knob and SD slot.
+    if (out.base_board && out.base_board->value == "ramps-1.4" && c.defined("REPRAP_DISCOUNT_SMART_CONTROLLER")) {
+        out.base_board = Sourced<std::string>{"ramps-1.4-smart-controller",
+                                              out.base_board->source + "; " + c.cite("REPRAP_DISCOUNT_SMART_CONTROLLER")};
+    }
     const std::string steps_name = sprinter ? "_AXIS_STEP_PER_UNIT" : "DEFAULT_AXIS_STEPS_PER_UNIT";
     const auto steps = c.numbers(steps_name);
     if (!steps && c.defined(steps_name)) out.not_mapped.push_back(c.cite(steps_name) + ": not a list of numbers");

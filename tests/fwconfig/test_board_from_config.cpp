@@ -259,6 +259,19 @@ TEST(BoardFromConfig, WithoutABoardItSaysWhichSettingAndAsksForBase) {
     EXPECT_THROW(detect_config_format({{"notes.txt", "hello\n"}}), BadInput);
 }
 
+TEST(BoardFromConfig, TheSmartControllerOnRampsExtendsTheBoardWithIt) {
+    // Marlin's REPRAP_DISCOUNT_SMART_CONTROLLER on RAMPS: the 20x4 LCD, the knob and the SD slot of pins_RAMPS.h.
+    const std::string text =
+        generate({{"Configuration.h", "#define MOTHERBOARD 33\n#define REPRAP_DISCOUNT_SMART_CONTROLLER\n"
+                                      "#define DEFAULT_AXIS_STEPS_PER_UNIT {80,80,400,100}\n"}});
+    EXPECT_TRUE(has_line(text, "extends: ramps-1.4-smart-controller")) << text;
+    EXPECT_NE(text.find("(Configuration.h:1: MOTHERBOARD 33; Configuration.h:2: REPRAP_DISCOUNT_SMART_CONTROLLER)"), std::string::npos)
+        << text;
+    Board board(load_generated(text, "smart"), {{"mega", test::firmware("ramps_home")}});
+    EXPECT_EQ(board.part("lcd").type(), "hd44780");
+    EXPECT_EQ(board.part("x").type(), "linear_axis");
+}
+
 TEST(BoardFromConfig, AThermocoupleOnAnAd595ReplacesTheThermistor) {
     // Marlin 1.0's Configuration.h: "-1 is thermocouple with AD595" (its stock TEMP_SENSOR_0).
     const std::string text = generate({{"Configuration.h", "#define MOTHERBOARD 33\n#define TEMP_SENSOR_0 -1\n#define DEFAULT_AXIS_STEPS_PER_UNIT {80,80,400,100}\n"}});
