@@ -98,6 +98,7 @@ std::vector<ParamSpec> MotionOracle::param_specs() {
 }
 
 MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& params) : Part(std::move(name), clock) {
+    if (params.has("no_home_because")) no_home_because_ = hex_escaped(params.text("no_home_because"));  // text for a terminal
     path_tolerance_mm_ = params.quantity("path_tolerance") * 1e3;
     if (params.has("end_tolerance")) end_tolerance_mm_ = params.quantity("end_tolerance") * 1e3;
     rapids_straight_ = params.text("rapids") == "straight";
@@ -110,7 +111,6 @@ MotionOracle::MotionOracle(std::string name, Mcu& clock, const ParamValues& para
         if (params.has("origin_" + a)) origin_given_mm_[k] = params.quantity("origin_" + a) * 1e3;
         start_mm_[k] = params.quantity("start_" + a) * 1e3;
         if (params.has("home_" + a)) home_mm_[k] = params.quantity("home_" + a) * 1e3;
-        if (params.has("no_home_because")) no_home_because_ = hex_escaped(params.text("no_home_because"));  // text for a terminal
         if (params.has("soft_min_" + a)) soft_limits_mm_[k][0] = params.quantity("soft_min_" + a) * 1e3;
         if (params.has("soft_max_" + a)) soft_limits_mm_[k][1] = params.quantity("soft_max_" + a) * 1e3;
         if (soft_limits_mm_[k][0] && soft_limits_mm_[k][1] && !(*soft_limits_mm_[k][0] < *soft_limits_mm_[k][1])) {
