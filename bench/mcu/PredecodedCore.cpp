@@ -404,17 +404,31 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // max_steps -, with the rest held back in `reserve` (budget = fuel +
     // reserve). When the fuel is out but not the budget, the batch ends
     // with Ended::Count, perhaps before max_steps, and Mcu::run_until runs
-    // another. So one counter and one test per instruction.
+    // another.
+    // The fuel and the instructions run since the last refuel share one
+    // 64-bit counter, `meter`: (fuel - 1) in the bits from kStepBits up, the
+    // room for instructions left in the bits below, so that an instruction
+    // of c cycles is one subtraction of the constant (c << kStepBits) + 1
+    // and the fuel is out exactly when the meter goes negative (one SUB and
+    // one JS on x86-64, where a separate step count took an ADD and a TEST
+    // more). The fuel is never more than the room (kStepRoom), and every
+    // instruction takes a cycle at least, so the room never borrows from
+    // the fuel.
     // (64-bit: it indexes the slots and flash with no zero-extension first.)
     std::size_t new_pc = avr->pc;
     avr_cycle_count_t cycle_limit = limits.cycle;
-    std::uint32_t steps = 0;
-    std::int64_t fuel;
+    constexpr int kStepBits = 20;
+    constexpr std::int64_t kStepRoom = (std::int64_t{1} << kStepBits) - 1;
+    std::uint32_t steps = 0;  // up to the last refuel
+    std::int64_t meter;
     std::int64_t reserve;
+    const auto fuel_left = [&] { return (meter >> kStepBits) + 1; };
+    const auto bank_steps = [&] { steps += static_cast<std::uint32_t>(kStepRoom - (meter & kStepRoom)); };
     const auto refuel = [&](std::int64_t budget) {
         const std::int64_t steps_left = cold.max_steps - steps;
-        reserve = budget > steps_left ? budget - steps_left : 0;
-        fuel = budget - reserve;
+        const std::int64_t fuel_cap = steps_left < kStepRoom ? steps_left : kStepRoom;
+        reserve = budget > fuel_cap ? budget - fuel_cap : 0;
+        meter = ((budget - reserve - 1) * (std::int64_t{1} << kStepBits)) + kStepRoom;
     };
     refuel(static_cast<std::int64_t>(cycle_limit - avr->cycle));
     const Slot* slot;
@@ -436,15 +450,14 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // in the handlers' checked copy the crash oracles.
 #define AVRBENCH_NEXT()                                                                           \
     do {                                                                                          \
-        ++steps;                                                                                  \
-        fuel -= cycle;                                                                            \
-        if (__builtin_expect(fuel <= 0, 0)) goto out_of_fuel;                                     \
+        meter -= (static_cast<std::int64_t>(cycle) << kStepBits) + 1;                             \
+        if (__builtin_expect(meter < 0, 0)) goto out_of_fuel;                                     \
         if constexpr (AVRBENCH_CHECKED) goto check_oracles;                                       \
         if constexpr (kCover) edges->hit(static_cast<std::uint32_t>(new_pc));                     \
         AVRBENCH_DISPATCH();                                                                      \
     } while (0)
 #define AVRBENCH_NEXT_CALLED() goto after_callbacks
-#define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(fuel + reserve))
+#define AVRBENCH_CYCLE_BEFORE (cycle_limit - static_cast<avr_cycle_count_t>(fuel_left() + reserve))
 #define AVRBENCH_PC slot_pc()
 #define AVRBENCH_HAND_OVER() goto hand_over
     // Every flash write invalidates the slot before the word it writes.
@@ -492,13 +505,14 @@ hand_over:
     avr->pc = slot_pc();
     goto out;
 after_callbacks : {
+    bank_steps();
     ++steps;
     // A callback may move the cycle count itself (fixes/EepromTiming
     // halts the core 4 cycles on a read that way): count on from it.
     const avr_cycle_count_t cycle_now = avr->cycle + static_cast<avr_cycle_count_t>(cycle);
     avr->cycle = cycle_now;
     cycle_limit = cycle_now;
-    fuel = 0;
+    meter = -1;  // no fuel, no instruction since the banking
     reserve = 0;
     // What the fast path checks after avr_run_one: a timer the callbacks
     // made due, a core no longer running, an interrupt on its way.
@@ -512,7 +526,7 @@ after_callbacks : {
     goto check_oracles;
 }
 out_of_fuel:
-    if (fuel + reserve <= 0) goto timer_due;
+    if (fuel_left() + reserve <= 0) goto timer_due;
     // Only the step limit's share is out: this instruction ends the batch.
     if (slot->check == 0) goto advance;
 check_oracles:
@@ -526,7 +540,7 @@ check_oracles:
     }
 advance:
     if constexpr (kCover) edges->hit(static_cast<std::uint32_t>(new_pc));
-    if (fuel <= 0) {
+    if (meter < 0) {  // no fuel left
         batch.ended = Ended::Count;
         avr->pc = static_cast<avr_flashaddr_t>(new_pc);
         goto out;
@@ -546,8 +560,9 @@ out:
 #undef AVRBENCH_NEXT_CALLED
 #undef AVRBENCH_NEXT
 #undef AVRBENCH_DISPATCH
+    bank_steps();
     batch.steps = steps;
-    avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(fuel + reserve);
+    avr->cycle = cycle_limit - static_cast<avr_cycle_count_t>(fuel_left() + reserve);
     return batch;
 }
 #if defined(__GNUC__) && !defined(__clang__)

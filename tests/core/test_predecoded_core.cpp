@@ -347,5 +347,47 @@ TEST(PredecodedCore, BatchStopsWhereTheOraclesLimitsSayEvenWhenTheyChange) {
     EXPECT_EQ(core.handed_to_simavr(), 0u);
 }
 
+// Batches that run millions of instructions (a loop far from any timer):
+// run_batch may end one with Ended::Count before the step limit (its
+// instruction count shares a counter with the cycles, and has room for
+// about a million), and the batches after it go on exactly where it
+// stopped. The NOP, NOP, RJMP loop again: 4 cycles and 3 instructions a
+// pass (ATmega328P instruction set summary), so 4 000 000 cycles are
+// 1 000 000 passes, 3 000 000 instructions, and the last, an RJMP, ends
+// exactly at the cycle limit: that batch ends with Ended::TimerDue.
+TEST(PredecodedCore, LongRunsOfBatchesCountEveryInstructionAndCycle) {
+    const ElfImage elf = ElfImage::load(test::firmware("busy_poll"));
+    Mcu mcu(elf, McuOptions{});
+    avr_t* avr = mcu.avr();
+    const avr_flashaddr_t at = (avr->flashend + 1) - 64;
+    put_word(avr, at, 0x0000);
+    put_word(avr, at + 2, 0x0000);
+    put_word(avr, at + 4, 0xcffd);
+    const std::uint32_t code_end_minus_one = avr->flashend - 1;
+    PredecodedCore core(avr, code_end_minus_one, ~0u);
+    avr->pc = at;
+    const avr_cycle_count_t cycle_before = avr->cycle;
+    const avr_cycle_count_t limit = cycle_before + 4'000'000;
+    std::uint64_t steps = 0;
+    int batches = 0;
+    PredecodedCore::Batch b;
+    do {
+        const PredecodedCore::BatchLimits limits{limit, 10'000'000, code_end_minus_one, ~0u, 0};
+        b = core.run_batch<false>(avr, limits, nullptr);
+        steps += b.steps;
+        ASSERT_LT(++batches, 100);
+        if (b.ended != PredecodedCore::Ended::TimerDue) {
+            ASSERT_EQ(b.ended, PredecodedCore::Ended::Count);
+        }
+    } while (b.ended == PredecodedCore::Ended::Count);
+    EXPECT_EQ(b.ended, PredecodedCore::Ended::TimerDue);
+    EXPECT_GT(batches, 1);  // more instructions than one batch counts
+    EXPECT_EQ(steps, 3'000'000u);
+    EXPECT_EQ(avr->cycle, limit);
+    EXPECT_EQ(avr->pc, at + 4);  // the RJMP, left for Mcu to finish
+    EXPECT_EQ(b.new_pc, at);
+    EXPECT_EQ(core.handed_to_simavr(), 0u);
+}
+
 }  // namespace
 }  // namespace avrbench
