@@ -27,6 +27,16 @@ constexpr std::size_t kMaxWrittenBytes = 64;
 // it again before watching other code (an ISR is typically tens of instructions).
 constexpr unsigned kDelayLoopGraceLooks = 64;
 constexpr std::uint32_t kDelayLoopGraceInterval = 16;
+// After a jump, the event that ended it is most often an interrupt, whose
+// service routine runs deeper on the stack than the loop (the return
+// address and its saved registers): a pass watched there fails at its RETI
+// and doubles the back-off, and the loop is found again only after the
+// watch of up to kMaxPassInstructions on the general step. Until SP is back
+// at the loop's level, look again this often, up to this many times.
+// (grbl_stepper during a move: a step interrupt every 2 000 cycles; 20 000
+// jumps cost 70 000 host instructions each before, docs/PERFORMANCE.md.)
+constexpr unsigned kAfterJumpLooks = 64;
+constexpr std::uint32_t kAfterJumpInterval = 16;
 
 constexpr std::uint32_t kIoBase = 0x20;
 
@@ -100,6 +110,10 @@ std::uint32_t IdleLoopSkipper::start_watching(std::uint64_t run_end_cycle) {
         backoff_ = kMinInterval;
         return 2;
     }
+    if (after_jump_looks_ < kAfterJumpLooks) {
+        ++after_jump_looks_;
+        if (stack_pointer(avr) < jump_sp_) return kAfterJumpInterval;
+    }
     head_pc_ = avr->pc;
     head_cycle_ = avr->cycle;
     const TimerShape timers = timer_shape(avr);
@@ -136,6 +150,8 @@ std::uint32_t IdleLoopSkipper::tick(std::uint64_t run_end_cycle) {
         ++jumps_;
         cycles_skipped_ += passes * period;
         backoff_ = kMinInterval;
+        jump_sp_ = sp_;
+        after_jump_looks_ = 0;
         return kMinInterval;
     }
     if (++watched_ > kMaxPassInstructions) return give_up();

@@ -75,6 +75,8 @@ private:
     std::uint32_t watched_ = 0;
     std::uint32_t backoff_ = 0;
     bool in_delay_loop_ = false;  // the last look found a delay loop
+    std::uint16_t jump_sp_ = 0;   // SP of the loop the last jump skipped
+    unsigned after_jump_looks_ = ~0u;  // looks since then (kAfterJumpLooks and up: none pending)
     unsigned delay_misses_ = 0;   // looks since that found none
 
     std::uint64_t jumps_ = 0;
