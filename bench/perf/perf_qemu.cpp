@@ -1,7 +1,9 @@
 // qemu-system-avr on the same ELF as the bench, for `avrbench_perf --mips`:
 // QEMU's TCG (a JIT, not cycle-exact) runs the program until the PC leaves
-// its work loop for the end label; QEMU's own CPU time (utime + stime from
-// /proc/<pid>/stat) from its start to then is the measure.
+// its work loop for the end label; QEMU's own CPU time from its start to
+// then is the measure: its threads' time on a CPU in nanoseconds
+// (/proc/<pid>/task/*/schedstat, proc(5)), or where the kernel does not
+// keep that, utime + stime from /proc/<pid>/stat in clock ticks (10 ms).
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -74,8 +76,10 @@ std::string qemu_version() {
 // through QEMU's monitor every 5 ms; -1 with `why` set when it cannot.
 // (A debugger's breakpoints would mark the two places exactly, but with
 // QEMU's gdb stub attached its TCG ran the same loop 4x slower: measured
-// 3.2 s against 0.8 s on busy_poll_passes.) The poll can add up to 5 ms and
-// a clock tick (10 ms) to QEMU's time: about 2 % of a 0.8 s run.
+// 3.2 s against 0.8 s on busy_poll_passes.) With the nanosecond clock the
+// end is placed between two polls, within 2.5 ms of QEMU's time (2.5 % of
+// the workload suite's shortest kernel, 0.1 s); with clock ticks a poll and
+// a tick (15 ms) can be added.
 double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::uint32_t to_addr, std::string& why,
                         bool stop_on_entry) {
     int to_qemu[2], from_qemu[2];
@@ -99,6 +103,21 @@ double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::ui
     close(from_qemu[1]);
     fcntl(from_qemu[0], F_SETFL, O_NONBLOCK);
     const std::string stat = "/proc/" + std::to_string(qemu) + "/stat";
+    // Nanoseconds on a CPU, all of QEMU's threads (its TCG thread and its
+    // main loop, which answers the monitor), or -1.
+    const std::string tasks = "/proc/" + std::to_string(qemu) + "/task";
+    const auto schedstat_ns = [&tasks]() -> long long {
+        long long sum = 0;
+        std::error_code error;
+        int threads = 0;
+        for (const auto& task : std::filesystem::directory_iterator(tasks, error)) {
+            const std::string text = slurp(task.path().string() + "/schedstat");
+            if (text.empty()) continue;  // a thread that just ended
+            sum += std::atoll(text.c_str());
+            ++threads;
+        }
+        return error || threads == 0 ? -1 : sum;
+    };
     const auto ticks = [&stat]() -> long long {
         const std::string text = slurp(stat);
         // Fields 14 and 15: utime and stime in clock ticks, after the command
@@ -129,11 +148,21 @@ double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::ui
     bool started = false;  // the PC seen inside the work (the start-up code runs before it)
     long last = -1;
     int same = 0;  // polls in a row at the same PC
-    const long long start = ticks();
+    // QEMU's CPU time in seconds (see the top of the file), or < 0.
+    const bool in_ns = schedstat_ns() >= 0;
+    const auto cpu_seconds = [&]() -> double {
+        if (in_ns) return static_cast<double>(schedstat_ns()) * 1e-9;
+        const long long t = ticks();
+        return t < 0 ? -1.0 : static_cast<double>(t) / static_cast<double>(sysconf(_SC_CLK_TCK));
+    };
+    const double start = cpu_seconds();
+    // The end was passed between the poll before and this one: the middle
+    // of the two is the estimate (off by half a poll, 2.5 ms, at most).
+    double previous = start;
     if (start >= 0 && say("cont\n")) {
         for (int poll = 0; poll < 60 * 200; ++poll) {  // at most a minute of wall time
             std::this_thread::sleep_for(std::chrono::milliseconds(5));
-            const long long now = ticks();
+            const double now = cpu_seconds();
             out.clear();
             if (!say("info registers\n")) break;
             for (int wait = 0; wait < 200 && last_pc() < 0; ++wait) {
@@ -155,9 +184,10 @@ double qemu_cpu_seconds(const std::string& elf, std::uint32_t from_addr, std::ui
             const bool inside = pc >= static_cast<long>(from_addr) && pc < static_cast<long>(to_addr);
             if (inside) started = true;
             if (stop_on_entry ? inside : started && !inside) {
-                seconds = static_cast<double>(now - start) / static_cast<double>(sysconf(_SC_CLK_TCK));
+                seconds = (in_ns ? (previous + now) / 2 : now) - start;
                 break;
             }
+            previous = now;
         }
     }
     if (seconds < 0 && why.empty()) why = stop_on_entry ? "qemu-system-avr did not reach the end label" : "qemu-system-avr did not run from main past busy_poll_done's loop";
