@@ -20,8 +20,13 @@ namespace {
 // 2 % (65 536 cost 7 % on the workload suite's kernels, docs/PERFORMANCE.md).
 constexpr std::uint32_t kMinInterval = 64;
 constexpr std::uint32_t kMaxInterval = 262144;
-// A pass longer than this is not the kind of loop worth watching.
-constexpr std::uint32_t kMaxPassInstructions = 1024;
+// A pass longer than this is not the kind of loop worth watching. The
+// longest idle passes seen: grbl 1.1's 185 instructions, Teacup's 104,
+// Prusa-Firmware's 64 (the passes the skipper jumped over, counted on
+// their runs); a watch that fails costs the general step (about 230 host
+// instructions each), and most that failed had watched 1 024 (a start
+// outside any loop): 256 took 14 % off a Teacup job.
+constexpr std::uint32_t kMaxPassInstructions = 256;
 constexpr std::size_t kMaxWrittenBytes = 64;
 // After a delay loop, how often and how many instructions apart to look for
 // it again before watching other code (an ISR is typically tens of instructions).
@@ -32,11 +37,14 @@ constexpr std::uint32_t kDelayLoopGraceInterval = 16;
 // address and its saved registers): a pass watched there fails at its RETI
 // and doubles the back-off, and the loop is found again only after the
 // watch of up to kMaxPassInstructions on the general step. Until SP is back
-// at the loop's level, look again this often, up to this many times.
+// at the loop's level, look again after this many instructions - or at once
+// after a RETI that returns to that level (look_after_interrupt_return),
+// where the loop usually comes back -, up to this many times.
 // (grbl_stepper during a move: a step interrupt every 2 000 cycles; 20 000
-// jumps cost 70 000 host instructions each before, docs/PERFORMANCE.md.)
-constexpr unsigned kAfterJumpLooks = 64;
-constexpr std::uint32_t kAfterJumpInterval = 16;
+// jumps cost 70 000 host instructions each before, docs/PERFORMANCE.md,
+// which has the other settings tried.)
+constexpr unsigned kAfterJumpLooks = 8;
+constexpr std::uint32_t kAfterJumpInterval = 128;
 
 constexpr std::uint32_t kIoBase = 0x20;
 
@@ -77,6 +85,10 @@ IdleLoopSkipper::IdleLoopSkipper(avr_t* avr) : avr_(avr), readable_io_(MAX_IOs, 
         const unsigned address = uart->rxc.raised.reg;
         if (address >= kIoBase && address < kIoBase + MAX_IOs) readable_io_[address - kIoBase] = true;
     }
+}
+
+bool IdleLoopSkipper::look_after_interrupt_return(std::uint16_t sp_after) const {
+    return !watching_ && after_jump_looks_ < kAfterJumpLooks && sp_after == jump_sp_;
 }
 
 std::uint32_t IdleLoopSkipper::give_up() {

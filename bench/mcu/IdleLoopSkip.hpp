@@ -40,6 +40,11 @@ public:
     // (its horizon timer says the same, but a reset drops every timer).
     std::uint32_t tick(std::uint64_t run_end_cycle);
 
+    // True while it waits for the loop its last jump skipped, after the
+    // event that ended it, and a RETI would leave SP at `sp_after`, the
+    // loop's level: the run loop then ticks it right after that RETI.
+    bool look_after_interrupt_return(std::uint16_t sp_after) const;
+
     std::uint64_t jumps() const { return jumps_; }
     std::uint64_t cycles_skipped() const { return cycles_skipped_; }
 

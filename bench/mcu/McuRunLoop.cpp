@@ -36,6 +36,7 @@ bool is_out_to(const avr_t* avr, std::uint32_t pc_bytes, unsigned io_address) {
 }
 
 constexpr unsigned kSleepOpcode = 0x9588;  // SLEEP (AVR Instruction Set Manual)
+constexpr unsigned kRetiOpcode = 0x9518;   // RETI
 
 // avr-gcc's prologues and epilogues set SP with `out SPH`, `out SREG`,
 // `out SPL`; between the SPH and SPL writes SP reads as new-high/old-low,
@@ -185,7 +186,7 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
         // SimavrStepper::finish, as step() would, and the loop goes back to
         // the general step.
         std::uint32_t countdown = skip_countdown_;
-        const std::uint32_t countdown_before = countdown;
+        std::uint32_t countdown_before = countdown;
         // avr->data is fixed once the core is made (fixes/MemoryGuard grows it then).
         const std::uint8_t* const data = avr->data;
         const std::uint16_t stack_floor = stack_floor_;
@@ -235,6 +236,16 @@ StopReason Mcu::run_until_impl(Cycle target_cycle, PcEdgeMap* edges) {
                 if (batch.ended == PredecodedCore::Ended::Count || countdown <= 1) continue;
                 if constexpr (kStopAtSleep) {
                     if (opcode_at(avr, avr->pc) == kSleepOpcode) break;
+                }
+                // The skipper, waiting for the loop an interrupt left, looks
+                // right after the RETI that may return to it (the general
+                // step below runs the RETI, then ticks it).
+                if (batch.ended == PredecodedCore::Ended::HandOver && countdown > 2 && skipper_ != nullptr &&
+                    opcode_at(avr, avr->pc) == kRetiOpcode &&
+                    skipper_->look_after_interrupt_return(
+                        static_cast<std::uint16_t>((data[R_SPL] | (data[R_SPH] << 8)) + avr->address_size))) {
+                    countdown_before -= countdown - 2;  // the steps below count turns of this loop, not the cut
+                    countdown = 2;
                 }
             }
             --countdown;
