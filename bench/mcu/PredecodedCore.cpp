@@ -194,8 +194,11 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
         case 0x9000:
             if ((opcode & 0xff0f) == 0x9408) {
                 const unsigned bit = (opcode >> 4) & 7;
-                if (bit != S_I) set((opcode & 0x0080) ? kSregClear : kSregSet, 0, bit);
-                break;  // SEI/CLI change the interrupt state: simavr
+                if (bit != S_I)
+                    set((opcode & 0x0080) ? kSregClear : kSregSet, 0, bit);
+                else
+                    s.kind = (opcode & 0x0080) ? kCli : kSei;
+                break;
             }
             switch (opcode) {
                 case 0x9588:  // SLEEP

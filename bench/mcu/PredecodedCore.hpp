@@ -11,11 +11,12 @@
 // executes itself does exactly what simavr 1.6's avr_run_one does,
 // its quirks included (an RJMP wraps modulo the flash size, a branch does
 // not; the flags of every ALU instruction; 0xF1F1 is a branch). IN, OUT,
-// SBI, CBI, SBIS and SBIC on an I/O register with callbacks or IRQs call
-// them as simavr's _avr_get_ram/_avr_set_r do. Everything else is handed
-// to avr_run_one before any state changes: loads and stores that reach such
-// a register, SREG through the data space, SEI/CLI/RETI (interrupt state),
-// SLEEP, BREAK, WDR, SPM, ELPM/EIJMP/EICALL, a data address outside RAM, a
+// SBI, CBI, SBIS, SBIC and the loads and stores (LD, LDD, LDS, ST, STD,
+// STS) on an I/O register with callbacks or IRQs call them as simavr's
+// _avr_get_ram/_avr_set_r do; CLI, SEI and OUT to SREG set the flags
+// through simavr's own avr_sreg_set (interrupt_state). Everything else is
+// handed to avr_run_one before any state changes: SREG through a load or
+// store, RETI, SLEEP, BREAK, WDR, SPM, ELPM/EIJMP/EICALL, a data address outside RAM, a
 // PC past the flash, invalid opcodes, and every access while simavr's own
 // GDB stub is attached (its watchpoints).
 // Exactness is proven instruction by instruction against avr_run_one on
@@ -62,7 +63,7 @@ struct Machine;
     X(kSub) X(kCpse) X(kCp) X(kAdc) X(kAnd) X(kEor) X(kOr) X(kMov)                            \
     X(kCpi) X(kSbci) X(kSubi) X(kOri) X(kAndi)                                                \
     X(kLddZ) X(kStdZ) X(kLddY) X(kStdY)                                                       \
-    X(kSregSet) X(kSregClear)                                                                 \
+    X(kSregSet) X(kSregClear) X(kCli) X(kSei)                                                 \
     X(kLpmR0) X(kLpm) X(kLpmInc) X(kLds) X(kSts)                                              \
     X(kLdX) X(kStX) X(kLdY) X(kStY) X(kLdZ) X(kStZ)                                           \
     X(kPop) X(kPush)                                                                          \
