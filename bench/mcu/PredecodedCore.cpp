@@ -101,7 +101,7 @@ PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint1
     const auto trips = [&](avr_flashaddr_t next) { return next - 1 >= limits.code_end_minus_one || next == limits.bad_interrupt_pc; };
     bool check = (s.flags & kMovesSp) || trips(pc + 2) || trips(pc + 4) || trips(pc + 6);
     switch (s.kind) {
-        case kIjmp: case kIcall: case kRet: case kJmp: case kCall:
+        case kIjmp: case kIcall: case kEijmp: case kEicall: case kRet: case kJmp: case kCall:
             check = true;
             break;
         case kRjmp: case kRcall: case kBrbs: case kBrbc:
@@ -205,12 +205,12 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
                 case 0x9598:  // BREAK
                 case 0x95a8:  // WDR
                 case 0x95e8:  // SPM
-                case 0x9419:  // EIJMP
-                case 0x9519:  // EICALL
                 case 0x9518:  // RETI
-                case 0x95d8:  // ELPM
                     break;
                 case 0x9409: s.kind = kIjmp; break;
+                case 0x9419: s.kind = kEijmp; break;
+                case 0x9519: s.kind = kEicall; break;
+                case 0x95d8: set(kElpm, 0, 0); break;  // ELPM (R0 <- (RAMPZ:Z))
                 case 0x9509: s.kind = kIcall; break;
                 case 0x9508: s.kind = kRet; break;
                 case 0x95c8: s.kind = kLpmR0; break;
@@ -219,7 +219,7 @@ PredecodedCore::Slot PredecodedCore::decode(const avr_t* avr, std::uint16_t opco
                         case 0x9000: set(kLds, d5(), 0); break;
                         case 0x9004: set(kLpm, d5(), 0); break;
                         case 0x9005: set(kLpmInc, d5(), 0); break;
-                        case 0x9006: case 0x9007: break;  // ELPM
+                        case 0x9006: case 0x9007: set(kElpm, d5(), opcode & 1); break;  // ELPM Rd, Z / Z+
                         case 0x900c: case 0x900d: case 0x900e: set(kLdX, d5(), opcode & 3); break;
                         case 0x920c: case 0x920d: case 0x920e: set(kStX, d5(), opcode & 3); break;
                         case 0x9009: case 0x900a: set(kLdY, d5(), opcode & 3); break;

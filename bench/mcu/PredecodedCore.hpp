@@ -16,7 +16,7 @@
 // _avr_get_ram/_avr_set_r do; CLI, SEI and OUT to SREG set the flags
 // through simavr's own avr_sreg_set (interrupt_state). Everything else is
 // handed to avr_run_one before any state changes: SREG through a load or
-// store, RETI, SLEEP, BREAK, WDR, SPM, ELPM/EIJMP/EICALL, a data address outside RAM, a
+// store, RETI, SLEEP, BREAK, WDR, SPM, ELPM past the flash, a data address outside RAM, a
 // PC past the flash, invalid opcodes, and every access while simavr's own
 // GDB stub is attached (its watchpoints).
 // Exactness is proven instruction by instruction against avr_run_one on
@@ -71,7 +71,7 @@ struct Machine;
     X(kJmp) X(kCall) X(kAdiw) X(kSbiw) X(kSbic) X(kSbis) X(kMul)                              \
     X(kOut) X(kIn) X(kCbi) X(kSbi)                                                            \
     X(kRjmp) X(kRcall) X(kLdi) X(kBrbs) X(kBrbc) X(kBld) X(kBst) X(kSbrc) X(kSbrs)            \
-    X(kIjmp) X(kIcall) X(kRet)
+    X(kIjmp) X(kIcall) X(kRet) X(kElpm) X(kEijmp) X(kEicall)
 
 class PredecodedCore {
 public:
@@ -175,7 +175,7 @@ private:
     static constexpr bool moves_sp(Kind k) {
         switch (k) {
             case kStdZ: case kStdY: case kSts: case kStX: case kStY: case kStZ:
-            case kPush: case kPop: case kCall: case kRcall: case kIcall: case kRet: case kOut:
+            case kPush: case kPop: case kCall: case kRcall: case kIcall: case kEicall: case kRet: case kOut:
                 return true;
             default:
                 return false;

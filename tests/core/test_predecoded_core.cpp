@@ -389,5 +389,20 @@ TEST(PredecodedCore, LongRunsOfBatchesCountEveryInstructionAndCycle) {
     EXPECT_EQ(core.handed_to_simavr(), 0u);
 }
 
+// ELPM (all three forms), EICALL and EIJMP are the core's own since the
+// ATmega2560 firmware (Marlin: 1.2 M of them on a homing job) handed them
+// to avr_run_one, each ending a batch. core_sweep_far runs every form
+// (RAMPZ 0..3, Z at each bank's ends, Z+ carrying into RAMPZ); the
+// instruction-by-instruction test above compares it with avr_run_one.
+// Here: the batches run it to its end with nothing handed over but the
+// final SLEEP (power-down with interrupts off, which halts).
+TEST(PredecodedCore, FarFlashAndFarJumpsRunInTheBatch) {
+    const ElfImage elf = ElfImage::load(test::firmware("core_sweep_far"));
+    Mcu mcu(elf, McuOptions{});
+    ASSERT_NE(mcu.predecoded_core(), nullptr);
+    EXPECT_EQ(mcu.run_until(16'000'000), StopReason::Halted);
+    EXPECT_EQ(mcu.predecoded_core()->handed_to_simavr(), 1u);
+}
+
 }  // namespace
 }  // namespace avrbench
