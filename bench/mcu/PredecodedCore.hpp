@@ -396,6 +396,20 @@ __attribute__((always_inline)) inline void push_return(const Machine& m, avr_fla
     set_sp(m.data, sp);
 }
 
+// LD/ST's pointer register pair at `low` (X, Y or Z) after its access,
+// read again from the registers (not written yet): pre-decremented
+// (mode 2) or post-incremented (mode 1), written back high byte first as
+// _avr_set_r16le_hl does. The I/O paths use it after a callback, where
+// keeping the pointer and the mode across the call cost the plain path
+// registers.
+inline void step_pointer(std::uint8_t* data, std::uint8_t low, std::uint8_t mode) {
+    std::uint16_t p = static_cast<std::uint16_t>((data[low + 1] << 8) | data[low]);
+    if (mode == 2) p--;
+    if (mode == 1) p++;
+    data[low + 1] = static_cast<std::uint8_t>(p >> 8);
+    data[low] = static_cast<std::uint8_t>(p);
+}
+
 // The flag helpers of sim_core.c, expression for expression.
 __attribute__((always_inline)) inline void flags_zns(std::uint8_t* s, std::uint8_t res) {
     s[S_Z] = res == 0;
