@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <simavr/avr_eeprom.h>
 #include <simavr/sim_avr.h>
@@ -17,6 +18,7 @@
 #include "SnapshotHeap.hpp"
 #include "boards/BoardFile.hpp"
 #include "core/Errors.hpp"
+#include "parts/Part.hpp"
 #include "run/Bench.hpp"
 
 namespace avrbench::fuzz {
@@ -26,6 +28,9 @@ namespace {
 // Never destroyed: at exit the fixes' registries (function-local statics)
 // may go first, and the process is ending anyway.
 Bench* g_bench = nullptr;
+// The board's parts, listed once at boot: an input allocates nothing for
+// them (a restore copies back every page an input wrote).
+std::vector<Part*> g_parts;
 TargetConfig g_config;
 std::string g_mcu_name;  // the fuzzed MCU: the serial port's
 std::size_t g_findings_at_ready = 0;
@@ -86,6 +91,15 @@ TargetConfig config_from_environment(const char* who, const char* executable) {
     if (const char* raw = std::getenv("AVRBENCH_FUZZ_RAW")) config.raw = std::string(raw) == "1";
     if (const char* hang = std::getenv("AVRBENCH_FUZZ_HANG")) config.hang_at_bound = std::string(hang) == "1";
     if (const char* boot = std::getenv("AVRBENCH_FUZZ_BOOT")) config.boot_s = std::max(0.0, std::atof(boot));
+    if (const char* steady = std::getenv("AVRBENCH_FUZZ_STEADY")) {
+        char* end = nullptr;
+        const unsigned long long value = std::strtoull(steady, &end, 10);
+        if (end == steady || *end != '\0') {
+            std::fprintf(stderr, "%s: AVRBENCH_FUZZ_STEADY: '%s' is not a count of instructions\n", who, steady);
+            std::exit(2);
+        }
+        config.steady_instructions = value;
+    }
     if (const char* fork = std::getenv("AVRBENCH_FUZZ_FORK")) config.fork = std::string(fork) == "1";
     if (!snapshot_heap::available()) config.fork = true;
     if (const char* list = std::getenv("AVRBENCH_FUZZ_FIRMWARE")) {
@@ -146,6 +160,11 @@ void boot(const TargetConfig& config, const char* who) {
         } else {
             UartHostOptions options = default_host_options(g_bench->serial_port());
             if (!config.family.empty()) options.family = parse_firmware_family(config.family, "AVRBENCH_FUZZ_FAMILY");
+            // A generic firmware has no welcome the host knows: it would get
+            // every input at reset and pay for the whole boot in each
+            // (grbl_stepper: 50 ms writing its EEPROM defaults, a busy wait
+            // on EEPE). Its first output line instead, at most boot_s.
+            start_generic_after_boot(options, config.boot_s);
             UartHost& host = g_bench->host("", options);
             const Cycle limit = mcu.cycle() + mcu.cycles_from_seconds(host.options().banner_timeout_s + 0.5);
             while (!host.ready() && !host.failed() && !mcu.halted() && mcu.cycle() < limit) g_bench->run_for(0.001);
@@ -155,6 +174,7 @@ void boot(const TargetConfig& config, const char* who) {
                 std::exit(2);
             }
         }
+        g_parts = g_bench->board().parts();
         const auto at_ready = g_bench->board().findings();
         g_findings_at_ready = at_ready.size();
         for (const auto& f : at_ready) ++g_findings_at_ready_by_source[f.source];
@@ -184,7 +204,8 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     }
     // Done sending: every line answered (or the host gave up), or every raw byte taken.
     const auto sent = [&] { return host != nullptr ? host->finished() : serial.pending_rx() == 0; };
-    Cycle end = mcu.cycle() + mcu.cycles_from_seconds(g_config.bound_s);
+    const Cycle start = mcu.cycle();
+    Cycle end = start + mcu.cycles_from_seconds(g_config.bound_s);
     // The board's run loop with the fuzzed MCU covering (Mcu::set_run_coverage:
     // alone, or in the lockstep among the board's other MCUs), in slices of
     // 1 ms simulated between which the settle time may start.
@@ -207,13 +228,47 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     // line answered, every accepted move made, heaters at their targets, no
     // step for settle_s), the first finding, or the bound.
     const Picoseconds settle_ps = ps_from_seconds(g_config.settle_s, "AVRBENCH_FUZZ_SETTLE");
+    // Repeating itself: since the last new coverage feature, `steady`
+    // instructions ran, the machine stepped in the last slice, and no part
+    // could find more going on at that pace until the bound. Whatever the
+    // rest of the bound would run is what the window ran again; it is the
+    // long moves' cost (grbl_stepper: a 3 s move is 24 000 step interrupts).
+    std::uint64_t features_seen = edges.features;
+    std::uint64_t steady_from = mcu.steps();
+    const auto mark_pace = [&] {
+        for (Part* part : g_parts) part->mark_pace();
+    };
+    mark_pace();
+    const auto repeating = [&](double slice_start_s) {
+        if (g_config.steady_instructions == 0) return false;
+        if (edges.features != features_seen) {
+            features_seen = edges.features;
+            steady_from = mcu.steps();
+            mark_pace();
+            return false;
+        }
+        if (mcu.steps() - steady_from < g_config.steady_instructions) return false;
+        if (bench.last_step_seconds() < slice_start_s) return false;  // not stepping: the hang oracles' time
+        const double left_s = static_cast<double>(end - mcu.cycle()) / static_cast<double>(mcu.frequency_hz());
+        for (Part* part : g_parts) {
+            if (part->may_find_more_at_pace(left_s)) return false;
+        }
+        return true;
+    };
     while (mcu.cycle() < end && !mcu.halted() && !found()) {
         if (!settling && sent()) settling = true;
-        if (settling && !bench.still_going(settle_ps)) break;
+        // At least one slice: an input with nothing to send (an empty line)
+        // still runs the firmware, whose edges AFL++ needs to see some of.
+        if (settling && mcu.cycle() != start && !bench.still_going(settle_ps)) break;
         const Cycle from = mcu.cycle();
         const Cycle to = std::min(end, from + slice);
+        const double from_s = bench.now_seconds();
         bench.run_for(static_cast<double>(to - from) / mcu.frequency_hz());
         bench.sample_heaters();
+        if (!found() && repeating(from_s)) {
+            outcome.ended_steady = true;
+            break;
+        }
         if (mcu.cycle() == from) break;  // nothing moved (a stop): never spin
     }
     mcu.set_run_coverage(nullptr);
@@ -242,7 +297,8 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     // on the line (an input that asks for more than the bound's time).
     const bool stepping = bench.last_step_seconds() >= 0 && host != nullptr &&
                           bench.now_seconds() - bench.last_step_seconds() < host->line_timeout_s();
-    if (detail.empty() && host != nullptr && g_config.hang_at_bound && !settling && !mcu.halted() && !stepping &&
+    if (detail.empty() && host != nullptr && g_config.hang_at_bound && !outcome.ended_steady && !settling &&
+        !mcu.halted() && !stepping &&
         host->outstanding_lines() > 0 && host->lines_acknowledged() < host->lines().size()) {
         // The oldest line still waiting when the input's simulated time ran out.
         const GcodeLine& line = host->lines()[host->lines_acknowledged()];

@@ -20,6 +20,13 @@
 //   AVRBENCH_FUZZ_HANG   1: a line still unanswered when the bound ends is a
 //                        finding ("hang"), keep-alives or not (the
 //                        serial port's line timeout is restarted by them)
+//   AVRBENCH_FUZZ_STEADY AVR instructions after which an input that only
+//                        repeats itself ends (default 100000; 0: never):
+//                        the machine steps, no PC edge reached a new
+//                        hit-count bucket, and no part could raise a finding
+//                        going on at that pace until the bound (a carriage
+//                        reaching an end of travel, a heater heating, a
+//                        judged move under way: Part::may_find_more_at_pace)
 //   AVRBENCH_FUZZ_SETTLE simulated seconds to keep running after the last
 //                        answer, for what the lines set in motion (default 0.1:
 //                        five RC-servo frames)
@@ -68,7 +75,11 @@ struct TargetConfig {
     double settle_s = 0.1;
     bool raw = false;
     bool hang_at_bound = false;  // an unanswered line at the bound's end is a finding
-    double boot_s = 0.2;   // raw mode: no banner, boot this long
+    double boot_s = 0.2;   // raw mode: no banner, boot this long; generic family: at most this long
+    // An input ends when the machine has only repeated itself for this many
+    // AVR instructions (no new coverage feature while it steps, and no part
+    // could find more at that pace before the bound); 0: run to the bound.
+    std::uint64_t steady_instructions = 100000;
     bool fork = false;     // fork per input instead of restoring a snapshot
 };
 
@@ -90,6 +101,7 @@ bool target_restores();
 struct InputOutcome {
     std::uint64_t steps = 0;      // AVR instructions
     bool finding = false;
+    bool ended_steady = false;    // ended repeating itself, before its bound
     char detail[512] = {};        // the first finding, one line
 };
 

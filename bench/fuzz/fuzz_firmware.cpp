@@ -55,6 +55,18 @@ __attribute__((section("__libfuzzer_extra_counters"), used)) std::uint8_t g_coun
 
 Shared* g_shared = nullptr;
 
+// Inputs run, and those that ended repeating themselves before their bound
+// (FirmwareTarget.hpp, AVRBENCH_FUZZ_STEADY): said once at exit, so a
+// campaign tells what it did not run to the end.
+unsigned long long g_inputs = 0;
+unsigned long long g_ended_steady = 0;
+
+void say_steady_count() {
+    if (g_inputs == 0) return;
+    std::fprintf(stderr, "avrbench fuzz: %llu of %llu inputs ended repeating themselves before their bound\n",
+                 g_ended_steady, g_inputs);
+}
+
 // crash-<FNV-1a of the bytes, 16 hex digits>: one file per distinct input.
 void save_crash(const char* dir, const std::uint8_t* data, std::size_t size) {
     std::uint64_t hash = 0xcbf29ce484222325ull;
@@ -72,6 +84,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
     const char* who = "fuzz_firmware";
     const char* executable = argc != nullptr && *argc > 0 ? (*argv)[0] : nullptr;
     avrbench::fuzz::boot_target(avrbench::fuzz::config_from_environment(who, executable), who);
+    std::atexit(say_steady_count);
     if (avrbench::fuzz::target_restores()) return 0;
     void* shared = ::mmap(nullptr, sizeof(Shared), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
     if (shared == MAP_FAILED) {
@@ -120,6 +133,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else {
         outcome = run_forked(data, size);
     }
+    ++g_inputs;
+    if (outcome.ended_steady) ++g_ended_steady;
     if (outcome.finding) {
         char line[sizeof outcome.detail + 96];
         std::snprintf(line, sizeof line, "avrbench fuzz: FINDING after %llu AVR instructions: %s",

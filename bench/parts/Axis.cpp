@@ -123,6 +123,21 @@ std::string Axis::summary() {
     return line;
 }
 
+void Axis::mark_pace() {
+    pace_carriage_256_ = carriage_256_;
+    pace_cycle_ = clock().cycle();
+}
+
+bool Axis::may_find_more_at_pace(double seconds) {
+    if (rotary_ || in_crash_) return false;  // no ends; or at one, its crash told
+    const Cycle elapsed = clock().cycle() - pace_cycle_;
+    if (elapsed == 0) return true;  // no pace seen yet: cannot tell
+    const double per_second = static_cast<double>(carriage_256_ - pace_carriage_256_) *
+                              static_cast<double>(clock().frequency_hz()) / static_cast<double>(elapsed);
+    const double ahead = static_cast<double>(carriage_256_) + per_second * seconds;
+    return ahead < 0.0 || ahead > static_cast<double>(travel_256_);
+}
+
 double Axis::position_steps() const {
     return static_cast<double>(driver_->position_256()) * driver_->configured_microsteps() / 256.0;
 }

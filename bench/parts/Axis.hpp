@@ -36,6 +36,10 @@ public:
     double travel_mm() const override { return travel_m_ * 1e3; }
     double step_mm() const override { return 1e3 / steps_per_unit_; }
     std::string summary() override;
+    // Linear: whether the carriage, at the speed it made since the mark,
+    // reaches an end of travel within `seconds` (a crash it has not had yet).
+    void mark_pace() override;
+    bool may_find_more_at_pace(double seconds) override;
     unsigned crashes() const { return crashes_; }
 
     void on_move(std::function<void(double position_m)> fn) override { move_listeners_.push_back(std::move(fn)); }
@@ -65,6 +69,8 @@ private:
     double stall_allowance_m_ = 0;
     std::int64_t stall_allowance_256_ = 0;
     std::int64_t pushed_256_ = 0;  // driven into the end since the carriage last moved freely
+    std::int64_t pace_carriage_256_ = 0;  // at mark_pace()
+    Cycle pace_cycle_ = 0;
     bool in_crash_ = false;
     unsigned crashes_ = 0;
     std::size_t sig_position_ = 0;

@@ -31,6 +31,12 @@ public:
     std::string_view type() const override { return "delta_robot"; }
     void start() override;
     std::string summary() override;
+    // The effector moved since the mark: a limit ahead cannot be told.
+    void mark_pace() override { pace_effector_mm_ = effector_mm_; }
+    bool may_find_more_at_pace(double seconds) override {
+        (void)seconds;
+        return effector_mm_ != pace_effector_mm_;
+    }
 
     const DeltaGeometry& geometry() const { return geometry_; }
     // The effector centre as of the last sample (mm), and whether the arms' angles reach one.
@@ -73,6 +79,7 @@ private:
     std::array<std::string, 3> horn_names_;  // the servos', for findings
     Cycle sample_cycles_;
     Eigen::Vector3d effector_mm_ = Eigen::Vector3d::Zero();
+    Eigen::Vector3d pace_effector_mm_ = Eigen::Vector3d::Zero();
     bool reachable_ = false;
     bool sampled_ = false;
     bool check_moves_ = true;

@@ -49,6 +49,12 @@ public:
     std::string_view type() const override { return unipolar_ ? "unipolar_stepper" : "hybrid_stepper"; }
     void start() override;
     std::string summary() override;
+    // Turning since the mark: a stall depends on speed and load, which may change.
+    void mark_pace() override { pace_shaft_steps_ = shaft_steps_; }
+    bool may_find_more_at_pace(double seconds) override {
+        (void)seconds;
+        return shaft_steps_ != pace_shaft_steps_;
+    }
 
     // Port `windings` requires what drives the windings (a DriveSource: the
     // motor knows the interface, not the parts); per winding (A, B; unipolar:
@@ -137,6 +143,7 @@ private:
     std::int64_t shaft_256_ = 0;
     std::int64_t shaft_full_ = 0;  // whole full steps, for steps_taken
     std::uint64_t shaft_steps_ = 0;
+    std::uint64_t pace_shaft_steps_ = 0;  // at mark_pace()
     std::vector<std::function<void(int)>> shaft_listeners_;
 
     // Synchronism.

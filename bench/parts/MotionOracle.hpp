@@ -66,6 +66,11 @@ public:
     // An accepted move the machine is making or has not begun: the run is
     // not done. A move begun and left short at rest is judged, not waited for.
     bool still_going(std::string* why) const override;
+    // A judged move under way runs to its end: a path is judged whole.
+    bool may_find_more_at_pace(double seconds) override {
+        (void)seconds;
+        return still_going(nullptr);
+    }
 
     void commanded(const CommandedMove& move) override;
     void position_renamed(const AxisPositions& was_mm, const AxisPositions& now_mm) override;

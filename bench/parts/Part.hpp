@@ -141,6 +141,19 @@ public:
         return false;
     }
 
+    // The pace of a run that only repeats itself (the fuzz target's steady
+    // stepping, bench/fuzz/FirmwareTarget.cpp): mark_pace() starts a window;
+    // may_find_more_at_pace(s) says whether going on for `s` more seconds as
+    // the part went since the mark (a carriage at the speed it made, a heater
+    // heating) could raise a finding it has not raised. A part whose findings
+    // come from the timing of its pins alone (a driver's pulse widths, a
+    // serial frame) repeats what the window showed: the default, no.
+    virtual void mark_pace() {}
+    virtual bool may_find_more_at_pace(double seconds) {
+        (void)seconds;
+        return false;
+    }
+
     // Faults, by name, for tests and scenario files ("open", "stuck_on", ...;
     // "none" repairs). inject_fault applies one when this part's clock reaches
     // `at_cycle` (at the next instruction boundary if that has passed); throws

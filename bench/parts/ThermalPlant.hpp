@@ -43,6 +43,10 @@ public:
     std::string_view type() const override { return "thermal_plant"; }
     void start() override;
     std::string summary() override;
+    // Heat put in since the mark (a heater on now or switched on since): it
+    // may go on to overheat the plant.
+    void mark_pace() override;
+    bool may_find_more_at_pace(double seconds) override;
 
     // Temperatures now (advances the model to the clock's current cycle).
     double block_degC();
@@ -98,6 +102,9 @@ private:
     bool diverged_ = false;  // a temperature stopped being a finite number (reported once)
     double fan_speed_ = 0, feed_mm_per_s_ = 0;
     bool detached_ = false;
+    bool heated_ = false;       // a heat source was ever turned on
+    Cycle last_heat_cycle_ = 0;  // the last time one was
+    Cycle pace_cycle_ = 0;       // mark_pace()
     bool overheated_ = false;
     // heating-unmonitored: thermistors on the body, the last one read, and
     // whether a heater was on since the last sample.

@@ -235,6 +235,7 @@ void BoardRun::start_gcode_job() {
         if (!(o.line_timeout_s > 0)) throw BadInput("--line-timeout: must be longer than 0");
     }
     if (job.wait_banner) o.startup = Startup::WaitForBanner;
+    if (job.generic_boot_s) start_generic_after_boot(o, *job.generic_boot_s);
     host_ = &bench_->host(decl.name, o);
     if (job.raw_bytes) {
         host_->add_lines(read_input_file(job.path, "--gcode", kMaxGcodeFileBytes));

@@ -55,6 +55,10 @@ struct BoardRunOptions {
         std::string flow, family, line_timeout;  // overrides of the port's declaration ("" = the board's)
         std::vector<std::string> error_patterns;  // besides the family's and the board's
         bool wait_banner = false;
+        // A generic firmware's port that starts at once: after its first
+        // output line instead, at most this long (start_generic_after_boot:
+        // the fuzz target's boot, for replaying its reproducers).
+        std::optional<double> generic_boot_s;
         std::vector<std::pair<Picoseconds, std::string>> realtime;  // bytes sent outside the line stream
     };
     std::optional<GcodeJob> gcode;

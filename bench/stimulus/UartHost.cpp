@@ -202,6 +202,10 @@ UartHost::UartHost(Mcu& mcu, SerialLink& link, UartHostOptions options)
                     become_ready();  // welcomed, but never quiet: start anyway
                     return;
                 }
+                if (options_.start_without_banner) {
+                    become_ready();
+                    return;
+                }
                 HostEvent e;
                 e.kind = HostEventKind::BannerTimeout;
                 e.cycle = mcu_.cycle();
@@ -283,6 +287,14 @@ bool UartHost::done() const {
 std::string UartHost::failure_message() const {
     if (!failure_event_) return "";
     return events_.all()[*failure_event_].message;
+}
+
+void start_generic_after_boot(UartHostOptions& options, double boot_s) {
+    if (options.family != FirmwareFamily::Generic || options.startup != Startup::Immediately || options.raw_bytes) return;
+    options.startup = Startup::WaitForBanner;
+    options.banner_contains.clear();
+    options.banner_timeout_s = boot_s;
+    options.start_without_banner = true;
 }
 
 // --- receiving -----------------------------------------------------------------

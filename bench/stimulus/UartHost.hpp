@@ -51,6 +51,12 @@ const char* to_string(FlowControl flow);
 // Throws BadInput naming `what` for anything else.
 FlowControl parse_flow_control(std::string_view text, std::string_view what);
 
+// A generic firmware's port that would start at once waits for the firmware's
+// first output line instead, at most `boot_s`, then starts (the fuzz target's
+// boot, and its reproducers' replay: bench/fuzz/FirmwareTarget.hpp).
+struct UartHostOptions;
+void start_generic_after_boot(UartHostOptions& options, double boot_s);
+
 enum class Startup {
     Immediately,    // send as soon as there are lines (Uart::send still waits for RXEN)
     WaitForBanner,  // wait for the firmware's first output line (or one containing banner_contains)
@@ -89,6 +95,7 @@ struct UartHostOptions {
     Startup startup = Startup::Immediately;
     std::string banner_contains;     // WaitForBanner: empty = the first line, whatever it says
     double banner_timeout_s = 2.0;   // WaitForBanner: give up (failed) after this long
+    bool start_without_banner = false;  // WaitForBanner: at banner_timeout_s start anyway (a firmware that may print nothing)
     double startup_delay_s = 0.0;    // FixedDelay
     // Lines the firmware prints that are errors besides its family's own
     // (stimulus/HostFamily.hpp): RE2 patterns searched in every line that

@@ -71,6 +71,7 @@ FuzzCampaignOptions campaign_options(const FuzzArgs& args) {
     o.firmware = firmware_assignments(args.firmware);
     o.raw = args.raw;
     o.hang = args.hang;
+    o.steady = args.steady;
     o.boot = args.boot;
     o.engine = args.engine;
     o.jobs = args.jobs;

@@ -20,6 +20,7 @@ struct FuzzArgs {
     std::vector<std::string> firmware;  // "mcu=elf" for a multi-MCU board's other MCUs serial port's
     bool raw = false;             // bytes straight to the port (binary protocols)
     bool hang = false;            // a line unanswered when the bound ends is a finding
+    unsigned long long steady = 100000;  // instructions an input may only repeat itself (0: to the bound)
     std::string boot = "0.2s";    // raw: simulated time the firmware boots before the first input
     std::string engine = "libfuzzer";  // or "afl"
     int jobs = 1;                 // 1 to 64

@@ -42,7 +42,11 @@ Command add_fuzz_command(CLI::App& app) {
     fuzz_cmd->add_option("--family", fuzz.family, "the host's firmware family: grbl, marlin, prusa, teacup, repetier, sprinter, generic (default: the board's)");
     fuzz_cmd->add_flag("--hang", fuzz.hang, "a line still unanswered when --bound ends is a finding, keep-alives or not");
     fuzz_cmd->add_flag("--raw", fuzz.raw, "send the input's bytes to the port as they are (binary protocols such as seed 002's records)");
-    fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw: simulated time the firmware boots before the first input (default 0.2s)");
+    fuzz_cmd->add_option("--boot", fuzz.boot, "with --raw, or a generic firmware that prints no banner: simulated time the firmware boots before the first input (default 0.2s; a generic one's first output line ends it sooner)");
+    fuzz_cmd->add_option("--steady", fuzz.steady,
+                         "AVR instructions an input may only repeat itself before it ends: stepping, no new coverage, "
+                         "no part able to find more at that pace before --bound (default 100000; 0: every input to --bound)")
+        ->check(CLI::Range(0ull, 1000000000000ull));
     fuzz_cmd->add_option("--firmware", fuzz.firmware, "MCU=ELF for a multi-MCU board's other MCUs (repeatable; as run's)");
     fuzz_cmd->add_option("--corpus", fuzz.corpus, "a directory of seed inputs (your jobs' lines) added to the family's seed lines");
     fuzz_cmd->add_option("--engine", fuzz.engine, "libfuzzer (default) or afl (Debian's afl++: one main and --jobs - 1 secondary instances)")

@@ -334,4 +334,77 @@ TEST(SnapshotHeap, AFaultOutsideTheRegionStillKillsTheProcess) {
     EXPECT_TRUE(WIFSIGNALED(r.status) && WTERMSIG(r.status) == SIGSEGV) << "status 0x" << std::hex << r.status << ": " << r.text;
 }
 
+// The target's per-input bound beyond the flat one (FirmwareTarget.hpp,
+// AVRBENCH_FUZZ_STEADY), on grbl_stepper and the UNO + CNC shield board:
+// 250 steps/mm, 200 mm of travel, carriages start at 100 mm
+// (bench/boards/arduino-uno-cnc-shield-v3.yaml); grbl_stepper steps at
+// 8 000 steps/s by default ($110 = 6000 mm/min at $100 = 80 steps/mm:
+// firmware/boards/grbl_stepper/main.c).
+namespace {
+
+std::string run_one(const fuzz::TargetConfig& c, const std::string& input) {
+    fuzz::boot_target(c, "test_snapshot_heap");
+    std::vector<std::uint8_t> edges(kMapSize);
+    fuzz::InputOutcome outcome;
+    fuzz::run_input(reinterpret_cast<const std::uint8_t*>(input.data()), input.size(), edges.data(), kMapSize - 1,
+                    outcome);
+    return "steady " + std::to_string(outcome.ended_steady ? 1 : 0) + " " + outcome_line(outcome, edges);
+}
+
+std::uint64_t steps_of(const std::string& line) {
+    const auto at = line.find("steps ");
+    return at == std::string::npos ? 0 : std::stoull(line.substr(at + 6));
+}
+
+fuzz::TargetConfig cnc_shield(double bound_s, std::uint64_t steady_instructions) {
+    fuzz::TargetConfig c = config("grbl_stepper", test::source_path("bench/boards/arduino-uno-cnc-shield-v3.yaml"), "generic");
+    c.bound_s = bound_s;
+    c.steady_instructions = steady_instructions;
+    return c;
+}
+
+}  // namespace
+
+TEST(FuzzTarget, AMoveThatOnlyRepeatsItselfEndsBeforeItsBound) {
+    // X16000: 2 s of step interrupts, 20 mm from 100 mm, inside the 3 s bound
+    // and far from either end of travel even going on for the whole bound
+    // (3 s x 32 mm/s = 96 mm < 100 mm). Its step vector stops adding
+    // coverage after its 128th run (libFuzzer's last hit-count bucket), so
+    // it ends the default 100 000 instructions later: under 1 M of the full
+    // move's 16 000 vector runs of hundreds of instructions each.
+    const ChildResult cut = in_child([] {
+        return run_one(cnc_shield(3.0, fuzz::TargetConfig{}.steady_instructions), "X16000\n");
+    });
+    ASSERT_EQ(cut.status, 0) << cut.text;
+    EXPECT_EQ(cut.text.rfind("steady 1 ", 0), 0u) << cut.text;
+    EXPECT_NE(cut.text.find("finding -"), std::string::npos) << cut.text;
+    EXPECT_LT(steps_of(cut.text), 1000000u) << cut.text;
+    // The same without the steady bound: the whole move, at least one vector run per step.
+    const ChildResult whole = in_child([] { return run_one(cnc_shield(3.0, 0), "X16000\n"); });
+    ASSERT_EQ(whole.status, 0) << whole.text;
+    EXPECT_EQ(whole.text.rfind("steady 0 ", 0), 0u) << whole.text;
+    EXPECT_GT(steps_of(whole.text), 16000u * 100u) << whole.text;
+}
+
+TEST(FuzzTarget, AMoveThatReachesAnEndOfTravelWithinTheBoundRunsToItsCrash) {
+    // X30000 from 100 mm: 100 mm (25 000 steps) to the upper end, reached
+    // after 25 000 / 8 000 = 3.125 s - within a 5 s bound, so the carriage's
+    // pace says a finding is ahead and the input is not cut.
+    const ChildResult r = in_child([] { return run_one(cnc_shield(5.0, fuzz::TargetConfig{}.steady_instructions), "X30000\n"); });
+    ASSERT_EQ(r.status, 0) << r.text;
+    EXPECT_EQ(r.text.rfind("steady 0 ", 0), 0u) << r.text;
+    EXPECT_NE(r.text.find("axis-out-of-travel"), std::string::npos) << r.text;
+    EXPECT_NE(r.text.find("past the upper end of travel"), std::string::npos) << r.text;
+}
+
+TEST(FuzzTarget, AGenericFirmwareGetsItsInputAfterItsBanner) {
+    // grbl_stepper writes its default settings to EEPROM at its first boot
+    // (15 bytes, each a 3.4 ms EEPE busy wait: about 50 ms, 800 000 cycles)
+    // before its banner. Booted to the banner, an input of '?' is only its
+    // own answer: 11 characters sent at 115 200 baud, polled.
+    const ChildResult r = in_child([] { return run_one(cnc_shield(3.0, fuzz::TargetConfig{}.steady_instructions), "?\n"); });
+    ASSERT_EQ(r.status, 0) << r.text;
+    EXPECT_LT(steps_of(r.text), 100000u) << r.text;
+}
+
 }  // namespace avrbench

@@ -80,7 +80,12 @@ Campaign libfuzzer_campaign(const FuzzCampaignOptions& args, const std::vector<s
         std::istringstream lines(slurp(log));
         std::string line;
         while (std::getline(lines, line)) {
-            unsigned long runs = 0, cov = 0, features = 0;
+            unsigned long runs = 0, cov = 0, features = 0, steady = 0, inputs = 0;
+            if (std::sscanf(line.c_str(), "avrbench fuzz: %lu of %lu inputs ended repeating", &steady, &inputs) == 2) {
+                campaign.ended_steady += steady;
+                campaign.inputs_counted += inputs;
+                continue;
+            }
             char event[16];
             if (std::sscanf(line.c_str(), "#%lu: cov: %lu ft: %lu", &runs, &cov, &features) == 3 ||
                 std::sscanf(line.c_str(), "#%lu %15s ft: %lu", &runs, event, &features) == 3) {

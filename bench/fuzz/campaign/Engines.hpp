@@ -18,6 +18,9 @@ struct Campaign {
     unsigned long executions = 0;
     unsigned long coverage_start = 0, coverage_end = 0;
     unsigned long wall_timeouts = 0;  // AFL++ only
+    // libFuzzer only (each job says it at exit): inputs run, and those that
+    // ended repeating themselves before their bound (AVRBENCH_FUZZ_STEADY).
+    unsigned long inputs_counted = 0, ended_steady = 0;
     std::vector<std::filesystem::path> artifacts;  // inputs the engine kept as crashes
     std::string artifact_dir;
 };

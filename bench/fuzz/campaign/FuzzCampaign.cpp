@@ -190,6 +190,7 @@ BoardRunOptions fuzz_replay_run(const FuzzCampaignOptions& args, const std::stri
         job.path = input;
         job.raw_bytes = true;
         job.family = fw.family;
+        job.generic_boot_s = seconds_from_ps(parse_duration_ps(args.boot, "--boot"));
         o.gcode = job;
     }
     o.on_announce = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
@@ -243,7 +244,8 @@ int run_fuzz_campaign(const FuzzCampaignOptions& args) {
                                           std::string("AVRBENCH_FUZZ_RAW=") + (args.raw ? "1" : "0"),
                                           "AVRBENCH_FUZZ_BOOT=" + std::to_string(seconds_from_ps(parse_duration_ps(args.boot, "--boot"))),
                                           "AVRBENCH_FUZZ_FIRMWARE=" + other_firmware,
-                                          std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0")};
+                                          std::string("AVRBENCH_FUZZ_HANG=") + (args.hang ? "1" : "0"),
+                                          "AVRBENCH_FUZZ_STEADY=" + std::to_string(args.steady)};
     const auto started = std::chrono::steady_clock::now();
     // --for bounds the whole campaign: the engine gets four fifths of it and
     // the replays, minimisation and recorded runs the rest, stopping at the
@@ -270,6 +272,11 @@ int run_fuzz_campaign(const FuzzCampaignOptions& args) {
     std::printf("  coverage   firmware edge %s %lu at the start, %lu at the end\n",
                 campaign.target.libfuzzer ? "features" : "tuples (AFL++'s edges)", campaign.coverage_start,
                 campaign.coverage_end);
+    if (campaign.inputs_counted != 0) {
+        std::printf("  repeating  %lu of %lu inputs ended before their bound, only repeating themselves (stepping, no new "
+                    "coverage for --steady %llu instructions, no part able to find more at that pace)\n",
+                    campaign.ended_steady, campaign.inputs_counted, static_cast<unsigned long long>(args.steady));
+    }
     if (campaign.wall_timeouts != 0) {
         std::printf("  timeouts   %lu inputs ran past AFL++'s wall-clock limit (out/afl/*/hangs; not findings: "
                     "the simulated bound is the hang oracle)\n",

@@ -29,6 +29,9 @@ struct FuzzCampaignOptions {
     std::map<std::string, std::string> firmware;  // the other MCUs of a multi-MCU board: MCU -> ELF
     bool raw = false;              // bytes straight to the port (binary protocols)
     bool hang = false;             // a line unanswered when the bound ends is a finding
+    // An input that only repeats itself this many AVR instructions ends
+    // (FirmwareTarget.hpp, AVRBENCH_FUZZ_STEADY); 0: every input to the bound.
+    unsigned long long steady = 100000;
     std::string boot = "0.2s";     // raw: simulated time the firmware boots before the first input
     std::string engine = "libfuzzer";  // or "afl"
     int jobs = 1;                  // 1 to 64
