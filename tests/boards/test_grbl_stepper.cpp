@@ -166,6 +166,23 @@ TEST(GrblStepper, MoveOfXProducesItsExactStepCountRateAndPulseWidth) {
 // 40 % of a move when it began watching inside the interrupt's routine,
 // which fails at the RETI and backs off; it waits for the loop's stack
 // level now.) The steps are the same as without skipping (the test above).
+TEST(GrblStepper, ControlCharactersAreDroppedAndEveryLineIsAnsweredOnce) {
+    // grbl's protocol.c drops control characters and answers an empty line
+    // "ok" (for syncing); a line ends at CR, LF or CR LF. The fuzzer found
+    // the firmware's old reader ending a line at a leading NUL, unanswered.
+    Grbl g;
+    EXPECT_EQ(g.command(std::string("\0X16", 4)), "ok\r\n");
+    EXPECT_EQ(g.command("?"), "<16,0,0>\r\nok\r\n");
+    EXPECT_EQ(g.command(std::string("\0\0", 2)), "ok\r\n") << "nothing left: an empty line";
+    EXPECT_EQ(g.command(""), "ok\r\n");
+    // "?\r" + the "\n" command() adds: one line, one answer (a second "ok"
+    // would answer a line the host never sent).
+    const std::string answer = g.command("?\r");
+    g.mcu().run_for(200000);  // 12.5 ms: room for a second answer (9 bytes take 0.8 ms at 115 200 baud)
+    EXPECT_EQ(answer, "<16,0,0>\r\nok\r\n");
+    EXPECT_EQ(g.command("?"), "<16,0,0>\r\nok\r\n") << "no answer left over from the CR LF line";
+}
+
 TEST(GrblStepper, IdlePassesBetweenStepInterruptsAreSkipped) {
     Grbl g;
     const Cycle start = g.mcu().cycle();

@@ -31,7 +31,8 @@
  * Settings live in EEPROM (struct settings_t at address 0, version byte +
  * additive checksum); defaults are written on the first boot.
  *
- * Commands, one per line (CR and/or LF), each answered "ok" when done:
+ * Commands, one per line (CR, LF or CR LF; control characters dropped; an
+ * empty line answered "ok" as grbl does), each answered "ok" when done:
  *   X<n> Y<n> Z<n>  relative move in steps (any subset, signed), e.g. X1600
  *   G X<mm> ...     relative move in whole millimetres (steps = mm * $10x)
  *   $<n>=<v>        set a setting ($0, $100..$102, $110..$112), saved to EEPROM
@@ -341,7 +342,10 @@ static uint8_t set_setting(int32_t id, int32_t value)
 static void execute(void)
 {
     const char* p = line;
-    if (*p == 0) return;
+    if (*p == 0) {
+        uart_puts("ok\r\n"); /* an empty line, as grbl answers it: for syncing */
+        return;
+    }
     if (p[0] == '$') {
         if (p[1] == '$') {
             print_settings();
@@ -417,15 +421,23 @@ int main(void)
     uart_puts("avrbench grbl_stepper ['$' for help]\r\n");
 
     uint8_t n = 0;
+    uint8_t after_cr = 0;
     for (;;) {
         const int c = uart_getc();
         if (c < 0) continue;
         if (c == '\r' || c == '\n') {
-            line[n] = 0;
-            execute();
-            n = 0;
-        } else if (n < sizeof line - 1) {
-            line[n++] = (char)c;
+            /* A line ends at CR, LF or CR LF: the LF of a CR LF ends none. */
+            if (c == '\r' || !after_cr) {
+                line[n] = 0;
+                execute();
+                n = 0;
+            }
+            after_cr = c == '\r';
+        } else {
+            after_cr = 0;
+            /* Control characters are dropped, as grbl's protocol.c drops
+             * them: a NUL once ended the line early, unanswered. */
+            if (c >= ' ' && n < sizeof line - 1) line[n++] = (char)c;
         }
     }
 }
