@@ -442,7 +442,13 @@ void MotionOracle::advance(const Eigen::Vector3d& p) {
         const Tracked& cur = moves_.front();
         const double here = distance(cur, p);
         std::size_t go = 0;
-        if (cur.end_reached && distance(moves_[1], p) <= here + path_tolerance_mm_) {
+        // A free move's path is its whole box, which the next one's may lie
+        // in (a delta's short moves): once its end was reached, the tool has
+        // gone on when it stands within the next move's end, clearly nearer
+        // to it than to this one's.
+        const bool at_next_end = cur.free && cur.end_reached && ends_within(moves_[1], p, moves_[1].to) &&
+                                 (p - moves_[1].to).norm() + path_tolerance_mm_ < (p - cur.to).norm();
+        if (cur.end_reached && (distance(moves_[1], p) <= here + path_tolerance_mm_ || at_next_end)) {
             go = 1;
         } else {
             for (std::size_t j = 1; j < moves_.size() && j <= kLookahead; ++j) {

@@ -93,6 +93,26 @@ TEST(DeltaMotion, RefusedLinesLeaveNothingToJudge) {
     }
 }
 
+// A move shorter than the board's 11 mm end tolerance lies inside the box
+// the previous free move spans (rapids: any, feeds: any): the judge stayed
+// on the previous move, found the tool inside its box, and never took the
+// next as begun, so a two-line job never finished ("accepted and not
+// begun", move-end-missed: the fuzzer's `G1 X5Y5F0`, `G1 X1Y5`). The
+// firmware moves there: the servos' pulses for (1, 5, -310) put the
+// effector at (1.6, 4.6, -309.9) mm, within a millimetre.
+TEST(DeltaMotion, AShortMoveInsideThePreviousMovesBoxIsJudgedMade) {
+    Bench bench(test::source_path("bench/boards/delta-seed004.yaml"), test::firmware("delta"));
+    bench.host().add_lines("G1 X5 Y5\nG1 X1 Y5\n");
+    const IdleResult r = bench.run_until_idle(10.0);
+    ASSERT_TRUE(bench.host().done()) << bench.host().tail(10);
+    EXPECT_EQ(r, IdleResult::Idle) << "the job never finished: " << to_string(r);
+    EXPECT_TRUE(bench.findings().empty()) << bench.findings().front().describe();
+    EXPECT_EQ(bench.board().part_as<MotionOracle>("motion").moves_judged(), 2u);
+    const Eigen::Vector3d at = bench.board().part_as<DeltaRobot>("robot").effector_mm();
+    EXPECT_NEAR(at.x(), 1, 1);
+    EXPECT_NEAR(at.y(), 5, 1);
+}
+
 std::string oracle_error(const std::string& motion_line, const std::string& more_nets = "") {
     BoardSpec spec = parse_board_text(R"(
 mcus:
