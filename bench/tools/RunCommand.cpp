@@ -64,6 +64,7 @@ struct RunArgs {
     std::string host;
     std::string flow;
     bool wait_banner = false;
+    std::string generic_boot;  // "" = none
     std::string settle = "50ms";
     std::string report;
     std::string profile;  // --profile: the timing profile as JSON
@@ -202,6 +203,7 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
         g.error_patterns = args.error_patterns;
         g.line_timeout = args.line_timeout;
         g.wait_banner = args.wait_banner;
+        if (!args.generic_boot.empty()) g.generic_boot_s = seconds_from_ps(parse_duration_ps(args.generic_boot, "--generic-boot"));
         for (const auto& item : args.realtime) g.realtime.push_back(parse_realtime_bytes(item, "--realtime"));
         o.gcode = g;
     } else if (!args.realtime.empty()) {
@@ -371,6 +373,9 @@ Command add_run_command(CLI::App& app) {
                         "free (default: as fast as it runs) | realtime (simulated time never ahead of wall time)");
     run_cmd->add_option("--flow", run.flow, "send_and_wait | character_counting (default: the board's)");
     run_cmd->add_flag("--wait-banner", run.wait_banner, "send the job only after the firmware's first output line");
+    run_cmd->add_option("--generic-boot", run.generic_boot,
+                        "a generic firmware's port: send the job after its first output line, or after this long if it prints "
+                        "none (how avrbench fuzz sends its inputs, e.g. 0.2s)");
     run_cmd->add_option("--family", run.family,
                         "grbl | marlin | prusa | teacup | repetier | sprinter | generic: the firmware's protocol on the "
                         "--host port, its welcome and error answers (default: the board's; docs/HOSTS.md)");

@@ -142,7 +142,8 @@ int report_findings(Campaign& campaign, const std::vector<std::string>& env, con
             // them until the firmware enables its receiver).
             run.insert(run.end(), {"--uart-in", base + ".gcode"});
         } else {
-            run.insert(run.end(), {"--family", family, "--gcode", base + ".gcode", "--gcode-bytes"});
+            // A generic firmware got it after its first line or --boot, as the target sent it.
+            run.insert(run.end(), {"--family", family, "--gcode", base + ".gcode", "--gcode-bytes", "--generic-boot", args.boot});
         }
         run_logged(run, {}, base + ".txt");
         const auto hit = hits.find(cause);
