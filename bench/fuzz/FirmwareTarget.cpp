@@ -230,9 +230,10 @@ void run_input(const std::uint8_t* data, std::size_t size, std::uint8_t* edge_ma
     const Picoseconds settle_ps = ps_from_seconds(g_config.settle_s, "AVRBENCH_FUZZ_SETTLE");
     // Repeating itself: since the last new coverage feature, `steady`
     // instructions ran, the machine stepped in the last slice, and no part
-    // could find more going on at that pace until the bound. Whatever the
-    // rest of the bound would run is what the window ran again; it is the
-    // long moves' cost (grbl_stepper: a 3 s move is 24 000 step interrupts).
+    // could find more going on at that pace until the bound. The rest of the
+    // bound would most likely run the window again (a change of behaviour
+    // after a longer quiet stretch is not followed: docs/FUZZING.md); it is
+    // the long moves' cost (grbl_stepper: a 3 s move is 24 000 step interrupts).
     std::uint64_t features_seen = edges.features;
     std::uint64_t steady_from = mcu.steps();
     const auto mark_pace = [&] {
