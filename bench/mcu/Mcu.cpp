@@ -170,7 +170,7 @@ Mcu::Mcu(const ElfImage& elf, McuOptions options) : options_(std::move(options))
 
 std::unique_ptr<PredecodedCore> Mcu::make_predecoded_core() const {
     // The oracle limits run_until passes (code_end_bytes_ - 1 as there).
-    return std::make_unique<PredecodedCore>(avr_, code_end_bytes_ - 1, bad_interrupt_pc_);
+    return std::make_unique<PredecodedCore>(avr_, code_end_bytes_ - 1, bad_interrupt_pc_, options_.translate_blocks);
 }
 
 void Mcu::load_bootloader() {
@@ -271,6 +271,12 @@ void Mcu::set_predecoded_core(bool on) {
     } else if (!predecoded_) {
         predecoded_ = make_predecoded_core();
     }
+}
+void Mcu::set_translate_blocks(bool on) {
+    if (in_run_) throw std::logic_error("Mcu::set_translate_blocks during a run");
+    if (options_.translate_blocks == on) return;
+    options_.translate_blocks = on;
+    if (predecoded_) predecoded_ = make_predecoded_core();
 }
 void Mcu::flash_written(std::uint32_t begin_bytes, std::uint32_t end_bytes) {
     if (predecoded_) predecoded_->flash_written(begin_bytes, end_bytes);

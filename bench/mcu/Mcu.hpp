@@ -58,6 +58,10 @@ struct McuOptions {
     // avr_run_one itself (`--simavr-core`; kept selectable for one release).
     // The reference run loop always uses avr_run_one.
     bool predecoded_core = true;
+    // On the predecoded core, run straight runs of register-only
+    // instructions as host code (mcu/BlockTranslator.hpp; x86-64 hosts).
+    // Exact like the rest of the core; off only to measure or compare.
+    bool translate_blocks = true;
     // Fuse bytes low, high, extended (e.g. an UNO's 0xFF, 0xDE, 0xFD);
     // replace the ELF's .fuse section when given.
     std::optional<std::array<std::uint8_t, 3>> fuses;
@@ -246,6 +250,8 @@ public:
     void set_skip_idle_loops(bool on);
     // McuOptions::predecoded_core after construction (not during a run).
     void set_predecoded_core(bool on);
+    // McuOptions::translate_blocks after construction (not during a run).
+    void set_translate_blocks(bool on);
     // Flash bytes [begin, end) were written from outside the firmware (a
     // debugger): the predecoded core decodes them again. SPM needs no call.
     void flash_written(std::uint32_t begin_bytes, std::uint32_t end_bytes);

@@ -9,6 +9,7 @@ extern "C" {
 #include <avr_flash.h>
 }
 
+#include "mcu/BlockTranslator.hpp"
 #include "mcu/Mcu.hpp"
 #include "core/ProcessHeap.hpp"
 
@@ -29,7 +30,8 @@ avr_io_read_t find_port_read(const avr_t* avr) {
 }
 }  // namespace
 
-PredecodedCore::PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc) : avr_(avr) {
+PredecodedCore::PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one, std::uint32_t bad_interrupt_pc, bool translate_blocks)
+    : avr_(avr) {
     // One slot per flash word; calloc leaves untouched pages unmapped and
     // zero is kUndecoded, so only the code that runs costs memory.
     slot_count_ = static_cast<std::size_t>(avr->flashend) / 2 + 2;
@@ -42,7 +44,8 @@ PredecodedCore::PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one, std
     slots_.reset(static_cast<Slot*>(std::calloc(slot_count_, sizeof(Slot))));
     checked_for_.reset(static_cast<CheckedFor*>(std::malloc(sizeof(CheckedFor))));
     if (!slots_ || !checked_for_) throw std::bad_alloc();
-    *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc, flash_written_};
+    if (translate_blocks && BlockTranslator::available()) translator_ = std::make_unique<BlockTranslator>();
+    *checked_for_ = CheckedFor{code_end_minus_one, bad_interrupt_pc, flash_written_, 0};
     port_read_ = find_port_read(avr);
     flash_watch_.io.kind = "predecoded-core";
     flash_watch_.io.ioctl = &PredecodedCore::on_ioctl;
@@ -78,6 +81,193 @@ int PredecodedCore::on_ioctl(avr_io_t* io, std::uint32_t ctl, void*) {
 
 void PredecodedCore::flash_written(avr_flashaddr_t begin, avr_flashaddr_t end) { invalidate(begin, end); }
 
+std::size_t PredecodedCore::translated_blocks() const { return translator_ ? translator_->blocks() : 0; }
+std::uint64_t PredecodedCore::translated_ops() const { return translator_ ? translator_->ops_translated() : 0; }
+
+namespace {
+// The kinds a translated block may hold (BlockTranslator::Op), or false.
+bool block_op(PredecodedCore::Kind kind, BlockTranslator::Op& op) {
+    using K = PredecodedCore;
+    using O = BlockTranslator::Op;
+    switch (kind) {
+        case K::kNop: op = O::kNop; return true;
+        case K::kAdd: op = O::kAdd; return true;
+        case K::kAdc: op = O::kAdc; return true;
+        case K::kSub: op = O::kSub; return true;
+        case K::kSbc: op = O::kSbc; return true;
+        case K::kCp: op = O::kCp; return true;
+        case K::kCpc: op = O::kCpc; return true;
+        case K::kCpi: op = O::kCpi; return true;
+        case K::kSubi: op = O::kSubi; return true;
+        case K::kSbci: op = O::kSbci; return true;
+        case K::kAnd: op = O::kAnd; return true;
+        case K::kOr: op = O::kOr; return true;
+        case K::kEor: op = O::kEor; return true;
+        case K::kAndi: op = O::kAndi; return true;
+        case K::kOri: op = O::kOri; return true;
+        case K::kMov: op = O::kMov; return true;
+        case K::kMovw: op = O::kMovw; return true;
+        case K::kLdi: op = O::kLdi; return true;
+        case K::kInc: op = O::kInc; return true;
+        case K::kDec: op = O::kDec; return true;
+        case K::kCom: op = O::kCom; return true;
+        case K::kNeg: op = O::kNeg; return true;
+        case K::kSwap: op = O::kSwap; return true;
+        case K::kLsr: op = O::kLsr; return true;
+        case K::kAsr: op = O::kAsr; return true;
+        case K::kRor: op = O::kRor; return true;
+        case K::kMul: op = O::kMul; return true;
+        case K::kAdiw: op = O::kAdiw; return true;
+        case K::kSbiw: op = O::kSbiw; return true;
+        case K::kBst: op = O::kBst; return true;
+        case K::kBld: op = O::kBld; return true;
+        case K::kSregSet: op = O::kSregSet; return true;
+        case K::kSregClear: op = O::kSregClear; return true;
+        case K::kLdX: op = O::kLdX; return true;
+        case K::kLdY: op = O::kLdY; return true;
+        case K::kLdZ: op = O::kLdZ; return true;
+        case K::kStX: op = O::kStX; return true;
+        case K::kStY: op = O::kStY; return true;
+        case K::kStZ: op = O::kStZ; return true;
+        case K::kLddY: op = O::kLddY; return true;
+        case K::kLddZ: op = O::kLddZ; return true;
+        case K::kStdY: op = O::kStdY; return true;
+        case K::kStdZ: op = O::kStdZ; return true;
+        case K::kLds: op = O::kLds; return true;
+        case K::kSts: op = O::kSts; return true;
+        case K::kLpm: op = O::kLpm; return true;
+        case K::kLpmR0: op = O::kLpm; return true;
+        case K::kLpmInc: op = O::kLpmInc; return true;
+        case K::kPush: op = O::kPush; return true;
+        case K::kPop: op = O::kPop; return true;
+        case K::kRcall: op = O::kRcall; return true;
+        case K::kCall: op = O::kCall; return true;
+        case K::kRet: op = O::kRet; return true;
+        case K::kIjmp: op = O::kIjmp; return true;
+        case K::kIcall: op = O::kIcall; return true;
+        case K::kBrbs: op = O::kBrbs; return true;
+        case K::kBrbc: op = O::kBrbc; return true;
+        case K::kRjmp: op = O::kRjmp; return true;
+        default: return false;
+    }
+}
+}  // namespace
+
+bool PredecodedCore::translate_block(avr_flashaddr_t head) {
+    using predecoded_detail::flash16;
+    // What the block may take as plain: RAM from past the I/O registers
+    // where simavr's io[] (which reaches past ioend on the smaller AVRs)
+    // has no callback or IRQ on the byte, as plain_access decides; the
+    // callbacks are registered when the board is made (the fixes hook I/O
+    // registers only). SP plain as plain_sp decides.
+    const avr_t* avr = avr_;
+    BlockTranslator::Memory memory{};
+    std::uint32_t ram_begin = avr->ioend + 1u;
+    for (std::uint32_t addr = ram_begin; addr < MAX_IOs + 31u && addr <= avr->ramend; ++addr) {
+        const auto& io = avr->io[AVR_DATA_TO_IO(addr)];
+        if (io.r.c != nullptr || io.w.c != nullptr || io.irq != nullptr) ram_begin = addr + 1;
+    }
+    memory.ram_begin = static_cast<std::uint16_t>(std::min<std::uint32_t>(ram_begin, 0xffff));
+    memory.ramend = static_cast<std::uint16_t>(avr->ramend);
+    memory.stack_floor = checked_for_->stack_floor;
+    const auto& spl = avr->io[AVR_DATA_TO_IO(R_SPL)];
+    const auto& sph = avr->io[AVR_DATA_TO_IO(R_SPH)];
+    memory.stack_plain = spl.w.c == nullptr && spl.r.c == nullptr && spl.irq == nullptr && sph.w.c == nullptr &&
+                         sph.r.c == nullptr && sph.irq == nullptr;
+    memory.flashend = avr->flashend;
+    memory.flash = avr->flash;
+    memory.address_size = avr->address_size;
+    memory.code_end_minus_one = checked_for_->code_end_minus_one;
+    memory.bad_interrupt_pc = checked_for_->bad_interrupt_pc;
+    const auto trips = [&](avr_flashaddr_t next) {
+        return next - 1 >= memory.code_end_minus_one || next == memory.bad_interrupt_pc;
+    };
+
+    // Long enough for the straight runs compiled C has (the workload
+    // suite's average is 2.4-10 instructions); a longer run is two blocks.
+    constexpr std::size_t kMostInstructions = 64;
+    BlockTranslator::Instruction run[kMostInstructions];
+    std::size_t count = 0;
+    avr_flashaddr_t pc = head;
+    while (count < kMostInstructions && pc < avr->flashend) {
+        Slot& s = slots_[pc >> 1];
+        if (s.kind == kUndecoded) s = decode_checked(avr, flash16(avr->flash, pc), pc);
+        BlockTranslator::Op op;
+        if (!block_op(s.kind, op)) break;
+        // An instruction after which the crash oracles must look ends the
+        // block before it: its next PC at their limits, or SP moved by it
+        // (the stores, PUSH and POP the block makes only on plain RAM, at
+        // or above the stack floor, so only their PC counts).
+        // Calls and returns: their SP in the block's range checks, a static
+        // target checked here, a run-time one in the code.
+        using O = BlockTranslator::Op;
+        const bool stack_op = op == O::kPush || op == O::kPop || op == O::kRcall || op == O::kCall || op == O::kRet || op == O::kIcall;
+        const bool jump_checked_here = op == O::kRcall || op == O::kCall || op == O::kRet || op == O::kIjmp || op == O::kIcall;
+        const bool only_sp_checked = (s.flags & kMovesSp) != 0 && !next_pc_may_trip(pc);
+        if (s.check != 0 && !only_sp_checked && !jump_checked_here) break;
+        if (stack_op && !memory.stack_plain) break;
+        std::uint32_t target = s.target;
+        if (op == O::kCall) {
+            if (pc + 3 > avr->flashend) break;  // no second word: avr_run_one's
+            target = ((static_cast<avr_flashaddr_t>(s.c) << 16) | flash16(avr->flash, pc + 2)) << 1;
+        }
+        if ((op == O::kRcall || op == O::kCall) && trips(target)) break;
+        if ((op == BlockTranslator::Op::kLds || op == BlockTranslator::Op::kSts) &&
+            (s.target < memory.ram_begin || s.target > memory.ramend)) {
+            break;
+        }
+        BlockTranslator::Instruction in{op, s.a, s.b, target};
+        // SregSet/SregClear carry their bit in b; LPM into R0 has Rd 0.
+        if (s.kind == kSregSet || s.kind == kSregClear) in.a = s.b;
+        if (s.kind == kLpmR0) in.a = 0;
+        run[count++] = in;
+        pc += 2u * static_cast<unsigned>(BlockTranslator::words_of(op));
+        if (BlockTranslator::ends_block(op)) break;
+    }
+    // One instruction alone gains nothing over its handler. The head's
+    // `target` becomes the block's index: not an LDS or STS, whose
+    // handler (run when the fuel does not cover the block) reads its
+    // address there.
+    if (count < 2 || BlockTranslator::ends_block(run[0].op) || run[0].op == BlockTranslator::Op::kLds ||
+        run[0].op == BlockTranslator::Op::kSts) {
+        return false;
+    }
+    const int index = translator_->translate(run, count, head, memory, kStepBits);
+    if (index < 0) return false;
+    Slot& first = slots_[head >> 1];
+    first.handler = kBlock;
+    first.target = static_cast<std::uint32_t>(index);
+    return true;
+}
+
+void PredecodedCore::translate_from(avr_flashaddr_t pc) {
+    if (!translator_) return;
+    // A loop's head is the target of the branch at its end, usually not the
+    // first instruction the dispatch met (the block that got there first
+    // ran through it): it gets a block of its own.
+    const auto branch_target = [&](const Slot& s, avr_flashaddr_t& target) {
+        if (s.kind != kBrbs && s.kind != kBrbc && s.kind != kRjmp && s.kind != kRcall) return false;
+        target = s.target;
+        return target < avr_->flashend && (target & 1) == 0;
+    };
+    avr_flashaddr_t target;
+    const Slot& at = slots_[pc >> 1];
+    if (branch_target(at, target)) {
+        if (slots_[target >> 1].handler != kBlock) {
+            if (slots_[target >> 1].kind == kUndecoded) slots_[target >> 1] = decode_checked(avr_, predecoded_detail::flash16(avr_->flash, target), target);
+            translate_block(target);
+        }
+        return;
+    }
+    if (!translate_block(pc)) return;
+    const BlockTranslator::Block& block = translator_->block(slots_[pc >> 1].target);
+    const Slot& last = slots_[(block.end - 2) >> 1];
+    if (branch_target(last, target) && target != pc && slots_[target >> 1].handler != kBlock) {
+        if (slots_[target >> 1].kind == kUndecoded) slots_[target >> 1] = decode_checked(avr_, predecoded_detail::flash16(avr_->flash, target), target);
+        translate_block(target);
+    }
+}
+
 void PredecodedCore::invalidate(avr_flashaddr_t begin, avr_flashaddr_t end) {
     static std::atomic<std::uint64_t> writes_in_process{0};
     flash_written_ = ++writes_in_process;
@@ -86,6 +276,15 @@ void PredecodedCore::invalidate(avr_flashaddr_t begin, avr_flashaddr_t end) {
     const std::size_t first = begin >= 2 ? (begin - 2) / 2 : 0;
     const std::size_t last = std::min<std::size_t>((static_cast<std::size_t>(end) + 1) / 2, slot_count_);
     if (first < last) std::memset(static_cast<void*>(slots_.get() + first), 0, (last - first) * sizeof(Slot));
+    // A block that began before the write and ran into it is no longer
+    // entered: its first slot runs as the instruction it is.
+    if (translator_) {
+        for (std::size_t i = 0; i < translator_->blocks(); ++i) {
+            const BlockTranslator::Block& block = translator_->block(i);
+            Slot& head = slots_[block.head >> 1];
+            if (block.head < end && block.end > begin && head.handler == kBlock && head.target == i) head.handler = own_handler(head);
+        }
+    }
 }
 
 PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint16_t word, avr_flashaddr_t pc) const {
@@ -99,7 +298,7 @@ PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint1
     // instruction), or the branch target.
     const CheckedFor& limits = *checked_for_;
     const auto trips = [&](avr_flashaddr_t next) { return next - 1 >= limits.code_end_minus_one || next == limits.bad_interrupt_pc; };
-    bool check = (s.flags & kMovesSp) || trips(pc + 2) || trips(pc + 4) || trips(pc + 6);
+    bool check = (s.flags & kMovesSp) || next_pc_may_trip(pc);
     switch (s.kind) {
         case kIjmp: case kIcall: case kEijmp: case kEicall: case kRet: case kJmp: case kCall:
             check = true;
@@ -113,6 +312,12 @@ PredecodedCore::Slot PredecodedCore::decode_checked(const avr_t* avr, std::uint1
     s.check = check ? 1 : 0;
     s.handler = static_cast<std::uint8_t>(s.kind + (check ? kKinds : 0));
     return s;
+}
+
+bool PredecodedCore::next_pc_may_trip(avr_flashaddr_t pc) const {
+    const CheckedFor& limits = *checked_for_;
+    const auto trips = [&](avr_flashaddr_t next) { return next - 1 >= limits.code_end_minus_one || next == limits.bad_interrupt_pc; };
+    return trips(pc + 2) || trips(pc + 4) || trips(pc + 6);
 }
 
 // The dispatch tree of simavr 1.6's avr_run_one (sim_core.c), in its order,
@@ -359,13 +564,14 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
         return batch;
     }
     if (checked_for_->code_end_minus_one != limits.code_end_minus_one || checked_for_->bad_interrupt_pc != limits.bad_interrupt_pc ||
-        checked_for_->flash_written != flash_written_) {
+        checked_for_->flash_written != flash_written_ || checked_for_->stack_floor != limits.stack_floor) {
         // Other oracle limits (a boot loader wrote another application):
         // every slot is decoded again, with its `check` for these. Or a
         // fuzz target restored its board: the slots may hold what an input
         // wrote to flash.
         std::memset(static_cast<void*>(slots_.get()), 0, slot_count_ * sizeof(Slot));
-        *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc, flash_written_};
+        *checked_for_ = CheckedFor{limits.code_end_minus_one, limits.bad_interrupt_pc, flash_written_, limits.stack_floor};
+        if (translator_) translator_->forget_all();
     }
     // Each handler twice: as is, and (from kKinds on) a copy that tests the
     // crash oracles after it - the slot's `handler` picks one, so the
@@ -420,7 +626,6 @@ PredecodedCore::Batch PredecodedCore::run_batch(avr_t* avr, const BatchLimits& l
     // (64-bit: it indexes the slots and flash with no zero-extension first.)
     std::size_t new_pc = avr->pc;
     avr_cycle_count_t cycle_limit = limits.cycle;
-    constexpr int kStepBits = 20;
     constexpr std::int64_t kStepRoom = (std::int64_t{1} << kStepBits) - 1;
     std::uint32_t steps = 0;  // up to the last refuel
     std::int64_t meter;
@@ -497,9 +702,28 @@ checked_kUndecoded:
     // new_pc already past it: the slot's own PC.
     const avr_flashaddr_t pc = slot_pc();
     slots[pc >> 1] = cold.core->decode_checked(avr, flash16(m.flash, pc), pc);  // `slot` points at it
+    if constexpr (!kCover) cold.core->translate_from(pc);
     new_pc = pc + 2;
     cycle = 1;
     goto* kHandlers[slot->handler];
+}
+op_kBlock:  // the head of a translated block (mcu/BlockTranslator.hpp)
+checked_kBlock: {
+    // Fuzzing counts every instruction's edge: one at a time. The block's
+    // first instruction is its slot's kind; it never needs the oracles.
+    if constexpr (kCover) goto* kHandlers[own_handler(*slot)];
+    const BlockTranslator::Block& block = cold.core->translator_->block(slot->target);
+    // Entered only when the fuel covers all of it (else its instructions
+    // run one by one, and the batch ends after the one that empties the
+    // fuel, as without blocks); the code charges the meter for what it ran.
+    if (__builtin_expect(meter < block.max_charge, 0)) goto* kHandlers[own_handler(*slot)];
+    const BlockTranslator::Exit exit = block.code(data, sreg);
+    // It ran nothing: its first instruction is the interpreter's (an
+    // access that is not plain RAM, say).
+    if (__builtin_expect(exit.charge == 0, 0)) goto* kHandlers[own_handler(*slot)];
+    meter -= static_cast<std::int64_t>(exit.charge);
+    new_pc = exit.pc;
+    AVRBENCH_DISPATCH();
 }
 op_kSimavr:
 checked_kSimavr:

@@ -47,6 +47,7 @@ extern "C" {
 
 namespace avrbench {
 
+class BlockTranslator;
 struct PcEdgeMap;
 namespace predecoded_detail {
 struct Machine;
@@ -56,7 +57,9 @@ struct Machine;
 // run_batch's handler table are both made from this list). kUndecoded:
 // calloc'd slots start here; kSimavr: avr_run_one executes it; the X/Y/Z
 // loads and stores carry in operand b 0 (plain), 1 (post-increment) or
-// 2 (pre-decrement).
+// 2 (pre-decrement). kBlock is never a slot's kind, only its handler: the
+// slot heads a translated block (mcu/BlockTranslator.hpp), whose index is
+// in its `target`.
 #define AVRBENCH_PREDECODED_KINDS(X)                                                          \
     X(kUndecoded) X(kSimavr) X(kNop)                                                          \
     X(kCpc) X(kAdd) X(kSbc) X(kMovw) X(kMuls) X(kMulsu) X(kFmul) X(kFmuls) X(kFmulsu)         \
@@ -71,14 +74,18 @@ struct Machine;
     X(kJmp) X(kCall) X(kAdiw) X(kSbiw) X(kSbic) X(kSbis) X(kMul)                              \
     X(kOut) X(kIn) X(kCbi) X(kSbi)                                                            \
     X(kRjmp) X(kRcall) X(kLdi) X(kBrbs) X(kBrbc) X(kBld) X(kBst) X(kSbrc) X(kSbrs)            \
-    X(kIjmp) X(kIcall) X(kRet) X(kElpm) X(kEijmp) X(kEicall)
+    X(kIjmp) X(kIcall) X(kRet) X(kElpm) X(kEijmp) X(kEicall)                                   \
+    X(kBlock)
 
 class PredecodedCore {
 public:
     // code_end_minus_one and bad_interrupt_pc: the crash oracles' limits
     // Mcu::run_until will pass in BatchLimits (decoding records which
     // instructions can reach them; other limits later cost one re-decode).
-    explicit PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u);
+    // translate_blocks: run straight runs of register-only instructions as
+    // host code (mcu/BlockTranslator.hpp) where the host has it.
+    explicit PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u,
+                            bool translate_blocks = true);
     ~PredecodedCore();  // unhooks from avr's I/O modules: before the avr_t is freed
     PredecodedCore(const PredecodedCore&) = delete;
     PredecodedCore& operator=(const PredecodedCore&) = delete;
@@ -126,6 +133,10 @@ public:
 
     // Instructions executed here and handed to avr_run_one (tests, perf).
     std::uint64_t handed_to_simavr() const { return handed_; }
+    // Blocks translated into host code so far (0 without translation), and
+    // which BlockTranslator::Op they held (bit n: Op n).
+    std::size_t translated_blocks() const;
+    std::uint64_t translated_ops() const;
 
     enum Kind : std::uint8_t {
 #define AVRBENCH_KIND_ENUMERATOR(kind) kind,
@@ -193,10 +204,13 @@ private:
     // Also the flash write the slots have seen last (flash_written_): a
     // restore takes the board's flash and flash_written_ back, not the
     // slots, and a different value makes run_batch decode every slot again.
+    // And the stack floor the translated blocks were made for (their
+    // PUSH and POP stop in front of it).
     struct CheckedFor {
         std::uint32_t code_end_minus_one;
         std::uint32_t bad_interrupt_pc;
         std::uint64_t flash_written;
+        std::uint16_t stack_floor;
     };
     std::unique_ptr<CheckedFor, FreeDeleter> checked_for_;
     // run_batch does not compare a slot with its flash word (run_one does):
@@ -211,6 +225,24 @@ private:
     };
     static int on_ioctl(avr_io_t* io, std::uint32_t ctl, void* param);
     void invalidate(avr_flashaddr_t begin, avr_flashaddr_t end);
+    // The handler decode_checked gives a slot (a block's head has kBlock).
+    static std::uint8_t own_handler(const Slot& s) { return static_cast<std::uint8_t>(s.kind + (s.check ? kKinds : 0)); }
+    // Translates the block starting at `pc` (a decoded slot), and the one
+    // at the target of the branch or RJMP that ends it or that `pc` holds,
+    // where none is there yet.
+    void translate_from(avr_flashaddr_t pc);
+    // The block starting at `pc`, if its instructions make one: true when
+    // the slot now heads it.
+    bool translate_block(avr_flashaddr_t pc);
+    // The next PC of the instruction at `pc` (+2, +4 or +6 after a skip)
+    // is at the crash oracles' limits (decode_checked's test without SP).
+    bool next_pc_may_trip(avr_flashaddr_t pc) const;
+    // The meter's layout in run_batch: (fuel - 1) from this bit up, the
+    // room for instructions below.
+    static constexpr int kStepBits = 20;
+    // On the process heap, beside the slots whose `target` indexes its
+    // blocks; null without translation.
+    std::unique_ptr<BlockTranslator> translator_;
     avr_t* avr_;
     FlashWatch flash_watch_{};
     // A value no other write in this process had (a process-wide count):
@@ -573,7 +605,12 @@ __attribute__((always_inline)) inline void flags_znv0s(std::uint8_t* s, std::uin
 __attribute__((always_inline)) inline PredecodedCore::Slot* PredecodedCore::slot_at(const predecoded_detail::Machine& m, avr_flashaddr_t pc) {
     Slot* slot = &slots_[pc >> 1];
     const std::uint16_t word = predecoded_detail::flash16(m.flash, pc);
-    if (__builtin_expect(slot->word != word || slot->kind == kUndecoded, 0)) *slot = decode_checked(m.avr, word, pc);
+    if (__builtin_expect(slot->word != word || slot->kind == kUndecoded, 0)) {
+        *slot = decode_checked(m.avr, word, pc);
+        // run_batch meets it as undecoded, decodes it again and may make it
+        // a block's head (it looks for blocks where it decodes).
+        if (translator_) slot->handler = kUndecoded;
+    }
     return slot;
 }
 

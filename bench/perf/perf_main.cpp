@@ -418,7 +418,7 @@ void run_check_rss(std::size_t edges, const std::string& firmware_dir) {
 struct SideTimes {
     std::uint64_t instructions = 0;
     avr_cycle_count_t cycles = 0;
-    double bench = 0, bench_simavr_core = 0, bare = 0, qemu = -1;
+    double bench = 0, bench_interpreted = 0, bench_simavr_core = 0, bare = 0, qemu = -1;
     std::string why;
 };
 
@@ -438,12 +438,14 @@ SideTimes time_program(const std::string& path, const std::string& done_symbol, 
         t.instructions = mcu.steps();
         t.cycles = mcu.cycle();
     }
-    std::vector<double> bare, bench, bench_simavr_core, emu;
+    std::vector<double> bare, bench, bench_interpreted, bench_simavr_core, emu;
     std::uint64_t events = 0;
-    avrbench::McuOptions simavr_core;
+    avrbench::McuOptions simavr_core, interpreted;
     simavr_core.predecoded_core = false;
+    interpreted.translate_blocks = false;
     for (int i = 0; i < repeats; ++i) {
         bench.push_back(run_avrbench(elf, t.cycles, vcd_path, &events));
+        bench_interpreted.push_back(run_avrbench(elf, t.cycles, vcd_path, &events, interpreted));
         bench_simavr_core.push_back(run_avrbench(elf, t.cycles, vcd_path, &events, simavr_core));
         bare.push_back(run_bare_simavr(elf, t.cycles));
         if (with_qemu && t.why.empty()) {
@@ -456,6 +458,7 @@ SideTimes time_program(const std::string& path, const std::string& done_symbol, 
     }
     std::filesystem::remove(vcd_path);
     t.bench = median(bench);
+    t.bench_interpreted = median(bench_interpreted);
     t.bench_simavr_core = median(bench_simavr_core);
     t.bare = median(bare);
     if (!emu.empty()) t.qemu = median(emu);
@@ -472,8 +475,9 @@ void run_workloads(const std::string& firmware_dir, int repeats, const std::stri
     const std::string qemu = avrbench_perf::qemu_version();
     std::printf("workload suite (firmware/workloads): CPU seconds, median of %d interleaved runs; %s\n", repeats,
                 qemu.empty() ? "qemu-system-avr not installed (bash ci/setup --perf)" : qemu.c_str());
-    std::printf("%-14s %8s %8s %9s %9s %9s %9s %9s %11s\n", "kernel", "M instr", "M cycles", "bench", "simavr-c",
-                "bare", "qemu", "MIPS", "qemu/bench");
+    // "interp.": the bench's core without block translation (--no-block-translation).
+    std::printf("%-14s %8s %8s %9s %9s %9s %9s %9s %9s %11s\n", "kernel", "M instr", "M cycles", "bench", "interp.",
+                "simavr-c", "bare", "qemu", "MIPS", "qemu/bench");
     double log_sum = 0, log_sum_cpu = 0;
     int measured = 0, measured_cpu = 0;
     double worst = 0;
@@ -482,9 +486,9 @@ void run_workloads(const std::string& firmware_dir, int repeats, const std::stri
         const std::string path = firmware_dir + "/workload_" + std::to_string(k) + ".elf";
         const SideTimes t = time_program(path, "workload_done", repeats, vcd_path, !qemu.empty());
         const double ratio = t.qemu > 0 ? t.qemu / t.bench : 0;
-        std::printf("%-14s %8.1f %8.1f %9.3f %9.3f %9.3f %9.3f %9.1f %11.3f%s\n", kNames[k - 1],
+        std::printf("%-14s %8.1f %8.1f %9.3f %9.3f %9.3f %9.3f %9.3f %9.1f %11.3f%s\n", kNames[k - 1],
                     static_cast<double>(t.instructions) / 1e6, static_cast<double>(t.cycles) / 1e6, t.bench,
-                    t.bench_simavr_core, t.bare, t.qemu, static_cast<double>(t.instructions) / t.bench / 1e6, ratio,
+                    t.bench_interpreted, t.bench_simavr_core, t.bare, t.qemu, static_cast<double>(t.instructions) / t.bench / 1e6, ratio,
                     t.qemu > 0 ? "" : (" (" + t.why + ")").c_str());
         if (t.qemu > 0) {
             log_sum += std::log(ratio);

@@ -165,6 +165,7 @@ BoardRun::BoardRun(BoardRunOptions options) : options_(std::move(options)) {
     for (Mcu* m : board.mcus()) {
         m->set_skip_idle_loops(options_.skip_idle_loops);
         m->set_predecoded_core(options_.predecoded_core);
+        m->set_translate_blocks(options_.translate_blocks);
     }
     if (!options_.profile.empty()) {
         for (Mcu* m : board.mcus()) m->enable_profile();

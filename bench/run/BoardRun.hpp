@@ -36,6 +36,7 @@ struct BoardRunOptions {
     Picoseconds settle_ps = 50 * kPsPerMs;        // a job is done once motion and lines were quiet this long
     bool skip_idle_loops = true;                  // mcu/IdleLoopSkip.hpp
     bool predecoded_core = true;                  // mcu/PredecodedCore.hpp; false: simavr's avr_run_one
+    bool translate_blocks = true;                 // mcu/BlockTranslator.hpp (on the predecoded core)
     bool periodic_waves = true;                   // periph/timer/PeriodicOutput.hpp
 
     // Serial ports by name ("" = the board's first).

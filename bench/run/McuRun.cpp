@@ -38,6 +38,7 @@ McuRun::McuRun(McuRunOptions options) : options_(std::move(options)) {
     mcu_options.mcu_type = options_.mcu_type;
     mcu_options.skip_idle_loops = options_.skip_idle_loops;
     mcu_options.predecoded_core = options_.predecoded_core;
+    mcu_options.translate_blocks = options_.translate_blocks;
     if (options_.frequency_hz != 0) mcu_options.frequency_hz = options_.frequency_hz;
     mcu_ = std::make_unique<Mcu>(elf, mcu_options);
     if (!options_.profile.empty()) mcu_->enable_profile();

@@ -26,6 +26,7 @@ struct McuRunOptions {
     std::uint32_t frequency_hz = 0;  // 0 = from the ELF's .mmcu section
     bool skip_idle_loops = true;
     bool predecoded_core = true;  // mcu/PredecodedCore.hpp; false: simavr's avr_run_one
+    bool translate_blocks = true;  // mcu/BlockTranslator.hpp (on the predecoded core)
     Picoseconds duration_ps = 1000 * kPsPerMs;
     std::string duration_text = "1s";  // as the user wrote it, for messages
     bool until_sleep = false;          // stop at the first SLEEP (bounded by the duration)

@@ -74,6 +74,7 @@ struct RunArgs {
     std::vector<std::string> realtime;  // --realtime TIME=BYTES (repeatable)
     bool no_idle_skip = false;          // --no-idle-skip: run every pass of idle loops
     bool simavr_core = false;           // --simavr-core: execute on avr_run_one, not the predecoded core
+    bool no_block_translation = false;  // --no-block-translation: the predecoded core interprets every instruction
     bool no_periodic_waves = false;     // --no-periodic-waves: every PWM edge through the nets
     std::vector<std::string> gdb;       // --gdb [MCU=]PORT (repeatable)
     bool break_at_finding = false;
@@ -192,6 +193,7 @@ BoardRunOptions board_run_options(const RunArgs& args, ProgressBar& progress) {
     o.read_uart_input = read_uart_input;
     o.skip_idle_loops = !args.no_idle_skip;
     o.predecoded_core = !args.simavr_core;
+    o.translate_blocks = !args.no_block_translation;
     o.periodic_waves = !args.no_periodic_waves;
     o.job_port = args.host;
     if (!args.gcode.empty()) {
@@ -285,6 +287,7 @@ int run_command(const RunArgs& args) {
     o.mcu_type = args.mcu;
     o.skip_idle_loops = !args.no_idle_skip;
     o.predecoded_core = !args.simavr_core;
+    o.translate_blocks = !args.no_block_translation;
     if (!args.freq.empty()) o.frequency_hz = parse_frequency_hz(args.freq, "--freq");
     o.duration_ps = parse_duration_ps(args.duration, "--for");
     o.duration_text = args.duration;
@@ -410,6 +413,9 @@ Command add_run_command(CLI::App& app) {
     run_cmd->add_flag("--simavr-core", run.simavr_core,
                       "execute every instruction on simavr's own avr_run_one instead of the predecoded core "
                       "(same results, slower; kept for one release to compare)");
+    run_cmd->add_flag("--no-block-translation", run.no_block_translation,
+                      "interpret every instruction on the predecoded core instead of running straight runs of "
+                      "register-only instructions as host code (same results, slower; to compare)");
     run_cmd->add_flag("--no-periodic-waves", run.no_periodic_waves,
                       "deliver every edge of a timer PWM through its net even when nothing records it "
                       "(heaters follow each edge instead of the mean power; slower)");

@@ -70,6 +70,10 @@ static const uint8_t core_sweep_table[4] PROGMEM = {0x5a, 0xa5, 0x00, 0xff};
                          : [a] "r"(a), [b] "r"(b)                                 \
                          : "r23", "r24", "r25")
 
+static uint8_t __attribute__((noinline)) core_sweep_twice(uint8_t v) { return (uint8_t)(v + v); }
+/* volatile: the call goes through the pointer (ICALL), not to the function. */
+static uint8_t (*volatile core_sweep_fn)(uint8_t) = core_sweep_twice;
+
 int main(void)
 {
     uint16_t sum = 0;
@@ -142,6 +146,10 @@ int main(void)
                              "add %A[s], __tmp_reg__\n\t"
                              : [s] "+r"(sum), "+y"(y)
                              : [v] "r"(a), [w] "r"(lpm_r0));
+        /* NOP inside a run of ALU instructions, and ICALL through a
+         * function pointer: compiled C rarely emits either. */
+        __asm__ __volatile__("mov r24, %[a]\n\tnop\n\tadd %A[s], r24\n\t" : [s] "+r"(sum) : [a] "r"(a) : "r24");
+        sum += core_sweep_fn(a);
     } while (++a != 0);
 
     core_sweep_sum = sum;

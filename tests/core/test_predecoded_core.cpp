@@ -118,6 +118,7 @@ TEST(PredecodedCore, MatchesAvrRunOneInstructionByInstructionOnEveryFirmware) {
     EXPECT_LT(total.handed * 4, total.instructions) << total.handed << " of " << total.instructions << " handed to avr_run_one";
     // Every kind the core executes itself ran somewhere.
     for (int kind = PredecodedCore::kNop; kind < PredecodedCore::kKinds; ++kind) {
+        if (kind == PredecodedCore::kBlock) continue;  // a handler only, never a slot's kind
         EXPECT_TRUE(total.kinds.count(kind)) << "no firmware executed predecoded kind " << kind;
     }
 }
