@@ -292,16 +292,32 @@ public:
     void store_cl_at_edx() { put({0x88, 0x0c, 0x17}); }       // mov %cl, (%rdi,%rdx,1)
 };
 
-// One instruction; `flags` false where every flag it sets is set again
-// before anything reads it.
-void emit(Emitter& e, const BlockTranslator::Instruction& in, bool flags, avr_flashaddr_t next_pc, std::int64_t charge_after,
+// How much of an instruction's flags the code computes: none (every flag
+// it sets is set again before anything reads it), only the host registers
+// (C in CF, Z in r9b: all that is read, by the next instruction, which
+// takes them from there and sets them again - the links of an ADC or CPC
+// chain), or SREG's bytes as well.
+enum class FlagWork { kNone, kRegisters, kAll };
+
+// One instruction.
+void emit(Emitter& e, const BlockTranslator::Instruction& in, FlagWork work, avr_flashaddr_t next_pc, std::int64_t charge_after,
           std::int64_t cycle_charge, const BlockTranslator::Memory& memory) {
     const unsigned a = in.a, b = in.b;
+    const bool flags = work == FlagWork::kAll;
+    const bool light = work == FlagWork::kRegisters;
+    // r9b = Z after a flag-setting instruction, without SREG.
+    const auto z_to_r9 = [&](bool keep_z) {
+        if (keep_z)
+            e.put({0x45, 0x0f, 0x45, 0xcb});  // cmovnz %r11d, %r9d
+        else
+            e.put({0x41, 0x0f, 0x94, 0xc1});  // setz %r9b
+        e.r9_is_z = true;
+    };
     // ADD/ADC/SUB/SBC and their compare and immediate forms: the host's own.
     const auto arith = [&](std::uint8_t mem_opcode, int imm_digit, bool carry, bool keep_z, bool store, bool immediate) {
-        if (!flags && !store) return;  // a compare nothing reads
+        if (!flags && !light && !store) return;  // a compare nothing reads
         e.load_cl(a);
-        if (keep_z && flags) e.z_in();
+        if (keep_z && (flags || light)) e.z_in();
         if (carry) e.carry_in();
         if (immediate)
             e.alu_cl_imm(imm_digit, b);
@@ -310,6 +326,7 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, bool flags, avr_fl
         e.cf_is_c = true;
         e.r9_is_z = false;
         if (flags) e.arith_flags(keep_z, false);
+        if (light) z_to_r9(keep_z);
         if (store) e.store_cl(a);
     };
     // AND, OR, EOR and their immediate forms, INC, DEC, COM: Z N V S.
@@ -330,9 +347,10 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, bool flags, avr_fl
         e.load_cl(a);
         if (rotate) e.carry_in();
         e.put({0xd0, modrm});                        // shr/sar/rcr %cl
-        e.put({0x41, 0x0f, 0x92, 0xc2});             // setc %r10b: the bit shifted out
         e.cf_is_c = true;
         e.r9_is_z = false;
+        if (light && !rotate) z_to_r9(false);        // (RCR sets no ZF: the translation asks for C only)
+        if (flags) e.put({0x41, 0x0f, 0x92, 0xc2});  // setc %r10b: the bit shifted out
         if (flags) {
             if (rotate) e.put({0x84, 0xc9});         // test %cl, %cl: RCR sets no ZF or SF
             e.flags_index(false, true);
@@ -383,6 +401,7 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, bool flags, avr_fl
             e.cf_is_c = true;
             e.r9_is_z = false;
             if (flags) e.arith_flags(false, false);
+            if (light) z_to_r9(false);
             e.store_cl(a);
             break;
         case Op::kMov:
@@ -434,6 +453,7 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, bool flags, avr_fl
             e.cf_is_c = true;
             e.r9_is_z = false;
             if (flags) e.arith_flags(false, true);
+            if (light) z_to_r9(false);
             e.store_cl(a);
             e.put({0x88, Emitter::at_data(Emitter::kCh), Emitter::u8(a + 1)});  // mov %ch, a+1(%rdi)
             break;
@@ -659,12 +679,36 @@ int BlockTranslator::translate(const Instruction* instructions, std::size_t coun
     if (code_ == nullptr || count == 0) return -1;
     // Which flags each instruction must leave: those read later in the
     // block before being set again, and all of them at its end.
-    std::vector<bool> flags_needed(count);
+    std::vector<unsigned> needed(count);  // the flags each sets that something reads
     unsigned live = kAllFlags;
     for (std::size_t i = count; i-- > 0;) {
         const unsigned written = flags_written(instructions[i]);
-        flags_needed[i] = (written & live) != 0;
+        needed[i] = written & live;
         live = (live & ~written) | flags_read(instructions[i]);
+    }
+    // Where only C and Z are read, by the next instruction alone (it sets
+    // them again), and it takes them from the host's CF and r9b (the
+    // arithmetic with a carry in, ROR), they stay in the host registers.
+    const auto keeps_c_z_in_registers = [](Op op, unsigned flags) {
+        switch (op) {
+            case Op::kAdd: case Op::kAdc: case Op::kSub: case Op::kSbc: case Op::kCp: case Op::kCpc: case Op::kCpi:
+            case Op::kSubi: case Op::kSbci: case Op::kNeg: case Op::kAdiw: case Op::kSbiw: case Op::kLsr: case Op::kAsr:
+                return true;
+            case Op::kRor: return (flags & kZ) == 0;
+            default: return false;
+        }
+    };
+    const auto takes_c_z_from_registers = [](Op op) {
+        return op == Op::kAdc || op == Op::kSbc || op == Op::kCpc || op == Op::kSbci || op == Op::kRor;
+    };
+    std::vector<FlagWork> work(count, FlagWork::kAll);
+    for (std::size_t i = 0; i < count; ++i) {
+        if (needed[i] == 0) {
+            work[i] = FlagWork::kNone;
+        } else if (i + 1 < count && (needed[i] & ~(kC | kZ)) == 0 && keeps_c_z_in_registers(instructions[i].op, needed[i]) &&
+                   takes_c_z_from_registers(instructions[i + 1].op) && (needed[i] & ~flags_written(instructions[i + 1])) == 0) {
+            work[i] = FlagWork::kRegisters;
+        }
     }
     const std::int64_t cycle_charge = std::int64_t{1} << step_bits;
     Emitter e;
@@ -679,7 +723,7 @@ int BlockTranslator::translate(const Instruction* instructions, std::size_t coun
         const std::int64_t charge_after = charge + cycles_of(op, memory.address_size) * cycle_charge + 1;
         e.pc_now = pc;
         e.charge_now = charge;
-        emit(e, instructions[i], flags_needed[i], next_pc, charge_after, cycle_charge, memory);
+        emit(e, instructions[i], work[i], next_pc, charge_after, cycle_charge, memory);
         pc = next_pc;
         charge = charge_after;
     }

@@ -107,6 +107,7 @@ public:
     // the interpreter runs them, as before). step_bits: the meter's layout.
     int translate(const Instruction* instructions, std::size_t count, avr_flashaddr_t head, const Memory& memory, int step_bits);
     const Block& block(std::size_t index) const { return blocks_[index]; }
+    const Block* block_array() const { return blocks_.data(); }
     std::size_t blocks() const { return blocks_.size(); }
     // Bit n set: some block held Op n (for the tests' coverage check).
     std::uint64_t ops_translated() const { return ops_translated_; }

@@ -712,17 +712,30 @@ checked_kBlock: {
     // Fuzzing counts every instruction's edge: one at a time. The block's
     // first instruction is its slot's kind; it never needs the oracles.
     if constexpr (kCover) goto* kHandlers[own_handler(*slot)];
-    const BlockTranslator::Block& block = cold.core->translator_->block(slot->target);
+    const BlockTranslator::Block* const blocks = cold.core->translator_->block_array();
+    const BlockTranslator::Block* block = &blocks[slot->target];
     // Entered only when the fuel covers all of it (else its instructions
     // run one by one, and the batch ends after the one that empties the
     // fuel, as without blocks); the code charges the meter for what it ran.
-    if (__builtin_expect(meter < block.max_charge, 0)) goto* kHandlers[own_handler(*slot)];
-    const BlockTranslator::Exit exit = block.code(data, sreg);
+    if (__builtin_expect(meter < block->max_charge, 0)) goto* kHandlers[own_handler(*slot)];
+    BlockTranslator::Exit exit = block->code(data, sreg);
     // It ran nothing: its first instruction is the interpreter's (an
     // access that is not plain RAM, say).
     if (__builtin_expect(exit.charge == 0, 0)) goto* kHandlers[own_handler(*slot)];
-    meter -= static_cast<std::int64_t>(exit.charge);
-    new_pc = exit.pc;
+    // Where the next instruction heads a block the fuel covers, that block
+    // runs straight away: a loop of blocks (a division's) goes round here
+    // without the dispatch in between. One that runs nothing goes back to
+    // the dispatch, which meets it again as above.
+    for (;;) {
+        meter -= static_cast<std::int64_t>(exit.charge);
+        new_pc = exit.pc;
+        const Slot* const next = reinterpret_cast<const Slot*>(reinterpret_cast<const char*>(slots) + new_pc * 8);
+        if (next->handler != kBlock) break;
+        block = &blocks[next->target];
+        if (meter < block->max_charge) break;
+        exit = block->code(data, sreg);
+        if (exit.charge == 0) break;
+    }
     AVRBENCH_DISPATCH();
 }
 op_kSimavr:
