@@ -244,28 +244,23 @@ void PredecodedCore::translate_from(avr_flashaddr_t pc) {
     if (!translator_) return;
     // A loop's head is the target of the branch at its end, usually not the
     // first instruction the dispatch met (the block that got there first
-    // ran through it): it gets a block of its own.
-    const auto branch_target = [&](const Slot& s, avr_flashaddr_t& target) {
-        if (s.kind != kBrbs && s.kind != kBrbc && s.kind != kRjmp && s.kind != kRcall) return false;
-        target = s.target;
-        return target < avr_->flashend && (target & 1) == 0;
-    };
-    avr_flashaddr_t target;
-    const Slot& at = slots_[pc >> 1];
-    if (branch_target(at, target)) {
-        if (slots_[target >> 1].handler != kBlock) {
-            if (slots_[target >> 1].kind == kUndecoded) slots_[target >> 1] = decode_checked(avr_, predecoded_detail::flash16(avr_->flash, target), target);
+    // ran through it): it gets a block of its own (translate_block decodes
+    // what it needs).
+    const auto translate_target = [&](const Slot& s) {
+        if (s.kind != kBrbs && s.kind != kBrbc && s.kind != kRjmp && s.kind != kRcall) return;
+        const avr_flashaddr_t target = s.target;
+        if (target < avr_->flashend && (target & 1) == 0 && target != pc && slots_[target >> 1].handler != kBlock) {
             translate_block(target);
         }
+    };
+    const Slot& at = slots_[pc >> 1];
+    if (at.kind == kBrbs || at.kind == kBrbc || at.kind == kRjmp || at.kind == kRcall) {
+        translate_target(at);
         return;
     }
     if (!translate_block(pc)) return;
     const BlockTranslator::Block& block = translator_->block(slots_[pc >> 1].target);
-    const Slot& last = slots_[(block.end - 2) >> 1];
-    if (branch_target(last, target) && target != pc && slots_[target >> 1].handler != kBlock) {
-        if (slots_[target >> 1].kind == kUndecoded) slots_[target >> 1] = decode_checked(avr_, predecoded_detail::flash16(avr_->flash, target), target);
-        translate_block(target);
-    }
+    translate_target(slots_[(block.end - 2) >> 1]);  // the branch that ends it, if one does
 }
 
 void PredecodedCore::invalidate(avr_flashaddr_t begin, avr_flashaddr_t end) {
