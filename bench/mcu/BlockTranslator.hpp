@@ -1,25 +1,29 @@
-// Straight runs of register-only AVR instructions translated into host
-// (x86-64) code, for PredecodedCore::run_batch: a block is one call where
-// the threaded interpreter paid a dispatch, a fuel test and a handler per
-// instruction (docs/PERFORMANCE.md, "Translated blocks").
+// Straight runs of AVR instructions translated into host (x86-64) code,
+// for PredecodedCore::run_batch: a block is one call where the threaded
+// interpreter paid a dispatch, a fuel test and a handler per instruction
+// (docs/PERFORMANCE.md, "Translated blocks").
 //
-// A block holds only instructions that touch nothing but the register file
-// (data[0..31]) and SREG: ALU operations, register moves, LDI, MUL, ADIW,
-// SBIW, BST/BLD and the flag sets and clears other than I - they call
-// nothing in simavr, cannot move SP or the PC anywhere but on, and so
-// cannot end a batch between them. It may end in a conditional branch or
-// an RJMP. run_batch enters a block only when the fuel covers all of it
-// (the cycle limit and the step limit), so no timer falls due inside it and
-// the batch ends where it would have one instruction at a time.
+// A block holds instructions that call nothing in simavr: ALU operations,
+// register moves, LDI, MUL, ADIW, SBIW, BST/BLD, the flag sets and clears
+// other than I, loads and stores of plain RAM, PUSH/POP, LPM; it may end
+// in a branch, RJMP, a call or a return. So no timer, IRQ or interrupt can
+// change inside it, and run_batch enters it only when the fuel covers all
+// of it (the cycle limit and the step limit): the batch ends where it
+// would have one instruction at a time. Whatever an instruction cannot do
+// there at run time (an access that is not plain RAM, the stack at the
+// crash oracle's floor, a new PC at the oracles' limits, Z past the flash)
+// the code leaves to the interpreter: it returns in front of it, with
+// every flag in SREG.
 //
 // Each instruction does what the predecoded core's handler does
-// (PredecodedOps.inc, simavr 1.6's avr_run_one), flags included: the
-// arithmetic ones from the host's own flags (as the handlers' add8/sub8),
-// the shifts from tables built from the handlers' formulas. A flag that a
-// later instruction of the same block sets again before anything reads it
-// is not computed (all flags are read at the block's end).
+// (PredecodedOps.inc, simavr 1.6's avr_run_one), flags included: from the
+// host's own flags (as the handlers' add8/sub8) through tables built from
+// the handlers' formulas. A flag that a later instruction of the same block
+// sets again before anything reads it is not computed; C and Z that only
+// the next instruction reads, from the host's registers, are not stored.
 // Proven against the interpreter and avr_run_one by the batched-run tests
-// (core_sweep's every operand pair, every firmware, the workload suite).
+// (core_sweep's every operand pair, every firmware, the workload suite)
+// and tests/core/test_block_translator.cpp.
 #pragma once
 
 #include <cstddef>

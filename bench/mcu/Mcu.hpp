@@ -58,7 +58,7 @@ struct McuOptions {
     // avr_run_one itself (`--simavr-core`; kept selectable for one release).
     // The reference run loop always uses avr_run_one.
     bool predecoded_core = true;
-    // On the predecoded core, run straight runs of register-only
+    // On the predecoded core, run straight runs of
     // instructions as host code (mcu/BlockTranslator.hpp; x86-64 hosts).
     // Exact like the rest of the core; off only to measure or compare.
     bool translate_blocks = true;

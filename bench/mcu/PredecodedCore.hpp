@@ -19,6 +19,9 @@
 // store, RETI, SLEEP, BREAK, WDR, SPM, ELPM past the flash, a data address outside RAM, a
 // PC past the flash, invalid opcodes, and every access while simavr's own
 // GDB stub is attached (its watchpoints).
+// On x86-64, run_batch runs straight runs of instructions as host code
+// (mcu/BlockTranslator.hpp), each entered where a run begins: a slot
+// heading one has the handler kBlock.
 // Exactness is proven instruction by instruction against avr_run_one on
 // every firmware the build makes (tests/core/test_predecoded_core.cpp) and
 // by every run-loop, scenario and golden test, which run on this core.
@@ -82,7 +85,7 @@ public:
     // code_end_minus_one and bad_interrupt_pc: the crash oracles' limits
     // Mcu::run_until will pass in BatchLimits (decoding records which
     // instructions can reach them; other limits later cost one re-decode).
-    // translate_blocks: run straight runs of register-only instructions as
+    // translate_blocks: run straight runs of instructions as
     // host code (mcu/BlockTranslator.hpp) where the host has it.
     explicit PredecodedCore(avr_t* avr, std::uint32_t code_end_minus_one = 0, std::uint32_t bad_interrupt_pc = ~0u,
                             bool translate_blocks = true);
