@@ -211,6 +211,12 @@ public:
         exit_values(pc, charge);
         put({0xc3});
     }
+    // The same with the new PC already in eax (RET, IJMP, ICALL).
+    void ret_pc_in_eax(std::int64_t charge) {
+        put({0xba});  // mov $charge, %edx
+        put32(static_cast<std::uint32_t>(charge));
+        put({0xc3});
+    }
 
     // Side exits: in front of the instruction being emitted (pc_now), with
     // the charge of those before it; the stubs go after the block's body.
@@ -531,9 +537,7 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, FlagWork work, avr
             e.exit_unless_pc_passes(memory);
             e.add_edx(static_cast<int>(size));
             e.store_dx_pair(R_SPL);
-            e.put({0xba});                                  // mov $charge, %edx
-            e.put32(static_cast<std::uint32_t>(charge_after));
-            e.put({0xc3});
+            e.ret_pc_in_eax(charge_after);
         } break;
         case Op::kIjmp:
         case Op::kIcall:
@@ -547,9 +551,7 @@ void emit(Emitter& e, const BlockTranslator::Instruction& in, FlagWork work, avr
                 e.push_return(next_pc, memory);
                 e.put({0x44, 0x89, 0xd0});                  // mov %r10d, %eax
             }
-            e.put({0xba});                                  // mov $charge, %edx
-            e.put32(static_cast<std::uint32_t>(charge_after));
-            e.put({0xc3});
+            e.ret_pc_in_eax(charge_after);
             break;
         // LD/ST Rd, X/Y/Z (+/-): the pointer written back before Rd, as the
         // interpreter does (simavr's order, for the undefined LD r26, X+).
